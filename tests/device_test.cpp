@@ -1,0 +1,120 @@
+// tests/device_test.cpp — the OpenCL host: embedded kernels with #line markers, the program cache,
+// BuildError carrying the log with the real file and line, named launches, device choice.
+#include "host/device.h"
+#include "host/embedded_kernels.h"
+#include "host/errors.h"
+#include "tests/test_util.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+namespace {
+
+TEST(Device, EmbeddedSourcesStartWithLineMarkersAndInlineHeaders)
+{
+    const auto& kernels = clvr::embeddedKernels();
+    const auto it = std::find_if(kernels.begin(), kernels.end(), [](const auto& k) { return k.name == "util.cl"; });
+    ASSERT_NE(it, kernels.end());
+    EXPECT_EQ(it->source.substr(0, 25), "#line 1 \"kernels/util.cl\"");
+    // The include on line 2 is replaced by the header, then a marker back to line 3.
+    EXPECT_NE(it->source.find("#line 1 \"kernels/clvr_common.h\""), std::string_view::npos);
+    EXPECT_NE(it->source.find("#line 3 \"kernels/util.cl\""), std::string_view::npos);
+    EXPECT_EQ(it->source.find("#include \"clvr_common.h\""), std::string_view::npos);
+}
+
+TEST(Device, FillKernelWritesEveryElementOfAnOddSizedBuffer)
+{
+    clvr::Device& device = clvr::test::device();
+    const cl_uint n = 1000;  // not a multiple of 64: exercises padding and the guard
+    std::vector<float> init(n + 24, -1.0f);
+    cl::Buffer buffer = device.upload("test buffer", init, CL_MEM_READ_WRITE);
+    cl::Kernel k = device.kernel("util.cl", "fill_float");
+    k.setArg(0, buffer);
+    k.setArg(1, 2.5f);
+    k.setArg(2, n);
+    device.launch("fill", k, n);
+    const std::vector<float> out = device.download<float>(buffer, n + 24);
+    for (cl_uint i = 0; i < n; ++i)
+        ASSERT_EQ(out[i], 2.5f) << "element " << i;
+    for (cl_uint i = n; i < n + 24; ++i)
+        ASSERT_EQ(out[i], -1.0f) << "element " << i << " past the guard was written";
+    const auto times = device.takePassTimes();
+    ASSERT_EQ(times.size(), 1u);
+    EXPECT_EQ(times[0].name, "fill");
+    EXPECT_GE(times[0].ms, 0.0);
+}
+
+TEST(Device, ProgramCacheReturnsTheSameProgram)
+{
+    clvr::Device& device = clvr::test::device();
+    const std::string source = "kernel void twice(global float* x) { x[get_global_id(0)] *= 2.0f; }";
+    cl::Program a = device.program("cache test", source, std::string(clvr::kBuildOptions));
+    const double after = device.compileMs();
+    cl::Program b = device.program("cache test", source, std::string(clvr::kBuildOptions));
+    EXPECT_EQ(a(), b());
+    EXPECT_EQ(device.compileMs(), after) << "a cache hit must not build again";
+    cl::Program c = device.program("cache test", source, std::string(clvr::kBuildOptions) + " -DX=1");
+    EXPECT_NE(a(), c()) << "other options are another program";
+}
+
+TEST(Device, BuildFailureCarriesTheLogWithFileAndLine)
+{
+    clvr::Device& device = clvr::test::device();
+    const std::string source = "#line 1 \"kernels/broken.cl\"\nkernel void broken(global float* x)\n{\n    x[0] = z;\n}\n";
+    try {
+        device.program("kernels/broken.cl", source, std::string(clvr::kBuildOptions));
+        FAIL() << "a kernel using an undeclared identifier built";
+    } catch (const clvr::BuildError& e) {
+        EXPECT_NE(std::string(e.what()).find("kernels/broken.cl"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("-cl-std=CL1.2"), std::string::npos) << e.what();
+        EXPECT_NE(e.log.find("kernels/broken.cl:3"), std::string::npos) << e.log;
+        EXPECT_NE(e.log.find("'z'"), std::string::npos) << e.log;
+    }
+}
+
+TEST(Device, FragmentProgramIsAppendedAndCachedSeparately)
+{
+    clvr::Device& device = clvr::test::device();
+    // util.cl declares nothing for it, so a self-contained extra kernel must work.
+    cl::Kernel k = device.kernel("util.cl", "extra", "kernel void extra(global float* x) { x[0] = 7.0f; }");
+    std::vector<float> v(1, 0.0f);
+    cl::Buffer b = device.upload("x", v, CL_MEM_READ_WRITE);
+    k.setArg(0, b);
+    device.launch("extra", k, 1);
+    EXPECT_EQ(device.download<float>(b, 1)[0], 7.0f);
+    device.takePassTimes();
+    EXPECT_THROW(device.kernel("util.cl", "extra"), clvr::DeviceError) << "without the fragment program there is no kernel 'extra'";
+}
+
+TEST(Device, ChoiceByIndexNameAndBadSpec)
+{
+    const auto all = clvr::listDevices();
+    ASSERT_FALSE(all.empty());
+    EXPECT_EQ(clvr::chooseDevice("0").name, all[0].name);
+    EXPECT_EQ(clvr::chooseDevice(all[0].name.substr(0, 4)).name, all[0].name);
+    EXPECT_THROW(clvr::chooseDevice("no-such-device-xyz"), clvr::DeviceError);
+    EXPECT_THROW(clvr::chooseDevice("99"), clvr::DeviceError);
+}
+
+TEST(Device, OversizedBufferIsAClearDeviceError)
+{
+    clvr::Device& device = clvr::test::device();
+    const std::size_t huge = static_cast<std::size_t>(device.listing().globalMemBytes) * 4;
+    try {
+        device.buffer("huge volume", huge);
+        FAIL() << "allocating 4x the device memory succeeded";
+    } catch (const clvr::DeviceError& e) {
+        EXPECT_NE(std::string(e.what()).find("out of device memory"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("huge volume"), std::string::npos) << e.what();
+    }
+}
+
+TEST(Device, ErrorNamesAreSymbolic)
+{
+    EXPECT_EQ(clvr::clErrorName(-5), "CL_OUT_OF_RESOURCES");
+    EXPECT_EQ(clvr::clErrorName(-11), "CL_BUILD_PROGRAM_FAILURE");
+    EXPECT_EQ(clvr::clErrorName(-12345), "CL error -12345");
+}
+
+}  // namespace

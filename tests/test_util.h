@@ -1,0 +1,50 @@
+// tests/test_util.h — what every suite shares: the test device, image comparison with stated
+// tolerances (NaN never passes, failure images written), seeded randomness, data paths.
+#pragma once
+
+#include "host/device.h"
+#include "host/image.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <string>
+
+namespace clvr::test {
+
+// CLVR_DEVICE, else the first CPU device (PoCL); opened once per process.
+Device& device();
+
+// ../shared/data/<relative>, and the repository's own data/<relative>.
+std::string sharedData(const std::string& relative);
+std::string repoData(const std::string& relative);
+
+struct Tolerance {
+    double maxAbs = 0.0;   // per channel, every pixel
+    double meanAbs = 0.0;  // per channel, averaged over the image
+};
+
+struct ImageError {
+    glm::dvec4 maxAbs{0.0};
+    glm::dvec4 meanAbs{0.0};
+    std::size_t nanCount = 0;
+};
+ImageError imageError(const Image4f& actual, const Image4d& expected);
+
+// Per channel max and mean absolute error against `expected`; fails on NaN or size mismatch.
+// On failure writes test_output/<suite>.<test>/{actual,expected,diff}.exr and says so.
+testing::AssertionResult imagesNear(const Image4f& actual, const Image4d& expected, Tolerance tolerance);
+
+// A small deterministic generator (splitmix64): the same numbers on every standard library.
+class Rng {
+public:
+    explicit Rng(std::uint64_t seed) : state_(seed) {}
+    std::uint64_t next();
+    double uniform(double lo = 0.0, double hi = 1.0);  // [lo, hi)
+    int integer(int lo, int hi);                       // [lo, hi]
+
+private:
+    std::uint64_t state_;
+};
+
+}  // namespace clvr::test
