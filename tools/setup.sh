@@ -1,0 +1,58 @@
+#!/usr/bin/env bash
+# tools/setup.sh — one command from a fresh Debian 12 machine (as root) to a result:
+#   bash tools/setup.sh          install what is missing, build, render the default scene to out/default.png
+#   bash tools/setup.sh test     install what is missing, build, run every test (ctest), then the host
+#                                code's tests again under AddressSanitizer + UndefinedBehaviorSanitizer
+# Environment: JOBS (parallel build jobs, default: number of cores), CLVR_SKIP_ASAN=1 skips the sanitizer pass.
+set -euo pipefail
+mode="${1:-render}"
+case "$mode" in render | test) ;; *)
+    echo "usage: bash tools/setup.sh [render|test]" >&2
+    exit 2
+    ;;
+esac
+cd "$(dirname "$0")/.."
+jobs="${JOBS:-$(nproc)}"
+
+packages=(cmake make g++ pkg-config clang
+    pocl-opencl-icd ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers
+    libglm-dev libopenimageio-dev openimageio-tools libtet1.5-dev nlohmann-json3-dev libcli11-dev
+    libgtest-dev libbenchmark-dev zlib1g-dev)
+missing=()
+for p in "${packages[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+    echo "clvr setup: installing ${missing[*]}"
+    if [ "$(id -u)" -ne 0 ]; then
+        echo "clvr setup: these Debian packages are missing and installing them needs root: ${missing[*]}" >&2
+        exit 1
+    fi
+    apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+echo "clvr setup: building (build/, $jobs jobs)"
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build build -j "$jobs"
+export POCL_CACHE_DIR="$PWD/build/pocl-cache"
+
+if [ "$mode" = render ]; then
+    mkdir -p out
+    ./build/clvr info
+    ./build/clvr render data/scenes/default.json -o out/default.png --stats out/default-stats.json
+    echo "clvr setup: the default scene is in $PWD/out/default.png (stats: out/default-stats.json)"
+    exit 0
+fi
+
+echo "clvr setup: running every test (build/)"
+ctest --test-dir build --output-on-failure -j "$jobs" --timeout 900
+
+if [ "${CLVR_SKIP_ASAN:-0}" != 1 ]; then
+    echo "clvr setup: host code under ASan + UBSan (build-asan/)"
+    cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCLVR_SANITIZE=ON >/dev/null
+    cmake --build build-asan -j "$jobs"
+    # The sanitizer pass runs the suites that exercise host code (parsing, readers, device host,
+    # errors, the command line); the long image-accuracy suites run once, above.
+    ctest --test-dir build-asan --output-on-failure -j "$jobs" --timeout 900 -L host
+fi
