@@ -517,7 +517,29 @@ NrrdHeader readNrrdHeader(const fs::path& path)
             }
             h.spacings = s;
         } else if (key == "spacedirections") {
-            h.directions = splitWhitespace(value);
+            // "(1,0,0) (0,1,0) none": a vector may hold spaces, "(1, 0, 0)", so split on parentheses.
+            std::vector<std::string> dirs;
+            for (std::size_t i = 0; i < value.size();) {
+                if (std::isspace(static_cast<unsigned char>(value[i]))) {
+                    ++i;
+                    continue;
+                }
+                std::size_t j = i;
+                if (value[i] == '(') {
+                    j = value.find(')', i);
+                    j = j == std::string::npos ? value.size() : j + 1;
+                } else {
+                    while (j < value.size() && !std::isspace(static_cast<unsigned char>(value[j])))
+                        ++j;
+                }
+                std::string d;
+                for (std::size_t k = i; k < j; ++k)
+                    if (!std::isspace(static_cast<unsigned char>(value[k])))
+                        d += value[k];
+                dirs.push_back(d);
+                i = j;
+            }
+            h.directions = dirs;
         } else if (key == "spaceorigin") {
             h.origin = value;
         } else if (key == "space") {
@@ -679,8 +701,13 @@ void readNrrdData(const NrrdHeader& h, const fs::path& file, std::uint64_t start
         while (i < data.size() && (std::isspace(data[i]) || data[i] == ','))
             ++i;
         token.clear();
-        while (i < data.size() && !std::isspace(data[i]) && data[i] != ',' && token.size() < 64)
-            token += static_cast<char>(data[i++]);
+        while (i < data.size() && !std::isspace(data[i]) && data[i] != ',') {
+            if (token.size() < 64)
+                token += static_cast<char>(data[i]);
+            else if (token.size() == 64)
+                token += "...";  // a 64-character number is garbage: fail on it, do not split it
+            ++i;
+        }
         if (!token.empty()) {
             storeAsciiValue(source, token, first + n, &value);
             out.push_back(value);
@@ -1075,8 +1102,13 @@ Volume readVtkStructuredPoints(const fs::path& path)
             while (pos < text.size() && std::isspace(static_cast<unsigned char>(text[pos])))
                 ++pos;
             token.clear();
-            while (pos < text.size() && !std::isspace(static_cast<unsigned char>(text[pos])) && token.size() < 64)
-                token += text[pos++];
+            while (pos < text.size() && !std::isspace(static_cast<unsigned char>(text[pos]))) {
+                if (token.size() < 64)
+                    token += text[pos];
+                else if (token.size() == 64)
+                    token += "...";  // a 64-character number is garbage: fail on it, do not split it
+                ++pos;
+            }
             if (!token.empty()) {  // values grow with what the file holds, not with what it claims
                 float value = 0.0f;
                 storeAsciiValue(source, token, n, &value);
@@ -1109,7 +1141,8 @@ Volume loadVolume(const nlohmann::json& spec, const fs::path& baseDir)
     const fs::path file = jsonString(spec, "file");
     const fs::path path = file.is_absolute() ? file : baseDir / file;
     const std::string ext = lower(file.extension().string());
-    if (spec.contains("dims") || ext == ".raw") {
+    const bool selfDescribing = ext == ".nrrd" || ext == ".nhdr" || ext == ".vtk";
+    if (!selfDescribing && (spec.contains("dims") || ext == ".raw")) {
         checkKeys(spec, {"file", "dims", "type", "endian", "spacing", "origin", "header_bytes"}, "a raw file");
         RawLayout layout;
         layout.dims = jsonDims(spec);

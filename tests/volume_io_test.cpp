@@ -353,8 +353,8 @@ TEST(VolumeIo, NrrdDetachedSingleFileWithSpaceDirections)
     fs::create_directories(dir / "sub");
     writeFile(dir / "sub" / "v.raw", encode(ScalarType::Int16, values, Endian::Big));
     writeFile(dir / "v.nhdr", "NRRD0005\ntype: int16\ndimension: 3\nsizes: 5 4 6\n"
-                              "space: left-posterior-superior\nspace directions: (0.5,0,0) (0,0.25,0) (0,0,2)\n"
-                              "space origin: (-1.5,0,2.25)\nkinds: domain domain domain\nendian: big\n"
+                              "space: left-posterior-superior\nspace directions: (0.5,0,0) (0, 0.25, 0)\t( 0,0,2 )\n"
+                              "space origin: (-1.5, 0, 2.25)\nkinds: domain domain domain\nendian: big\n"
                               "encoding: raw\ndata file: sub/v.raw\n");
     const clvr::Volume v = clvr::loadVolume({{"file", "v.nhdr"}}, dir.path());
     expectValues(v, values);
@@ -527,6 +527,7 @@ TEST(VolumeIo, LoadVolumeRejectsUnknownKeysAndBadValues)
     EXPECT_TRUE(throwsInputError(
         load({{"file", "x.raw"}, {"dims", {4, 4, 4}}, {"type", "uint8"}, {"header_bytes", -1}}), {"\"header_bytes\""}));
     EXPECT_TRUE(throwsInputError(load({{"file", "x.img"}}), {"x.img", "unknown volume format"}));
+    EXPECT_TRUE(throwsInputError(load({{"file", "x.nrrd"}, {"dims", {4, 4, 4}}}), {"unknown key \"dims\"", ".nrrd"}));
     EXPECT_TRUE(throwsInputError(load({{"file", 7}}), {"\"file\" must be a string"}));
 }
 
@@ -656,6 +657,8 @@ TEST(VolumeIo, NrrdDataTooShortSaysBothSizes)
     EXPECT_TRUE(throwsInputError([&] { clvr::readNrrd(dir / "t.nrrd"); }, {"t.nrrd", "120 values, file has 5"}));
     writeFile(dir / "w.nrrd", nrrdHeader("double", "\n", "ascii") + "1 2 x3\n");
     EXPECT_TRUE(throwsInputError([&] { clvr::readNrrd(dir / "w.nrrd"); }, {"w.nrrd", "\"x3\", not a number"}));
+    writeFile(dir / "l.nrrd", nrrdHeader("double", "\n", "ascii") + "1 2 " + std::string(70, '1') + "\n");
+    EXPECT_TRUE(throwsInputError([&] { clvr::readNrrd(dir / "l.nrrd"); }, {"l.nrrd", "value 2", "not a number"}));
 }
 
 TEST(VolumeIo, NrrdGzipTruncatedOrCorrupt)
