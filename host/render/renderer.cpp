@@ -1,0 +1,24 @@
+// host/render/renderer.cpp — technique names and the factory makeRenderer.
+#include "host/render/renderer.h"
+
+#include "host/errors.h"
+#include "host/render/slice3d.h"
+
+namespace clvr {
+
+std::vector<std::string> techniqueNames() { return {"slice3d"}; }
+
+std::unique_ptr<Renderer> makeRenderer(Device& device, const Scene& scene, const Volume& volume)
+{
+    if (scene.technique == "slice3d") {
+        if (volume.values.empty())
+            throw InputError("technique slice3d needs a regular-grid \"volume\", and the scene has none");
+        return makeSlice3dRenderer(device, scene, volume);
+    }
+    std::string known;
+    for (const std::string& name : techniqueNames())
+        known += (known.empty() ? "" : ", ") + name;
+    throw InputError("technique: unknown technique \"" + scene.technique + "\" (known: " + known + ")");
+}
+
+}  // namespace clvr

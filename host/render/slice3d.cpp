@@ -1,0 +1,378 @@
+// host/render/slice3d.cpp — options, slice planning, slice polygons, and the two paths of the
+// slice3d technique: the fused kernel (kernels/slice3d.cl: slice3d_fused) and the pass-by-pass
+// path through raster::draw with kernels/slice3d.cl as fragment program.
+#include "host/render/slice3d.h"
+
+#include "host/embedded_kernels.h"
+#include "host/errors.h"
+#include "raster/framebuffer.h"
+#include "raster/rasterizer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+namespace clvr {
+namespace {
+
+constexpr int kMaxSlices = 65536;
+constexpr const char* kKnownOptions = "slices, slice_spacing, order, early_termination, path";
+
+[[noreturn]] void badOption(const std::string& key, const std::string& what)
+{
+    throw InputError("options." + key + ": " + what);
+}
+
+cl_float4 toCl4(const glm::dvec3& v, double w = 0.0)
+{
+    return {{static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z), static_cast<float>(w)}};
+}
+
+class Slice3dRenderer final : public Renderer {
+public:
+    Slice3dRenderer(Device& device, const Scene& scene, const Volume& volume);
+    Image4f render(FrameStats& stats) override;
+    std::uint64_t residentBytes() const override { return residentBytes_; }
+
+private:
+    Image4f renderFused(FrameStats& stats);
+    Image4f renderRaster(FrameStats& stats);
+    cl_float4 cameraParams() const;
+
+    Device& device_;
+    Slice3dOptions options_;
+    Camera camera_;
+    ImageSpec image_;
+    glm::ivec3 dims_;
+    glm::dvec3 origin_, spacing_, lo_, hi_;
+    int tfCount_ = 0;
+    SlicePlan plan_;
+    cl::Buffer volume_, tf_;
+    std::uint64_t residentBytes_ = 0;
+    // Fused path.
+    cl::Kernel fused_;
+    cl::Buffer out_, samples_;
+    // Pass-by-pass path.
+    std::unique_ptr<raster::Framebuffer> framebuffer_;
+    raster::FragmentProgram fragmentProgram_;
+    cl::Kernel overBackground_;
+};
+
+Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volume& volume)
+    : device_(device), options_(parseSlice3dOptions(scene.options)), image_(scene.image)
+{
+    volume.validate();
+    dims_ = volume.dims;
+    origin_ = volume.origin;
+    spacing_ = volume.spacing;
+    lo_ = volume.boundsMin();
+    hi_ = volume.boundsMax();
+    camera_ = scene.camera ? *scene.camera : fitCamera(lo_, hi_);
+    camera_.validate();
+    if (image_.width < 1 || image_.height < 1)
+        throw InputError("image: width and height must be >= 1");
+    plan_ = planSlices(camera_, lo_, hi_, options_);
+
+    // float32 on the device, 4 bytes per grid point; Device::buffer throws DeviceError if too big.
+    volume_ = device_.upload("slice3d volume (float32)", volume.values);
+    const std::vector<float> tf = packTransferFunction(scene.transferFunction);
+    tfCount_ = static_cast<int>(scene.transferFunction.points().size());
+    tf_ = device_.upload("slice3d transfer function", tf);
+    residentBytes_ = volume.values.size() * sizeof(float) + tf.size() * sizeof(float);
+
+    const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
+    if (options_.path == Slice3dOptions::Path::Fused) {
+        fused_ = device_.kernel("slice3d.cl", "slice3d_fused");
+        out_ = device_.buffer("slice3d image", pixels * sizeof(cl_float4), CL_MEM_WRITE_ONLY);
+        samples_ = device_.buffer("slice3d sample counts", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
+    } else {
+        framebuffer_ = std::make_unique<raster::Framebuffer>(device_, image_.width, image_.height);
+        overBackground_ = device_.kernel("slice3d.cl", "slice3d_over_background");
+        std::string_view source;
+        for (const EmbeddedKernel& k : embeddedKernels())
+            if (k.name == "slice3d.cl")
+                source = k.source;
+        fragmentProgram_.source = "#define CLVR_SLICE3D_FRAGMENT 1\n" + std::string(source);
+        fragmentProgram_.buffers[0] = volume_;
+        fragmentProgram_.buffers[1] = tf_;
+        const glm::dvec3 invSpacing = 1.0 / spacing_;
+        fragmentProgram_.uniforms = {
+            glm::vec4(glm::vec3(camera_.position), 0.0f),
+            glm::vec4(glm::vec3(camera_.forward()), 0.0f),
+            glm::vec4(glm::vec3(camera_.right()), 0.0f),
+            glm::vec4(glm::vec3(camera_.up()), 0.0f),
+            glm::vec4(cameraParams().s[0], cameraParams().s[1], cameraParams().s[2], 0.0f),
+            glm::vec4(image_.width, image_.height, static_cast<float>(plan_.deltaS), tfCount_),
+            glm::vec4(glm::vec3(origin_), 0.0f),
+            glm::vec4(glm::vec3(invSpacing), 0.0f),
+            glm::vec4(dims_.x, dims_.y, dims_.z, 0.0f),
+        };
+    }
+}
+
+cl_float4 Slice3dRenderer::cameraParams() const
+{
+    const double aspect = static_cast<double>(image_.width) / image_.height;
+    const double scale = camera_.parallel ? camera_.parallelScale : std::tan(glm::radians(camera_.viewAngle) * 0.5);
+    return {{static_cast<float>(scale), static_cast<float>(aspect), camera_.parallel ? 1.0f : 0.0f, 0.0f}};
+}
+
+Image4f Slice3dRenderer::render(FrameStats& stats)
+{
+    const auto start = std::chrono::steady_clock::now();
+    Image4f image = options_.path == Slice3dOptions::Path::Fused ? renderFused(stats) : renderRaster(stats);
+    stats.frameMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    stats.extra["slices"] = plan_.count;
+    stats.extra["slice_spacing"] = plan_.deltaS;
+    stats.extra["depth_range"] = {plan_.depthMin, plan_.depthMax};
+    stats.extra["order"] = options_.order == Slice3dOptions::Order::BackToFront ? "back-to-front" : "front-to-back";
+    stats.extra["path"] = options_.path == Slice3dOptions::Path::Fused ? "fused" : "raster";
+    stats.extra["early_termination"] = options_.earlyTermination;
+    stats.extra["voxels"] = static_cast<std::uint64_t>(dims_.x) * dims_.y * dims_.z;
+    stats.extra["resident_bytes"] = residentBytes_;
+    return image;
+}
+
+Image4f Slice3dRenderer::renderFused(FrameStats& stats)
+{
+    const glm::dvec3 invSpacing = 1.0 / spacing_;
+    const bool frontToBack = options_.order == Slice3dOptions::Order::FrontToBack;
+    // ERT threshold 1.0 means off: pass a value accumulated opacity can never reach.
+    const float ert = options_.earlyTermination < 1.0 ? static_cast<float>(options_.earlyTermination) : 2.0f;
+    int a = 0;
+    fused_.setArg(a++, out_);
+    fused_.setArg(a++, samples_);
+    fused_.setArg(a++, static_cast<cl_int>(image_.width));
+    fused_.setArg(a++, static_cast<cl_int>(image_.height));
+    fused_.setArg(a++, volume_);
+    fused_.setArg(a++, cl_int4{{dims_.x, dims_.y, dims_.z, 0}});
+    fused_.setArg(a++, toCl4(origin_));
+    fused_.setArg(a++, toCl4(invSpacing));
+    fused_.setArg(a++, tf_);
+    fused_.setArg(a++, static_cast<cl_int>(tfCount_));
+    fused_.setArg(a++, toCl4(camera_.position));
+    fused_.setArg(a++, toCl4(camera_.forward()));
+    fused_.setArg(a++, toCl4(camera_.right()));
+    fused_.setArg(a++, toCl4(camera_.up()));
+    fused_.setArg(a++, cameraParams());
+    fused_.setArg(a++, static_cast<cl_float>(plan_.depth(0)));
+    fused_.setArg(a++, static_cast<cl_float>(plan_.deltaS));
+    fused_.setArg(a++, static_cast<cl_int>(plan_.count));
+    fused_.setArg(a++, static_cast<cl_int>(frontToBack ? 1 : 0));
+    fused_.setArg(a++, static_cast<cl_float>(ert));
+    fused_.setArg(a++, toCl4(image_.background, 0.0));
+    device_.launch("slice3d: fused", fused_, image_.width, image_.height);
+
+    const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
+    Image4f image(image_.width, image_.height);
+    device_.queue().enqueueReadBuffer(out_, CL_FALSE, 0, pixels * sizeof(glm::vec4), image.pixels().data());
+    const std::vector<cl_uint> counts = device_.download<cl_uint>(samples_, pixels);
+    stats.samples = std::accumulate(counts.begin(), counts.end(), std::uint64_t(0));
+    stats.passes = device_.takePassTimes();
+    return image;
+}
+
+Image4f Slice3dRenderer::renderRaster(FrameStats& stats)
+{
+    const bool frontToBack = options_.order == Slice3dOptions::Order::FrontToBack;
+    // Clip-space vertices of every slice polygon, fanned into a triangle list, in blending order.
+    const glm::dvec3 forward = camera_.forward();
+    const double nearZ = 0.5 * plan_.depth(0);
+    const double farZ = 2.0 * plan_.depthMax + 1.0;
+    const glm::dmat4 viewProjection =
+        camera_.projectionMatrix(image_.width, image_.height, nearZ, farZ) * camera_.viewMatrix();
+    std::vector<raster::Vertex> vertices;
+    vertices.reserve(static_cast<std::size_t>(plan_.count) * 12);
+    for (int i = 0; i < plan_.count; ++i) {
+        const int k = frontToBack ? i : plan_.count - 1 - i;
+        const double offset = glm::dot(forward, camera_.position) + plan_.depth(k);
+        const std::vector<glm::dvec3> polygon = slicePolygon(lo_, hi_, forward, offset);
+        auto vertex = [&](const glm::dvec3& p) {
+            raster::Vertex v;
+            v.position = glm::vec4(viewProjection * glm::dvec4(p, 1.0));
+            v.attributes[0] = glm::vec4(glm::vec3(p), 1.0f);
+            return v;
+        };
+        for (std::size_t j = 1; j + 1 < polygon.size(); ++j) {
+            vertices.push_back(vertex(polygon[0]));
+            vertices.push_back(vertex(polygon[j]));
+            vertices.push_back(vertex(polygon[j + 1]));
+        }
+    }
+    raster::DrawState state;
+    state.fragment.blend.enabled = true;
+    if (frontToBack) {  // "under": dst += (1 - dst.a) src
+        state.fragment.blend.srcRgb = state.fragment.blend.srcAlpha = raster::BlendFactor::OneMinusDstAlpha;
+        state.fragment.blend.dstRgb = state.fragment.blend.dstAlpha = raster::BlendFactor::One;
+    } else {            // "over" on premultiplied color: dst = src + (1 - src.a) dst
+        state.fragment.blend.srcRgb = state.fragment.blend.srcAlpha = raster::BlendFactor::One;
+        state.fragment.blend.dstRgb = state.fragment.blend.dstAlpha = raster::BlendFactor::OneMinusSrcAlpha;
+    }
+    framebuffer_->clearColor(device_, glm::vec4(0.0f));
+    raster::DrawStats drawStats;
+    if (!vertices.empty())
+        drawStats = raster::draw(device_, *framebuffer_, state, raster::Topology::Triangles, vertices, fragmentProgram_);
+    const std::size_t pixels = framebuffer_->pixelCount();
+    overBackground_.setArg(0, framebuffer_->color());
+    overBackground_.setArg(1, static_cast<cl_int>(pixels));
+    overBackground_.setArg(2, toCl4(image_.background, 0.0));
+    device_.launch("slice3d: over background", overBackground_, pixels);
+    Image4f image = framebuffer_->readColor(device_);
+    stats.passes = device_.takePassTimes();
+    stats.samples = drawStats.fragments;  // fragments of slice polygons; those outside the grid are discarded
+    stats.extra["triangles"] = drawStats.triangles;
+    return image;
+}
+
+}  // namespace
+
+Slice3dOptions parseSlice3dOptions(const nlohmann::json& options)
+{
+    Slice3dOptions o;
+    if (options.is_null())
+        return o;
+    if (!options.is_object())
+        throw InputError("options: must be an object");
+    for (const auto& [key, value] : options.items()) {
+        if (key == "slices") {
+            if (!value.is_number_integer())
+                badOption(key, "must be an integer, got " + value.dump());
+            const auto n = value.get<long long>();
+            if (n < 1 || n > kMaxSlices)
+                badOption(key, "must be in [1, " + std::to_string(kMaxSlices) + "], got " + std::to_string(n));
+            o.slices = static_cast<int>(n);
+        } else if (key == "slice_spacing") {
+            if (!value.is_number() || !(value.get<double>() > 0.0) || !std::isfinite(value.get<double>()))
+                badOption(key, "must be a positive number (world units), got " + value.dump());
+            o.sliceSpacing = value.get<double>();
+        } else if (key == "order") {
+            const std::string s = value.is_string() ? value.get<std::string>() : "";
+            if (s == "back-to-front")
+                o.order = Slice3dOptions::Order::BackToFront;
+            else if (s == "front-to-back")
+                o.order = Slice3dOptions::Order::FrontToBack;
+            else
+                badOption(key, "must be \"back-to-front\" or \"front-to-back\", got " + value.dump());
+        } else if (key == "early_termination") {
+            if (!value.is_number() || !(value.get<double>() > 0.0 && value.get<double>() <= 1.0))
+                badOption(key, "must be an opacity in (0, 1] (1 = off), got " + value.dump());
+            o.earlyTermination = value.get<double>();
+        } else if (key == "path") {
+            const std::string s = value.is_string() ? value.get<std::string>() : "";
+            if (s == "fused")
+                o.path = Slice3dOptions::Path::Fused;
+            else if (s == "raster")
+                o.path = Slice3dOptions::Path::Raster;
+            else
+                badOption(key, "must be \"fused\" or \"raster\", got " + value.dump());
+        } else {
+            badOption(key, std::string("unknown option for slice3d (known: ") + kKnownOptions + ")");
+        }
+    }
+    if (options.contains("slices") && options.contains("slice_spacing"))
+        badOption("slice_spacing", "give either slices or slice_spacing, not both");
+    if (o.earlyTermination < 1.0 && o.order != Slice3dOptions::Order::FrontToBack)
+        badOption("early_termination", "needs \"order\": \"front-to-back\" (back to front cannot stop early)");
+    if (o.earlyTermination < 1.0 && o.path == Slice3dOptions::Path::Raster)
+        badOption("early_termination", "is only available on the fused path (the blending stage cannot stop a pixel)");
+    return o;
+}
+
+SlicePlan planSlices(const Camera& camera, const glm::dvec3& lo, const glm::dvec3& hi, const Slice3dOptions& options)
+{
+    const glm::dvec3 forward = camera.forward();
+    double dMin = std::numeric_limits<double>::infinity(), dMax = -dMin;
+    for (int c = 0; c < 8; ++c) {
+        const glm::dvec3 corner((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
+        const double d = glm::dot(forward, corner - camera.position);
+        dMin = std::min(dMin, d);
+        dMax = std::max(dMax, d);
+    }
+    SlicePlan plan;
+    plan.depthMin = std::max(dMin, 0.0);
+    plan.depthMax = dMax;
+    const double range = dMax - plan.depthMin;
+    if (!(range > 0.0))
+        return plan;  // behind the camera: no slices
+    if (options.sliceSpacing > 0.0) {
+        const double n = std::ceil(range / options.sliceSpacing);
+        if (n > kMaxSlices)
+            badOption("slice_spacing", std::to_string(options.sliceSpacing) + " gives " + std::to_string(n) +
+                                           " slices for this view, more than " + std::to_string(kMaxSlices));
+        plan.count = std::max(1, static_cast<int>(n));
+        plan.deltaS = options.sliceSpacing;
+    } else {
+        plan.count = options.slices;
+        plan.deltaS = range / options.slices;
+    }
+    return plan;
+}
+
+std::vector<glm::dvec3> slicePolygon(const glm::dvec3& lo, const glm::dvec3& hi, const glm::dvec3& normal,
+                                     double offset)
+{
+    std::vector<glm::dvec3> points;
+    auto corner = [&](int c) {
+        return glm::dvec3((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
+    };
+    const double scale = glm::length(hi - lo);
+    const double eps = 1e-12 * (scale + std::abs(offset));
+    // The 12 edges: corner pairs differing in one bit.
+    for (int c = 0; c < 8; ++c)
+        for (int bit = 1; bit < 8; bit <<= 1) {
+            if (c & bit)
+                continue;
+            const glm::dvec3 a = corner(c), b = corner(c | bit);
+            const double da = glm::dot(normal, a) - offset, db = glm::dot(normal, b) - offset;
+            if ((da > eps && db > eps) || (da < -eps && db < -eps))
+                continue;
+            glm::dvec3 p;
+            if (std::abs(da - db) <= eps)  // edge in the plane: both ends
+                continue;                  // (its ends are found by the adjacent edges)
+            p = a + (b - a) * glm::clamp(da / (da - db), 0.0, 1.0);
+            bool duplicate = false;
+            for (const glm::dvec3& q : points)
+                duplicate = duplicate || glm::length(p - q) <= 1e-9 * scale;
+            if (!duplicate)
+                points.push_back(p);
+        }
+    if (points.size() < 3)
+        return {};
+    glm::dvec3 centroid(0.0);
+    for (const glm::dvec3& p : points)
+        centroid += p;
+    centroid /= static_cast<double>(points.size());
+    // Plane basis (u, v) with u x v = normal.
+    const glm::dvec3 helper = std::abs(normal.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
+    const glm::dvec3 u = glm::normalize(glm::cross(helper, normal));
+    const glm::dvec3 v = glm::cross(normal, u);
+    std::sort(points.begin(), points.end(), [&](const glm::dvec3& a, const glm::dvec3& b) {
+        return std::atan2(glm::dot(a - centroid, v), glm::dot(a - centroid, u)) <
+               std::atan2(glm::dot(b - centroid, v), glm::dot(b - centroid, u));
+    });
+    return points;
+}
+
+std::vector<float> packTransferFunction(const TransferFunction& tf)
+{
+    const auto& points = tf.points();
+    const std::size_t n = points.size(), m = (n + 3) / 4 * 4;
+    std::vector<float> out(m + 4 * n, 0.0f);
+    for (std::size_t i = 0; i < n; ++i) {
+        out[i] = static_cast<float>(points[i].s);
+        out[m + 4 * i + 0] = static_cast<float>(points[i].color.r);
+        out[m + 4 * i + 1] = static_cast<float>(points[i].color.g);
+        out[m + 4 * i + 2] = static_cast<float>(points[i].color.b);
+        out[m + 4 * i + 3] = static_cast<float>(points[i].tau);
+    }
+    return out;
+}
+
+std::unique_ptr<Renderer> makeSlice3dRenderer(Device& device, const Scene& scene, const Volume& volume)
+{
+    return std::make_unique<Slice3dRenderer>(device, scene, volume);
+}
+
+}  // namespace clvr

@@ -1,0 +1,58 @@
+// host/render/slice3d.h — 3D-texture slicing (§2 of seeds/000_354856c7f65dc3f9.txt; the "Blend"
+// method of seeds/004): slices parallel to the image plane through the volume box, classified after
+// trilinear interpolation and blended "over", back to front. Two paths: a fused kernel (one
+// work-item per pixel loops over all slices; the fast path) and the pass-by-pass path through
+// raster::draw (slice polygons with a fragment program; the specification). docs/slice3d.md.
+#pragma once
+
+#include "host/render/renderer.h"
+
+#include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
+
+#include <vector>
+
+namespace clvr {
+
+struct Slice3dOptions {
+    enum class Order { BackToFront, FrontToBack };
+    enum class Path { Fused, Raster };
+    int slices = 256;            // slices across the box's eye-depth range ...
+    double sliceSpacing = 0.0;   // ... or, when > 0, this spacing in world units (then slices is derived)
+    Order order = Order::BackToFront;
+    double earlyTermination = 1.0;  // front-to-back only: stop once A >= this; 1.0 = off
+    Path path = Path::Fused;
+};
+
+// Reads the scene's "options" for slice3d. Throws InputError naming the key ("options.slices: ...")
+// for unknown keys, wrong types and values out of range.
+Slice3dOptions parseSlice3dOptions(const nlohmann::json& options);
+
+// Slice k (0 = nearest) lies on the plane dot(forward, p - position) = depthMin + (k + 0.5) * deltaS.
+struct SlicePlan {
+    double depthMin = 0.0;  // eye depth where the slab of slices begins (>= 0: nothing behind the camera)
+    double depthMax = 0.0;  // eye depth of the box's farthest corner
+    double deltaS = 0.0;    // slice spacing along forward, world units
+    int count = 0;          // 0 when the box is entirely behind the camera
+    double depth(int k) const { return depthMin + (k + 0.5) * deltaS; }
+};
+
+// Slices over the eye-depth range of the box [lo, hi] (its 8 corners, clipped at depth 0): `slices`
+// equal slabs, or slabs of `sliceSpacing` (count = ceil(range / spacing); InputError if > 65536).
+SlicePlan planSlices(const Camera& camera, const glm::dvec3& lo, const glm::dvec3& hi, const Slice3dOptions& options);
+
+// The cross-section of the box [lo, hi] with the plane dot(normal, p) = offset (normal unit length):
+// the plane cut with the 12 box edges, duplicates (plane through a corner) merged, 3 to 6 vertices
+// ordered by angle about their centroid in a plane basis (u, v) with u x v = normal. Empty when the
+// plane misses the box or only touches it in fewer than 3 distinct points.
+std::vector<glm::dvec3> slicePolygon(const glm::dvec3& lo, const glm::dvec3& hi, const glm::dvec3& normal,
+                                     double offset);
+
+// The transfer function as kernels/transfer_function.h lays it out.
+std::vector<float> packTransferFunction(const TransferFunction& tf);
+
+// Renderer for "slice3d". Uploads the volume as float32 (4 bytes per grid point) and the packed
+// transfer function; throws InputError for bad options and DeviceError when the volume does not fit.
+std::unique_ptr<Renderer> makeSlice3dRenderer(Device& device, const Scene& scene, const Volume& volume);
+
+}  // namespace clvr

@@ -1,0 +1,160 @@
+// kernels/slice3d.cl — 3D-texture slicing (§2 of seeds/000_354856c7f65dc3f9.txt): planes parallel to
+// the image plane, trilinear samples, classification after interpolation, alpha = 1 - exp(-tau Delta)
+// with Delta the pixel ray's length between slices, premultiplied color, "over" blending.
+// Two uses of this file (host/render/slice3d.cpp):
+//  - the fused kernel slice3d_fused: one work-item per pixel walks all slices (the fast path);
+//  - with CLVR_SLICE3D_FRAGMENT defined, it is appended after kernels/raster.cl as the fragment
+//    program of the pass-by-pass path (the specification): one fragment per slice and pixel.
+// The host has validated everything; this file only does arithmetic.
+#include "clvr_common.h"
+#include "transfer_function.h"
+#include "volume_sampling.h"
+
+/* Normalized device coordinates of window position w (pixel center (x + 0.5, row + 0.5), row 0 at
+ * the top), y up — host/camera.cpp's Camera::ray. */
+float2 slice3d_ndc(const float2 w, const int width, const int height)
+{
+    return (float2)(w.x / (float)width * 2.0f - 1.0f, 1.0f - w.y / (float)height * 2.0f);
+}
+
+/* The pixel's ray as origin o + z * d, z the eye depth along forward (dot(d, forward) = 1), so the
+ * ray's point on the slice at depth z is o + z d and a slice spacing deltaS is a ray length
+ * deltaS * |d| (= deltaS / cos(theta)). params: x = tan(view_angle / 2) or parallel_scale,
+ * y = aspect (width / height), z = 1 for a parallel camera. */
+void slice3d_ray(const float2 ndc, const float4 position, const float4 forward, const float4 right,
+                 const float4 up, const float4 params, float3* o, float3* d)
+{
+    const float sx = ndc.x * params.x * params.y, sy = ndc.y * params.x;
+    if (params.z != 0.0f) {
+        *o = position.xyz + sx * right.xyz + sy * up.xyz;
+        *d = forward.xyz;
+    } else {
+        *o = position.xyz;
+        *d = forward.xyz + sx * right.xyz + sy * up.xyz;
+    }
+}
+
+/* |d| of slice3d_ray: 1 / cos(theta) for perspective (orthonormal frame), 1 for parallel. */
+float slice3d_stretch(const float2 ndc, const float4 params)
+{
+    if (params.z != 0.0f)
+        return 1.0f;
+    const float sx = ndc.x * params.x * params.y, sy = ndc.y * params.x;
+    return sqrt(1.0f + sx * sx + sy * sy);
+}
+
+#ifndef CLVR_SLICE3D_FRAGMENT
+
+/* One work-item per pixel: slices k = 0 .. slice_count-1 at eye depth depth0 + k * delta_s. Only the
+ * slices whose ray point lies in the grid bounds are sampled (the rest are empty, DESIGN.md); their
+ * number goes to samples[pixel]. Back to front: c = C alpha + (1 - alpha) c (the paper's blending);
+ * front to back: c += T alpha C, T *= 1 - alpha, stopping once 1 - T >= ert_alpha. The pixel is
+ * c + (1 - A) background, A. */
+kernel void slice3d_fused(global float4* out, global uint* samples, const int width, const int height,
+                          global const float* volume, const int4 dims, const float4 grid_origin,
+                          const float4 inv_spacing, global const float* tf, const int tf_count,
+                          const float4 cam_position, const float4 cam_forward, const float4 cam_right,
+                          const float4 cam_up, const float4 cam_params, const float depth0,
+                          const float delta_s, const int slice_count, const int front_to_back,
+                          const float ert_alpha, const float4 background)
+{
+    CLVR_GUARD_2D(width, height);
+    const int x = (int)get_global_id(0), y = (int)get_global_id(1);
+    const float2 ndc = slice3d_ndc((float2)((float)x + 0.5f, (float)y + 0.5f), width, height);
+    float3 o, d;
+    slice3d_ray(ndc, cam_position, cam_forward, cam_right, cam_up, cam_params, &o, &d);
+    const float delta = delta_s * slice3d_stretch(ndc, cam_params);  /* ray length per slice */
+    const float3 go = (o - grid_origin.xyz) * inv_spacing.xyz;     /* grid coordinates */
+    const float3 gd = d * inv_spacing.xyz;
+
+    /* Depth interval of the ray inside the grid bounds (slab test), widened by one slice each way;
+     * each sample is still checked, so this only limits the loop. */
+    float zin = -INFINITY, zout = INFINITY;
+    const float3 last = convert_float3(dims.xyz - 1);
+    for (int a = 0; a < 3; ++a) {
+        const float g0 = a == 0 ? go.x : (a == 1 ? go.y : go.z);
+        const float gs = a == 0 ? gd.x : (a == 1 ? gd.y : gd.z);
+        const float hi = a == 0 ? last.x : (a == 1 ? last.y : last.z);
+        if (gs == 0.0f) {
+            if (g0 < 0.0f || g0 > hi)
+                zout = -INFINITY;
+            continue;
+        }
+        const float t0 = (0.0f - g0) / gs, t1 = (hi - g0) / gs;
+        zin = fmax(zin, fmin(t0, t1));
+        zout = fmin(zout, fmax(t0, t1));
+    }
+    int k_lo = 0, k_hi = -1;
+    if (zin <= zout) {
+        const float n = (float)slice_count;
+        k_lo = (int)clamp(ceil((zin - depth0) / delta_s) - 1.0f, 0.0f, n);
+        k_hi = (int)clamp(floor((zout - depth0) / delta_s) + 1.0f, -1.0f, n - 1.0f);
+    }
+
+    float3 c = (float3)(0.0f);
+    float alpha_acc = 0.0f;
+    uint taken = 0;
+    if (front_to_back) {
+        float transmittance = 1.0f;
+        for (int k = k_lo; k <= k_hi; ++k) {
+            const float3 g = go + (depth0 + (float)k * delta_s) * gd;
+            if (!clvr_grid_inside(g, dims))
+                continue;
+            ++taken;
+            const float4 ct = clvr_tf_eval(tf, tf_count, clvr_trilinear(volume, dims, g));
+            const float alpha = 1.0f - exp(-ct.w * delta);
+            c += (transmittance * alpha) * ct.xyz;
+            transmittance *= 1.0f - alpha;
+            if (1.0f - transmittance >= ert_alpha)
+                break;
+        }
+        alpha_acc = 1.0f - transmittance;
+    } else {
+        for (int k = k_hi; k >= k_lo; --k) {
+            const float3 g = go + (depth0 + (float)k * delta_s) * gd;
+            if (!clvr_grid_inside(g, dims))
+                continue;
+            ++taken;
+            const float4 ct = clvr_tf_eval(tf, tf_count, clvr_trilinear(volume, dims, g));
+            const float alpha = 1.0f - exp(-ct.w * delta);
+            c = ct.xyz * alpha + (1.0f - alpha) * c;
+            alpha_acc = alpha + (1.0f - alpha) * alpha_acc;
+        }
+    }
+    const int i = y * width + x;
+    out[i] = (float4)(c + (1.0f - alpha_acc) * background.xyz, alpha_acc);
+    samples[i] = taken;
+}
+
+/* The pass-by-pass path's last pass: premultiplied (I, A) in place -> I + (1 - A) background, A. */
+kernel void slice3d_over_background(global float4* color, const int count, const float4 background)
+{
+    CLVR_GUARD_1D(count);
+    const size_t i = get_global_id(0);
+    const float4 c = color[i];
+    color[i] = (float4)(c.xyz + (1.0f - c.w) * background.xyz, c.w);
+}
+
+#else
+
+/* Fragment program of the pass-by-pass path (raster/rasterizer.h). attr[0] = world position on the
+ * slice (perspective-correct). uniforms: 0..3 camera position, forward, right, up; 4 camera params
+ * (see slice3d_ray); 5 (width, height, delta_s, tf_count); 6 grid origin; 7 1 / spacing;
+ * 8 dims. buffer[0] volume values, buffer[1] transfer function (transfer_function.h layout).
+ * Output: premultiplied (C alpha, alpha), blended by the draw state. */
+int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* color)
+{
+    constant float4* u = r->uniforms;
+    const int4 dims = convert_int4(u[8]);
+    const float3 g = (f->attr[0].xyz - u[6].xyz) * u[7].xyz;
+    if (!clvr_grid_inside(g, dims))
+        return 0;
+    const float2 ndc = slice3d_ndc(f->window, (int)u[5].x, (int)u[5].y);
+    const float delta = u[5].z * slice3d_stretch(ndc, u[4]);
+    const float4 ct = clvr_tf_eval(r->buffer[1], (int)u[5].w, clvr_trilinear(r->buffer[0], dims, g));
+    const float alpha = 1.0f - exp(-ct.w * delta);
+    *color = (float4)(ct.xyz * alpha, alpha);
+    return 1;
+}
+
+#endif

@@ -1,0 +1,34 @@
+/* kernels/volume_sampling.h — trilinear reconstruction of a regular grid (DESIGN.md, Conventions:
+ * values on grid points, x fastest) from a global float buffer, written by hand: faster than
+ * image3d_t on PoCL and available everywhere (OPENCL-NOTES.md). OpenCL C 1.2. */
+#ifndef CLVR_VOLUME_SAMPLING_H
+#define CLVR_VOLUME_SAMPLING_H
+
+/* 1 if grid coordinates g (world position minus origin, over spacing) lie in the bounds [0, n-1]. */
+int clvr_grid_inside(const float3 g, const int4 dims)
+{
+    return g.x >= 0.0f && g.y >= 0.0f && g.z >= 0.0f && g.x <= (float)(dims.x - 1) &&
+           g.y <= (float)(dims.y - 1) && g.z <= (float)(dims.z - 1);
+}
+
+/* Trilinear value at grid coordinates g, which the caller has checked with clvr_grid_inside. The
+ * lower corner is clamped to n-2 so that g = n-1 takes the last cell with weight 1. */
+float clvr_trilinear(global const float* v, const int4 dims, const float3 g)
+{
+    const int i = min((int)g.x, dims.x - 2);
+    const int j = min((int)g.y, dims.y - 2);
+    const int k = min((int)g.z, dims.z - 2);
+    const float fx = g.x - (float)i, fy = g.y - (float)j, fz = g.z - (float)k;
+    const size_t nx = (size_t)dims.x;
+    const size_t nxy = nx * (size_t)dims.y;
+    global const float* p = v + (size_t)k * nxy + (size_t)j * nx + (size_t)i;
+    const float c00 = p[0] + fx * (p[1] - p[0]);
+    const float c10 = p[nx] + fx * (p[nx + 1] - p[nx]);
+    const float c01 = p[nxy] + fx * (p[nxy + 1] - p[nxy]);
+    const float c11 = p[nxy + nx] + fx * (p[nxy + nx + 1] - p[nxy + nx]);
+    const float c0 = c00 + fy * (c10 - c00);
+    const float c1 = c01 + fy * (c11 - c01);
+    return c0 + fz * (c1 - c0);
+}
+
+#endif
