@@ -21,6 +21,8 @@ TEST(Device, EmbeddedSourcesStartWithLineMarkersAndInlineHeaders)
     EXPECT_NE(it->source.find("#line 1 \"kernels/clvr_common.h\""), std::string_view::npos);
     EXPECT_NE(it->source.find("#line 3 \"kernels/util.cl\""), std::string_view::npos);
     EXPECT_EQ(it->source.find("#include \"clvr_common.h\""), std::string_view::npos);
+    // Macro line continuations and brackets survive embedding byte for byte.
+    EXPECT_NE(it->source.find("#define CLVR_GUARD_1D(n) \\\n    if (get_global_id(0)"), std::string_view::npos);
 }
 
 TEST(Device, FillKernelWritesEveryElementOfAnOddSizedBuffer)

@@ -6,9 +6,11 @@
 
 function(clvr_expand file_name out_var seen_var)
   set(seen ${${seen_var}})
-  # CMake lists split on ';' and treat '[' ']' specially: hide them, split on newlines,
-  # and put them back once the text is assembled.
+  # CMake lists split on ';', treat '[' ']' specially and read '\;' as an escaped ';' (a macro's
+  # line continuation would swallow the newline): hide all three, split on newlines, and put them
+  # back once the text is assembled.
   file(READ "${KERNEL_DIR}/${file_name}" text)
+  string(REPLACE "\\" "@CLVR_BSL@" text "${text}")
   string(REPLACE ";" "@CLVR_SEMI@" text "${text}")
   string(REPLACE "[" "@CLVR_LBR@" text "${text}")
   string(REPLACE "]" "@CLVR_RBR@" text "${text}")
@@ -50,6 +52,7 @@ foreach(src IN LISTS sources)
   string(REPLACE "@CLVR_SEMI@" ";" expanded "${expanded}")
   string(REPLACE "@CLVR_LBR@" "[" expanded "${expanded}")
   string(REPLACE "@CLVR_RBR@" "]" expanded "${expanded}")
+  string(REPLACE "@CLVR_BSL@" "\\" expanded "${expanded}")
   string(HEX "${expanded}" hex)
   string(LENGTH "${hex}" hex_len)
   math(EXPR byte_count "${hex_len} / 2")
