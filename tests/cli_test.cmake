@@ -1,7 +1,9 @@
-# tests/cli_test.cmake — the clvr program end to end (cmake -P): exit codes and one-line errors.
-# Inputs: CLVR (the program), SRC (source tree), WORK (scratch folder).
+# tests/cli_test.cmake — the clvr program end to end (cmake -P): exit codes, one-line errors that name
+# the file, valid outputs, and no output file after any failure (DESIGN.md, "Scene files and the command
+# line"). Inputs: CLVR (the program), SRC (source tree), WORK (scratch folder). Images are 64x64 to stay fast.
 file(REMOVE_RECURSE "${WORK}")
 file(MAKE_DIRECTORY "${WORK}")
+set(SMALL --set image.width=64 --set image.height=64)
 
 function(expect_run expected_rc pattern)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 300)
@@ -13,6 +15,154 @@ function(expect_run expected_rc pattern)
   endif()
 endfunction()
 
+# expect_error(RC OUTPUT PATTERN args...): exit RC, nothing on stdout, exactly one stderr line
+# "clvr: error: ..." that contains PATTERN (a regex: the file's name and what is wrong), and no OUTPUT file.
+function(expect_error expected_rc output pattern)
+  file(REMOVE "${output}")
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 300)
+  set(context "${ARGN}\n  exit ${rc}\n  stdout: ${out}\n  stderr: ${err}")
+  if(NOT rc STREQUAL "${expected_rc}")
+    message(FATAL_ERROR "${context}\n  want exit ${expected_rc}")
+  endif()
+  if(NOT out STREQUAL "")
+    message(FATAL_ERROR "${context}\n  want nothing on stdout")
+  endif()
+  if(NOT err MATCHES "^clvr: error: [^\n]*\n$")
+    message(FATAL_ERROR "${context}\n  want exactly one line 'clvr: error: ...' on stderr")
+  endif()
+  if(NOT err MATCHES "${pattern}")
+    message(FATAL_ERROR "${context}\n  stderr does not match '${pattern}'")
+  endif()
+  if(EXISTS "${output}")
+    message(FATAL_ERROR "${context}\n  left an output file ${output}")
+  endif()
+  file(GLOB leftovers "${WORK}/.*.tmp*")
+  if(leftovers)
+    message(FATAL_ERROR "${context}\n  left temporary files: ${leftovers}")
+  endif()
+endfunction()
+
+# The width and height in a PNG's IHDR chunk (bytes 16..23, big-endian), after checking its signature.
+function(expect_png path want_w want_h)
+  if(NOT EXISTS "${path}")
+    message(FATAL_ERROR "${path} was not written")
+  endif()
+  file(READ "${path}" head LIMIT 24 HEX)
+  string(SUBSTRING "${head}" 0 16 signature)
+  if(NOT signature STREQUAL "89504e470d0a1a0a")
+    message(FATAL_ERROR "${path} is not a PNG (starts with ${signature})")
+  endif()
+  string(SUBSTRING "${head}" 32 8 w)
+  string(SUBSTRING "${head}" 40 8 h)
+  math(EXPR w "0x${w}")
+  math(EXPR h "0x${h}")
+  if(NOT w EQUAL want_w OR NOT h EQUAL want_h)
+    message(FATAL_ERROR "${path} is ${w}x${h}, want ${want_w}x${want_h}")
+  endif()
+endfunction()
+
+# --- usage and devices
 expect_run(0 "using device" ${CLVR} info)
-expect_run(2 "^clvr: error: " ${CLVR} no-such-command)
+expect_run(0 "--output" ${CLVR} render --help)
+expect_run(0 "render" ${CLVR} --help)
+expect_error(2 "${WORK}/none.png" "command line: .*no-such-command" ${CLVR} no-such-command)
+expect_error(2 "${WORK}/none.png" "command line: .*--output" ${CLVR} render)
 expect_run(3 "^clvr: error: .*matches no OpenCL device" ${CLVR} info --device no-such-device-xyz)
+
+# --- good renders: the default scene (omitted and named), PNG of the right size, EXR, stats with every key
+set(png "${WORK}/default.png")
+expect_run(0 "^wrote .*default.png \\(64x64, slice3d, [0-9.]+ ms/frame\\)\n$"
+  ${CLVR} render -o ${png} ${SMALL} --stats ${WORK}/stats.json)
+expect_png(${png} 64 64)
+file(READ "${WORK}/stats.json" stats)
+foreach(key technique device width height frame_ms compile_ms first_frame_ms passes voxels samples resident_bytes)
+  string(JSON value ERROR_VARIABLE missing GET "${stats}" ${key})
+  if(missing)
+    message(FATAL_ERROR "stats.json has no \"${key}\":\n${stats}")
+  endif()
+endforeach()
+string(JSON width GET "${stats}" width)
+string(JSON technique GET "${stats}" technique)
+string(JSON npasses LENGTH "${stats}" passes)
+string(JSON pass0 GET "${stats}" passes 0 name)
+if(NOT width EQUAL 64 OR NOT technique STREQUAL "slice3d" OR npasses LESS 1 OR pass0 STREQUAL "")
+  message(FATAL_ERROR "stats.json: unexpected values:\n${stats}")
+endif()
+expect_run(0 "wrote .*named.png \\(48x32," ${CLVR} render default -o ${WORK}/named.png
+  --set image.width=48 --set image.height=32)
+expect_png(${WORK}/named.png 48 32)
+expect_run(0 "wrote .*default.exr" ${CLVR} render -o ${WORK}/default.exr ${SMALL})
+file(READ "${WORK}/default.exr" exrMagic LIMIT 4 HEX)
+if(NOT exrMagic STREQUAL "762f3101")
+  message(FATAL_ERROR "default.exr is not an OpenEXR file (starts with ${exrMagic})")
+endif()
+
+# A scene file with a relative data path and no camera (the camera fits the bounds); a NRRD written here.
+file(WRITE "${WORK}/data/cube.nrrd" "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 4 4\nencoding: ascii\n\n")
+foreach(i RANGE 63)
+  math(EXPR v "(${i} * 4) % 256")
+  file(APPEND "${WORK}/data/cube.nrrd" "${v}\n")
+endforeach()
+file(WRITE "${WORK}/cube.json" [=[{
+  "volume": {"file": "data/cube.nrrd"},
+  "image": {"width": 40, "height": 30},
+  "transfer_function": {"points": [[0, 0,0,0, 0], [255, 1,1,1, 0.5]]}
+}]=])
+expect_run(0 "wrote .*cube.png \\(40x30, slice3d" ${CLVR} render ${WORK}/cube.json -o ${WORK}/cube.png)
+expect_png(${WORK}/cube.png 40 30)
+
+# --- bad input: exit 2, one line naming the file, no output file
+set(out "${WORK}/out.png")
+expect_error(2 ${out} "missing.json: no such scene file" ${CLVR} render ${WORK}/missing.json -o ${out})
+file(WRITE "${WORK}/malformed.json" "{\n  \"volume\": {\"generator\": \"sphere\" \"dims\": [8,8,8]}\n}\n")
+expect_error(2 ${out} "malformed.json: malformed JSON at line 2, column" ${CLVR} render ${WORK}/malformed.json -o ${out})
+file(WRITE "${WORK}/truncated.json" "{\n  \"volume\": {\"generator\": \"sphere\",")
+expect_error(2 ${out} "truncated.json: malformed JSON at line 2" ${CLVR} render ${WORK}/truncated.json -o ${out})
+file(WRITE "${WORK}/unknown.json" [=[{
+  "volume": {"generator": "sphere", "dims": [8,8,8]},
+  "camera": {"position": [0,0,4], "fov": 30},
+  "transfer_function": {"points": [[0, 0,0,0, 0], [1, 1,1,1, 4]]}
+}]=])
+expect_error(2 ${out} "unknown.json: unknown key \"camera.fov\" \\(known: position," ${CLVR} render ${WORK}/unknown.json -o ${out})
+expect_error(2 ${out} "default scene: --set \"camera.position=\\[0,0,\": malformed value"
+  ${CLVR} render -o ${out} --set "camera.position=[0,0,")
+expect_error(2 ${out} "default scene: --set \"camera\": expected path=value" ${CLVR} render -o ${out} --set camera)
+expect_error(2 "${WORK}/out.jpg" "out.jpg: unsupported image format \"\\.jpg\"" ${CLVR} render -o ${WORK}/out.jpg ${SMALL})
+expect_error(2 "${WORK}/no-dir/out.png" "no-dir/out.png: directory .*no-dir does not exist"
+  ${CLVR} render -o ${WORK}/no-dir/out.png ${SMALL})
+expect_error(2 ${out} "default scene: image.width must be in 1..16384, got 0" ${CLVR} render -o ${out} --set image.width=0)
+expect_error(2 ${out} "default scene: technique: unknown technique \"no-such-technique\"" ${CLVR} render -o ${out} ${SMALL} --set technique=no-such-technique)
+file(WRITE "${WORK}/nodata.json" [=[{
+  "volume": {"file": "data/not-there.nrrd"},
+  "transfer_function": {"points": [[0, 0,0,0, 0], [1, 1,1,1, 4]]}
+}]=])
+expect_error(2 ${out} "data/not-there.nrrd: no such file" ${CLVR} render ${WORK}/nodata.json -o ${out} ${SMALL})
+# A NRRD whose header promises 8x8x8 uint16 samples (1024 bytes) but carries 100.
+string(REPEAT "x" 100 shortData)
+file(WRITE "${WORK}/data/short.nrrd" "NRRD0004\ntype: uint16\ndimension: 3\nsizes: 8 8 8\nendian: little\nencoding: raw\n\n${shortData}")
+file(WRITE "${WORK}/short.json" [=[{
+  "volume": {"file": "data/short.nrrd"},
+  "transfer_function": {"points": [[0, 0,0,0, 0], [1, 1,1,1, 4]]}
+}]=])
+expect_error(2 ${out} "data/short.nrrd: header says 8x8x8" ${CLVR} render ${WORK}/short.json -o ${out} ${SMALL})
+file(WRITE "${WORK}/nan.json" [=[{
+  "volume": {"generator": "sphere", "dims": [8,8,8]},
+  "transfer_function": {"points": [[0, 0,0,0, 0], [1, 1,1,1, 1e999]]}
+}]=])
+expect_error(2 ${out} "nan.json: malformed JSON at line 3, column [0-9]+: number 1e999 is out of range"
+  ${CLVR} render ${WORK}/nan.json -o ${out} ${SMALL})
+expect_error(2 ${out} "default scene: transfer_function.points\\[1\\]\\[1\\] must be a number"
+  ${CLVR} render -o ${out} ${SMALL} "--set=transfer_function.points=[[0,0,0,0,0],[1,\"nan\",1,1,1]]")
+expect_error(2 ${out} "stats.json: directory .*no-dir does not exist"
+  ${CLVR} render -o ${out} ${SMALL} --stats ${WORK}/no-dir/stats.json)
+
+expect_error(2 ${out} "default scene: options.slicez: unknown option"
+  ${CLVR} render -o ${out} ${SMALL} --set options.slicez=3)
+
+# --- device failures: exit 3, one line, no output file
+expect_error(3 ${out} "--device \"no-such-device\" matches no OpenCL device"
+  ${CLVR} render -o ${out} ${SMALL} --device no-such-device)
+# No OpenCL platform at all: the ICD loader finds no vendor file in an empty folder.
+file(MAKE_DIRECTORY "${WORK}/empty-icd")
+expect_error(3 ${out} "no OpenCL device"
+  ${CMAKE_COMMAND} -E env OCL_ICD_VENDORS=${WORK}/empty-icd ${CLVR} render -o ${out} ${SMALL})
