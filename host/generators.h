@@ -25,9 +25,8 @@ double marschnerLobb(const glm::dvec3& p);
 // are spheres of radius 1 - value.
 double sphereField(const glm::dvec3& p);
 
-// "blobs": sum over four fixed Gaussians a_k exp(-|p - c_k|^2 / (2 sigma_k^2)) with sum a_k = 1, so
-// values lie in [0,1] (about 0.41 at the largest blob's center); the centers and widths are in
-// generators.cpp and docs/data-formats.md.
+// "blobs": min(1, sum over four fixed Gaussians a_k exp(-|p - c_k|^2 / (2 sigma_k^2))), amplitudes a_k
+// 1, 0.75, 0.5 and 0.25; values in [0,1]. Centers and widths are in generators.cpp and docs/data-formats.md.
 double blobsField(const glm::dvec3& p);
 
 }  // namespace clvr
