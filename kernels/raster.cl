@@ -65,50 +65,102 @@ uint clvr_stencil_op(uint op, uint s, uint ref, uint write_mask)
     return ((s & ~write_mask) | (v & write_mask)) & 255u;
 }
 
-/* GL blend factor (GL 2.1 table 4.2) for all four channels; rgb uses .xyz, alpha uses .w. */
-float4 clvr_blend_factor(uint f, float4 src, float4 dst, float4 k)
+/* GL blend factors (GL 2.1 table 4.2) as linear forms, set up once per work-item so that the
+ * per-fragment work has no branches (PoCL if-converts branches when it vectorizes work-items):
+ * factor = base + c_src * src + c_dst * dst + c_src_a * src.w + c_dst_a * dst.w + c_sat * sat,
+ * sat = min(src.w, 1 - dst.w). Exactly one term besides base is nonzero and the coefficients are
+ * 0 or +-1, so the result has the rounding of the direct formula (1 - src is 1 + (-1) * src). */
+typedef struct {
+    float4 base, c_src, c_dst, c_src_a, c_dst_a, c_sat;
+} ClvrBlendFactor;
+
+void clvr_factor_channel(uint f, float4 k, int ch, ClvrBlendFactor* out)
 {
+    float base = 0.0f, cs = 0.0f, cd = 0.0f, csa = 0.0f, cda = 0.0f, csat = 0.0f;
+    const float kc = ch == 0 ? k.x : ch == 1 ? k.y : ch == 2 ? k.z : k.w;
     switch (f) {
-    case CLVR_FACTOR_ZERO: return (float4)(0.0f);
-    case CLVR_FACTOR_ONE: return (float4)(1.0f);
-    case CLVR_FACTOR_SRC_COLOR: return src;
-    case CLVR_FACTOR_ONE_MINUS_SRC_COLOR: return 1.0f - src;
-    case CLVR_FACTOR_DST_COLOR: return dst;
-    case CLVR_FACTOR_ONE_MINUS_DST_COLOR: return 1.0f - dst;
-    case CLVR_FACTOR_SRC_ALPHA: return (float4)(src.w);
-    case CLVR_FACTOR_ONE_MINUS_SRC_ALPHA: return (float4)(1.0f - src.w);
-    case CLVR_FACTOR_DST_ALPHA: return (float4)(dst.w);
-    case CLVR_FACTOR_ONE_MINUS_DST_ALPHA: return (float4)(1.0f - dst.w);
-    case CLVR_FACTOR_CONSTANT_COLOR: return k;
-    case CLVR_FACTOR_ONE_MINUS_CONSTANT_COLOR: return 1.0f - k;
-    case CLVR_FACTOR_CONSTANT_ALPHA: return (float4)(k.w);
-    case CLVR_FACTOR_ONE_MINUS_CONSTANT_ALPHA: return (float4)(1.0f - k.w);
-    default: { /* SRC_ALPHA_SATURATE */
-        const float f_sat = min(src.w, 1.0f - dst.w);
-        return (float4)(f_sat, f_sat, f_sat, 1.0f);
+    case CLVR_FACTOR_ZERO: break;
+    case CLVR_FACTOR_ONE: base = 1.0f; break;
+    case CLVR_FACTOR_SRC_COLOR: cs = 1.0f; break;
+    case CLVR_FACTOR_ONE_MINUS_SRC_COLOR: base = 1.0f; cs = -1.0f; break;
+    case CLVR_FACTOR_DST_COLOR: cd = 1.0f; break;
+    case CLVR_FACTOR_ONE_MINUS_DST_COLOR: base = 1.0f; cd = -1.0f; break;
+    case CLVR_FACTOR_SRC_ALPHA: csa = 1.0f; break;
+    case CLVR_FACTOR_ONE_MINUS_SRC_ALPHA: base = 1.0f; csa = -1.0f; break;
+    case CLVR_FACTOR_DST_ALPHA: cda = 1.0f; break;
+    case CLVR_FACTOR_ONE_MINUS_DST_ALPHA: base = 1.0f; cda = -1.0f; break;
+    case CLVR_FACTOR_CONSTANT_COLOR: base = kc; break;
+    case CLVR_FACTOR_ONE_MINUS_CONSTANT_COLOR: base = 1.0f - kc; break;
+    case CLVR_FACTOR_CONSTANT_ALPHA: base = k.w; break;
+    case CLVR_FACTOR_ONE_MINUS_CONSTANT_ALPHA: base = 1.0f - k.w; break;
+    default: /* SRC_ALPHA_SATURATE: (sat, sat, sat, 1) */
+        if (ch == 3)
+            base = 1.0f;
+        else
+            csat = 1.0f;
+        break;
     }
-    }
-}
-
-/* GL blend equation per channel; MIN and MAX ignore the factors. No clamp: the buffer is float. */
-float4 clvr_blend_equation(uint eq, float4 s, float4 sf, float4 d, float4 df)
-{
-    switch (eq) {
-    case CLVR_BLEND_SUBTRACT: return s * sf - d * df;
-    case CLVR_BLEND_REVERSE_SUBTRACT: return d * df - s * sf;
-    case CLVR_BLEND_MIN: return fmin(s, d);
-    case CLVR_BLEND_MAX: return fmax(s, d);
-    default: return s * sf + d * df;
+    switch (ch) {
+    case 0: out->base.x = base; out->c_src.x = cs; out->c_dst.x = cd; out->c_src_a.x = csa; out->c_dst_a.x = cda; out->c_sat.x = csat; break;
+    case 1: out->base.y = base; out->c_src.y = cs; out->c_dst.y = cd; out->c_src_a.y = csa; out->c_dst_a.y = cda; out->c_sat.y = csat; break;
+    case 2: out->base.z = base; out->c_src.z = cs; out->c_dst.z = cd; out->c_src_a.z = csa; out->c_dst_a.z = cda; out->c_sat.z = csat; break;
+    default: out->base.w = base; out->c_src.w = cs; out->c_dst.w = cd; out->c_src_a.w = csa; out->c_dst_a.w = cda; out->c_sat.w = csat; break;
     }
 }
 
-float4 clvr_blend(const ClBlendState* b, float4 src, float4 dst)
+/* The source or destination factor: rgb from rgb_factor, alpha from alpha_factor. */
+ClvrBlendFactor clvr_blend_factor_setup(uint rgb_factor, uint alpha_factor, float4 k)
 {
-    const float4 rgb = clvr_blend_equation(b->rgb_equation, src, clvr_blend_factor(b->src_rgb, src, dst, b->color),
-                                           dst, clvr_blend_factor(b->dst_rgb, src, dst, b->color));
-    const float4 a = clvr_blend_equation(b->alpha_equation, src, clvr_blend_factor(b->src_alpha, src, dst, b->color),
-                                         dst, clvr_blend_factor(b->dst_alpha, src, dst, b->color));
-    return (float4)(rgb.xyz, a.w);
+    ClvrBlendFactor f;
+    for (int ch = 0; ch < 3; ++ch)
+        clvr_factor_channel(rgb_factor, k, ch, &f);
+    clvr_factor_channel(alpha_factor, k, 3, &f);
+    return f;
+}
+
+float4 clvr_blend_factor(const ClvrBlendFactor* f, float4 src, float4 dst)
+{
+    const float sat = min(src.w, 1.0f - dst.w);
+    return f->base + f->c_src * src + f->c_dst * dst + f->c_src_a * src.w + f->c_dst_a * dst.w + f->c_sat * sat;
+}
+
+/* GL blend equations as signs per channel: ADD (+1, +1), SUBTRACT (+1, -1), REVERSE_SUBTRACT (-1, +1);
+ * MIN and MAX ignore the factors. No clamp: the buffer is float. */
+typedef struct {
+    ClvrBlendFactor src, dst;
+    float4 sign_src, sign_dst;
+    int4 use_min, use_max;
+} ClvrBlend;
+
+void clvr_equation_channel(uint eq, float* ss, float* sd, int* mn, int* mx)
+{
+    *ss = eq == CLVR_BLEND_REVERSE_SUBTRACT ? -1.0f : 1.0f;
+    *sd = eq == CLVR_BLEND_SUBTRACT ? -1.0f : 1.0f;
+    *mn = eq == CLVR_BLEND_MIN ? -1 : 0;
+    *mx = eq == CLVR_BLEND_MAX ? -1 : 0;
+}
+
+ClvrBlend clvr_blend_setup(const ClBlendState* b)
+{
+    ClvrBlend r;
+    r.src = clvr_blend_factor_setup(b->src_rgb, b->src_alpha, b->color);
+    r.dst = clvr_blend_factor_setup(b->dst_rgb, b->dst_alpha, b->color);
+    float ss, sd, as, ad;
+    int mn, mx, amn, amx;
+    clvr_equation_channel(b->rgb_equation, &ss, &sd, &mn, &mx);
+    clvr_equation_channel(b->alpha_equation, &as, &ad, &amn, &amx);
+    r.sign_src = (float4)(ss, ss, ss, as);
+    r.sign_dst = (float4)(sd, sd, sd, ad);
+    r.use_min = (int4)(mn, mn, mn, amn);
+    r.use_max = (int4)(mx, mx, mx, amx);
+    return r;
+}
+
+float4 clvr_blend(const ClvrBlend* b, float4 src, float4 dst)
+{
+    const float4 linear = b->sign_src * (src * clvr_blend_factor(&b->src, src, dst)) +
+                          b->sign_dst * (dst * clvr_blend_factor(&b->dst, src, dst));
+    return select(select(linear, fmin(src, dst), b->use_min), fmax(src, dst), b->use_max);
 }
 
 /* Edge function of edge a -> b at p, all in subpixel units: positive inside a set-up triangle.
@@ -152,6 +204,9 @@ kernel void raster_fragments(global float4* color, global float* depth, global u
     resources.buffer[3] = buffer3;
     resources.uniforms = uniforms;
 
+    const ClvrBlend blend = clvr_blend_setup(&bs);
+    const int4 write_mask = (int4)((fs.color_mask & CLVR_MASK_R) ? -1 : 0, (fs.color_mask & CLVR_MASK_G) ? -1 : 0,
+                                   (fs.color_mask & CLVR_MASK_B) ? -1 : 0, (fs.color_mask & CLVR_MASK_A) ? -1 : 0);
     float4 c = color[pixel];
     float d = depth[pixel];
     uint s = stencil[pixel];
@@ -204,9 +259,8 @@ kernel void raster_fragments(global float4* color, global float* depth, global u
         }
         if (fs.stencil_test)
             s = clvr_stencil_op(fs.stencil_dppass, s, fs.stencil_ref, fs.stencil_write_mask);
-        const float4 blended = bs.enabled ? clvr_blend(&bs, src, c) : src;
-        c = (float4)((fs.color_mask & CLVR_MASK_R) ? blended.x : c.x, (fs.color_mask & CLVR_MASK_G) ? blended.y : c.y,
-                     (fs.color_mask & CLVR_MASK_B) ? blended.z : c.z, (fs.color_mask & CLVR_MASK_A) ? blended.w : c.w);
+        const float4 blended = bs.enabled ? clvr_blend(&blend, src, c) : src;
+        c = select(c, blended, write_mask);
     }
 
     if (covered) {
