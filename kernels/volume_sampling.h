@@ -12,16 +12,19 @@ int clvr_grid_inside(const float3 g, const int4 dims)
 }
 
 /* Trilinear value at grid coordinates g, which the caller has checked with clvr_grid_inside. The
- * lower corner is clamped to n-2 so that g = n-1 takes the last cell with weight 1. */
+ * lower corner is clamped to n-2 so that g = n-1 takes the last cell with weight 1. At most
+ * 2^32 - 1 grid points. */
 float clvr_trilinear(global const float* v, const int4 dims, const float3 g)
 {
     const int i = min((int)g.x, dims.x - 2);
     const int j = min((int)g.y, dims.y - 2);
     const int k = min((int)g.z, dims.z - 2);
     const float fx = g.x - (float)i, fy = g.y - (float)j, fz = g.z - (float)k;
-    const size_t nx = (size_t)dims.x;
-    const size_t nxy = nx * (size_t)dims.y;
-    global const float* p = v + (size_t)k * nxy + (size_t)j * nx + (size_t)i;
+    /* 32-bit index arithmetic (cheaper than size_t per sample); the host allows at most 2^32 - 1
+     * grid points. */
+    const uint nx = (uint)dims.x;
+    const uint nxy = nx * (uint)dims.y;
+    global const float* p = v + ((uint)k * nxy + (uint)j * nx + (uint)i);
     const float c00 = p[0] + fx * (p[1] - p[0]);
     const float c10 = p[nx] + fx * (p[nx + 1] - p[nx]);
     const float c01 = p[nxy] + fx * (p[nxy + 1] - p[nxy]);

@@ -64,6 +64,8 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
     : device_(device), options_(parseSlice3dOptions(scene.options)), image_(scene.image)
 {
     volume.validate();
+    if (volume.voxelCount() > 0xffffffffull)
+        throw InputError(volume.source + ": slice3d takes at most 2^32 - 1 grid points (32-bit voxel indices)");
     dims_ = volume.dims;
     origin_ = volume.origin;
     spacing_ = volume.spacing;
@@ -359,13 +361,16 @@ std::vector<float> packTransferFunction(const TransferFunction& tf)
 {
     const auto& points = tf.points();
     const std::size_t n = points.size(), m = (n + 3) / 4 * 4;
-    std::vector<float> out(m + 4 * n, 0.0f);
+    std::vector<float> out(m + 8 * n, 0.0f);
+    auto value = [&](std::size_t i) { return glm::dvec4(points[i].color, points[i].tau); };
     for (std::size_t i = 0; i < n; ++i) {
         out[i] = static_cast<float>(points[i].s);
-        out[m + 4 * i + 0] = static_cast<float>(points[i].color.r);
-        out[m + 4 * i + 1] = static_cast<float>(points[i].color.g);
-        out[m + 4 * i + 2] = static_cast<float>(points[i].color.b);
-        out[m + 4 * i + 3] = static_cast<float>(points[i].tau);
+        const glm::dvec4 slope =
+            i + 1 < n ? (value(i + 1) - value(i)) / (points[i + 1].s - points[i].s) : glm::dvec4(0.0);
+        for (int c = 0; c < 4; ++c) {
+            out[m + 4 * i + c] = static_cast<float>(value(i)[c]);
+            out[m + 4 * n + 4 * i + c] = static_cast<float>(slope[c]);
+        }
     }
     return out;
 }
