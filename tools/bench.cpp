@@ -1,0 +1,432 @@
+// tools/bench.cpp — `clvr bench` (DESIGN.md, "How results are judged": speed and peers). Steady-state
+// frames with the data already on the device, compilation reported apart, median of several frames;
+// the ceiling loop (tools/ceiling.h) and VTK (tools/peer_vtk.py) on the same scene in the same run.
+#include "tools/bench.h"
+
+#include "host/device.h"
+#include "host/errors.h"
+#include "host/image_io.h"
+#include "host/render/renderer.h"
+#include "host/scene.h"
+#include "host/volume_io.h"
+#include "tools/ceiling.h"
+
+#if __has_include("raster/rasterizer.h")
+#include "raster/rasterizer.h"
+#define CLVR_BENCH_RASTER 1
+#else
+#define CLVR_BENCH_RASTER 0
+#endif
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+#include <thread>
+#include <unistd.h>
+
+namespace clvr::tools {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+double msSince(Clock::time_point t0)
+{
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+struct Spread {
+    double median = 0.0, min = 0.0, max = 0.0;
+};
+
+Spread spread(std::vector<double> v)
+{
+    if (v.empty())
+        return {};
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    const double median = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+    return {median, v.front(), v.back()};
+}
+
+// A file of the repository (data/scenes/bench/..., tools/peer_vtk.py): looked up from the current
+// folder, then from the executable's folder and its parents (a build folder inside the repository).
+fs::path repoFile(const fs::path& relative)
+{
+    if (fs::exists(relative))
+        return relative;
+    std::error_code ec;
+    fs::path dir = fs::read_symlink("/proc/self/exe", ec).parent_path();
+    for (int up = 0; !ec && up < 4 && !dir.empty(); ++up, dir = dir.parent_path())
+        if (fs::exists(dir / relative))
+            return dir / relative;
+    throw InputError(relative.string() + ": not found in the current folder or above the clvr executable "
+                     "(run clvr bench from the repository root, or name the scene files)");
+}
+
+std::string cpuModel()
+{
+    std::ifstream in("/proc/cpuinfo");
+    for (std::string line; std::getline(in, line);)
+        if (line.rfind("model name", 0) == 0) {
+            const auto colon = line.find(':');
+            return colon == std::string::npos ? line : line.substr(colon + 2);
+        }
+    return "unknown";
+}
+
+// /proc/loadavg's first three fields: the machine is shared, so every report says how busy it was.
+std::string loadAverage()
+{
+    std::ifstream in("/proc/loadavg");
+    std::string a, b, c;
+    in >> a >> b >> c;
+    return in ? a + " " + b + " " + c : "unknown";
+}
+
+std::string utcNow()
+{
+    const std::time_t t = std::time(nullptr);
+    std::tm tm{};
+    gmtime_r(&t, &tm);
+    char buf[32];
+    std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+    return buf;
+}
+
+// Per-channel absolute difference over R, G, B (VTK's PNG has no alpha).
+struct ImageDiff {
+    double mean = 0.0, max = 0.0;
+};
+ImageDiff imageDiff(const Image4f& a, const Image4f& b)
+{
+    if (a.width() != b.width() || a.height() != b.height())
+        throw InputError("images to compare differ in size: " + std::to_string(a.width()) + "x" +
+                         std::to_string(a.height()) + " and " + std::to_string(b.width()) + "x" +
+                         std::to_string(b.height()));
+    ImageDiff d;
+    for (std::size_t i = 0; i < a.pixelCount(); ++i)
+        for (int c = 0; c < 3; ++c) {
+            const double e = std::abs(static_cast<double>(a.pixels()[i][c]) - b.pixels()[i][c]);
+            d.mean += e;
+            d.max = std::max(d.max, e);
+        }
+    d.mean /= 3.0 * std::max<std::size_t>(a.pixelCount(), 1);
+    return d;
+}
+
+std::string fixed(double v, int digits)
+{
+    std::ostringstream s;
+    s << std::fixed << std::setprecision(digits) << v;
+    return s.str();
+}
+
+std::string si(double v)  // 1.23e+08 -> "123.0 M"
+{
+    const char* unit[] = {"", " k", " M", " G", " T"};
+    int u = 0;
+    while (std::abs(v) >= 1000.0 && u < 4) {
+        v /= 1000.0;
+        ++u;
+    }
+    return fixed(v, 1) + unit[u];
+}
+
+// The plain C++ ceiling loop on the same scene (slice3d only): timing and image difference.
+nlohmann::json runCeiling(const Scene& scene, const Volume& volume, const Camera& camera, const Image4f& clvrImage,
+                          double clvrSamplesPerS, const fs::path& imagePath)
+{
+    CeilingScene cs;
+    cs.camera = camera;
+    cs.width = scene.image.width;
+    cs.height = scene.image.height;
+    cs.background = scene.image.background;
+    cs.options = parseSlice3dOptions(scene.options);
+    const Ceiling ceiling(volume, scene.transferFunction, cs);
+    const int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    CeilingResult first = ceiling.render(threads);  // warms caches and pages
+    std::vector<double> ms;
+    for (int i = 0; i < 3; ++i) {
+        const auto t0 = Clock::now();
+        first = ceiling.render(threads);
+        ms.push_back(msSince(t0));
+    }
+    const Spread s = spread(ms);
+    const double samplesPerS = first.samples / (s.median * 1e-3);
+    writeImage(imagePath.string(), first.image);
+    const ImageDiff d = imageDiff(clvrImage, first.image);
+    return {{"threads", threads},
+            {"frame_ms", s.median},
+            {"samples", first.samples},
+            {"samples_per_s", samplesPerS},
+            {"clvr_ratio", clvrSamplesPerS / samplesPerS},
+            {"slices", ceiling.plan().count},
+            {"slice_spacing", ceiling.plan().deltaS},
+            {"image", imagePath.string()},
+            {"image_diff_vs_clvr", {{"mean", d.mean}, {"max", d.max}}}};
+}
+
+// tools/peer_vtk.py under xvfb-run on the same scene; its figures, and its image against clvr's PNG.
+nlohmann::json runPeer(const fs::path& scenePath, int frames, double sampleDistance, const fs::path& clvrPng,
+                       const fs::path& outPrefix)
+{
+    const fs::path script = repoFile("tools/peer_vtk.py");
+    const fs::path png = outPrefix.string() + ".vtk.png", json = outPrefix.string() + ".vtk.json";
+    std::error_code ec;
+    fs::remove(json, ec);
+    std::ostringstream cmd;
+    cmd << "xvfb-run -a /usr/bin/python3 '" << script.string() << "' '" << scenePath.string() << "' --frames "
+        << frames << " --sample-distance " << std::setprecision(17) << sampleDistance << " --out-png '"
+        << png.string() << "' --out-json '" << json.string() << "'";
+    std::cout << "peer: " << cmd.str() << '\n' << std::flush;
+    const int rc = std::system(cmd.str().c_str());
+    std::ifstream in(json);
+    if (rc != 0 || !in)
+        return {{"error", "tools/peer_vtk.py failed (status " + std::to_string(rc) + "); command: " + cmd.str()}};
+    nlohmann::json peer = nlohmann::json::parse(in);
+    const ImageDiff d = imageDiff(readImage(clvrPng.string()), readImage(png.string()));
+    peer["image"] = png.string();
+    peer["image_diff_vs_clvr"] = {{"mean", d.mean}, {"max", d.max}};
+    return peer;
+}
+
+#if CLVR_BENCH_RASTER
+// raster::draw on a 512x512 frame buffer: 1000 random triangles (fixed seed, splitmix64), blended
+// with SRC_ALPHA, ONE_MINUS_SRC_ALPHA, default fragment program; first draw apart, median of 5.
+nlohmann::json rasterBench(Device& device)
+{
+    constexpr int kSize = 512, kTriangles = 1000, kDraws = 5;
+    std::uint64_t state = 0x9e3779b97f4a7c15ull;
+    auto uniform = [&state] {  // splitmix64 -> [0, 1)
+        std::uint64_t z = (state += 0x9e3779b97f4a7c15ull);
+        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+        z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+        return static_cast<float>((z ^ (z >> 31)) >> 40) / static_cast<float>(1 << 24);
+    };
+    std::vector<raster::Vertex> vertices;
+    for (int t = 0; t < kTriangles; ++t) {
+        const glm::vec2 center(uniform() * 2.0f - 1.0f, uniform() * 2.0f - 1.0f);
+        const float radius = 0.05f + 0.25f * uniform();  // NDC units
+        const glm::vec4 color(uniform(), uniform(), uniform(), 0.2f + 0.6f * uniform());
+        for (int v = 0; v < 3; ++v) {
+            const float angle = 6.2831853f * (v / 3.0f + 0.2f * uniform());
+            raster::Vertex vertex;
+            vertex.position = glm::vec4(center + radius * glm::vec2(std::cos(angle), std::sin(angle)),
+                                        uniform() * 2.0f - 1.0f, 1.0f);
+            vertex.attributes[0] = color;
+            vertices.push_back(vertex);
+        }
+    }
+    raster::DrawState drawState;
+    drawState.fragment.blend.enabled = true;
+    drawState.fragment.blend.srcRgb = drawState.fragment.blend.srcAlpha = raster::BlendFactor::SrcAlpha;
+    drawState.fragment.blend.dstRgb = drawState.fragment.blend.dstAlpha = raster::BlendFactor::OneMinusSrcAlpha;
+    raster::Framebuffer fb(device, kSize, kSize);
+    fb.clearColor(device, glm::vec4(0.0f));
+    const double compile0 = device.compileMs();
+    auto t0 = Clock::now();
+    raster::DrawStats stats = raster::draw(device, fb, drawState, raster::Topology::Triangles, vertices);
+    const double firstMs = msSince(t0);
+    const double compileMs = device.compileMs() - compile0;
+    std::vector<double> ms;
+    for (int i = 0; i < kDraws; ++i) {
+        t0 = Clock::now();
+        stats = raster::draw(device, fb, drawState, raster::Topology::Triangles, vertices);
+        device.queue().finish();
+        ms.push_back(msSince(t0));
+    }
+    device.takePassTimes();
+    const Spread s = spread(ms);
+    return {{"width", kSize},
+            {"height", kSize},
+            {"triangles", stats.triangles},
+            {"fragments", stats.fragments},
+            {"first_draw_ms", firstMs},
+            {"compile_ms", compileMs},
+            {"draw_ms", s.median},
+            {"draw_ms_min", s.min},
+            {"draw_ms_max", s.max},
+            {"triangles_per_s", stats.triangles / (s.median * 1e-3)},
+            {"fragments_per_s", stats.fragments / (s.median * 1e-3)}};
+}
+#endif
+
+}  // namespace
+
+int bench(const BenchOptions& options)
+{
+    std::vector<fs::path> scenes(options.scenes.begin(), options.scenes.end());
+    if (scenes.empty())
+        for (const char* name : {"slice3d-ml256.json", "slice3d-engine.json"})
+            scenes.push_back(repoFile(fs::path("data/scenes/bench") / name));
+    const int frames = std::max(options.frames, 5);
+    const fs::path outJson = options.outJson;
+    const fs::path outDir = outJson.has_parent_path() ? outJson.parent_path() : fs::path(".");
+    fs::create_directories(outDir);
+
+    Device device(options.deviceSpec);
+    nlohmann::json report;
+    const char* poclCache = std::getenv("POCL_CACHE_DIR");
+    report["machine"] = {{"device", device.description()},
+                         {"device_name", device.listing().name},
+                         {"device_version", device.listing().version},
+                         {"platform", device.listing().platform},
+                         {"platform_version",
+                          cl::Platform(device.device().getInfo<CL_DEVICE_PLATFORM>()).getInfo<CL_PLATFORM_VERSION>()},
+                         {"device_compute_units", device.listing().computeUnits},
+                         {"cpu", cpuModel()},
+                         {"cores", std::thread::hardware_concurrency()},
+                         {"date", utcNow()},
+                         {"load_average_start", loadAverage()},
+                         {"pocl_cache_dir", poclCache ? poclCache : "default (~/.cache/pocl)"}};
+    report["frames"] = frames;
+    report["scenes"] = nlohmann::json::array();
+    std::cout << "clvr bench on " << device.description() << "\nplatform "
+              << report["machine"]["platform_version"].get<std::string>() << "\nCPU " << cpuModel() << ", "
+              << std::thread::hardware_concurrency() << " cores, " << utcNow() << ", load average "
+              << loadAverage() << "\n\n";
+
+    for (const fs::path& scenePath : scenes) {
+        const std::string name = scenePath.stem().string();
+        const fs::path prefix = outDir / ("bench." + name);
+        const Scene scene = loadScene(scenePath);
+        const Volume volume = loadVolume(scene.volume, scene.baseDir);
+        const Camera camera = scene.camera ? *scene.camera : fitCamera(volume.boundsMin(), volume.boundsMax());
+
+        const double compile0 = device.compileMs();
+        auto t0 = Clock::now();
+        const std::unique_ptr<Renderer> renderer = makeRenderer(device, scene, volume);
+        const double setupMs = msSince(t0);
+        FrameStats firstStats;
+        t0 = Clock::now();
+        renderer->render(firstStats);
+        const double firstFrameMs = msSince(t0);
+        const double compileMs = device.compileMs() - compile0;
+
+        std::vector<double> ms, statsMs;
+        FrameStats stats;
+        Image4f image;
+        for (int i = 0; i < frames; ++i) {
+            stats = FrameStats{};
+            t0 = Clock::now();
+            image = renderer->render(stats);
+            ms.push_back(msSince(t0));
+            statsMs.push_back(stats.frameMs);
+        }
+        const Spread s = spread(ms);
+        const double samplesPerS = stats.samples / (s.median * 1e-3);
+        const std::uint64_t resident = renderer->residentBytes();
+        const fs::path clvrPng = prefix.string() + ".clvr.png";
+        writeImage(clvrPng.string(), image);
+
+        nlohmann::json r = {
+            {"scene", scenePath.string()},
+            {"name", name},
+            {"technique", scene.technique},
+            {"width", scene.image.width},
+            {"height", scene.image.height},
+            {"dims", {volume.dims.x, volume.dims.y, volume.dims.z}},
+            {"voxels", volume.voxelCount()},
+            {"setup_ms", setupMs},
+            {"compile_ms", compileMs},
+            {"first_frame_ms", firstFrameMs},
+            {"frame_ms", s.median},
+            {"frame_ms_min", s.min},
+            {"frame_ms_max", s.max},
+            {"frame_ms_all", ms},
+            {"frame_ms_renderer", spread(statsMs).median},
+            {"fps", 1000.0 / s.median},
+            {"samples", stats.samples},
+            {"samples_per_s", samplesPerS},
+            {"resident_bytes", resident},
+            {"bytes_per_voxel", static_cast<double>(resident) / volume.voxelCount()},
+            {"image", clvrPng.string()},
+            {"extra", stats.extra}};
+        r["passes"] = nlohmann::json::array();
+        for (const PassTime& p : stats.passes)
+            r["passes"].push_back({{"name", p.name}, {"ms", p.ms}});
+
+        std::cout << name << " (" << scene.technique << ", " << volume.dims.x << "x" << volume.dims.y << "x"
+                  << volume.dims.z << ", " << scene.image.width << "x" << scene.image.height << ")\n"
+                  << "  frame        " << fixed(s.median, 1) << " ms median (min " << fixed(s.min, 1) << ", max "
+                  << fixed(s.max, 1) << ", " << frames << " frames), " << fixed(1000.0 / s.median, 2) << " frames/s\n"
+                  << "  samples      " << si(static_cast<double>(stats.samples)) << " per frame, "
+                  << si(samplesPerS) << " samples/s\n"
+                  << "  first frame  " << fixed(firstFrameMs, 1) << " ms, after set-up " << fixed(setupMs, 1)
+                  << " ms; kernel compile " << fixed(compileMs, 1) << " ms of the two\n"
+                  << "  resident     " << fixed(static_cast<double>(resident) / volume.voxelCount(), 2)
+                  << " bytes/voxel (" << si(static_cast<double>(resident)) << "B)\n"
+                  << std::flush;
+
+        if (scene.technique == "slice3d") {
+            r["ceiling"] = runCeiling(scene, volume, camera, image, samplesPerS, prefix.string() + ".ceiling.png");
+            const nlohmann::json& c = r["ceiling"];
+            std::cout << "  ceiling      " << fixed(c["frame_ms"].get<double>(), 1) << " ms, "
+                      << si(c["samples_per_s"].get<double>()) << " samples/s (" << c["threads"].get<int>()
+                      << " threads); clvr at " << fixed(100.0 * c["clvr_ratio"].get<double>(), 1)
+                      << "% of it; image |diff| max " << fixed(c["image_diff_vs_clvr"]["max"].get<double>(), 4)
+                      << ", mean " << fixed(c["image_diff_vs_clvr"]["mean"].get<double>(), 5) << '\n'
+                      << std::flush;
+        }
+        if (options.peer) {
+            // VTK samples at clvr's slice spacing (slice3d reports it; other techniques: slice3d's default plan).
+            const double sampleDistance =
+                stats.extra.contains("slice_spacing")
+                    ? stats.extra["slice_spacing"].get<double>()
+                    : planSlices(camera, volume.boundsMin(), volume.boundsMax(), Slice3dOptions{}).deltaS;
+            nlohmann::json peer = runPeer(scenePath, frames, sampleDistance, clvrPng, prefix);
+            if (peer.contains("frame_ms")) {
+                peer["clvr_speedup"] = peer["frame_ms"].get<double>() / s.median;
+                std::cout << "  VTK          " << fixed(peer["frame_ms"].get<double>(), 1) << " ms ("
+                          << peer.value("mapper", std::string("?")) << "); clvr "
+                          << fixed(peer["clvr_speedup"].get<double>(), 2) << "x faster; image |diff| mean "
+                          << fixed(peer["image_diff_vs_clvr"]["mean"].get<double>(), 4) << ", max "
+                          << fixed(peer["image_diff_vs_clvr"]["max"].get<double>(), 4) << '\n';
+            } else {
+                std::cout << "  VTK          " << peer.value("error", std::string("failed")) << '\n';
+            }
+            r["peer"] = peer;
+        }
+        std::cout << '\n';
+        report["scenes"].push_back(r);
+    }
+
+#if CLVR_BENCH_RASTER
+    report["raster"] = rasterBench(device);
+    {
+        const nlohmann::json& r = report["raster"];
+        std::cout << "raster (raster::draw, 512x512, 1000 random blended triangles)\n"
+                  << "  draw         " << fixed(r["draw_ms"].get<double>(), 2) << " ms median (first "
+                  << fixed(r["first_draw_ms"].get<double>(), 1) << " ms, compile "
+                  << fixed(r["compile_ms"].get<double>(), 1) << " ms)\n"
+                  << "  throughput   " << si(r["triangles_per_s"].get<double>()) << " triangles/s, "
+                  << si(r["fragments_per_s"].get<double>()) << " fragments/s (" << r["fragments"].get<std::uint64_t>()
+                  << " fragments per draw)\n\n";
+    }
+#else
+    report["raster"] = {{"skipped", "raster/rasterizer.h not wired into clvr bench yet"}};
+#endif
+
+    report["machine"]["load_average_end"] = loadAverage();
+    std::ofstream out(outJson);
+    if (!out)
+        throw InputError(outJson.string() + ": cannot write");
+    out << report.dump(2) << '\n';
+    if (!out)
+        throw InputError(outJson.string() + ": write failed");
+    std::cout << "wrote " << outJson.string() << '\n';
+    return 0;
+}
+
+}  // namespace clvr::tools

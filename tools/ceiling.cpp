@@ -1,0 +1,161 @@
+// tools/ceiling.cpp — the plain C++ ceiling loop for slice3d (see ceiling.h): kernels/slice3d.cl's
+// slice3d_fused, line for line in float, over rows on std::threads.
+#include "tools/ceiling.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <thread>
+
+namespace clvr::tools {
+
+Ceiling::Ceiling(const Volume& volume, const TransferFunction& tf, const CeilingScene& scene)
+    : volume_(volume), scene_(scene),
+      plan_(planSlices(scene.camera, volume.boundsMin(), volume.boundsMax(), scene.options))
+{
+    for (const ControlPoint& p : tf.points()) {
+        tfS_.push_back(static_cast<float>(p.s));
+        tfValue_.emplace_back(glm::vec3(p.color), static_cast<float>(p.tau));
+    }
+}
+
+CeilingResult Ceiling::render(int threads) const
+{
+    if (threads <= 0)
+        threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    CeilingResult result;
+    result.image = Image4f(scene_.width, scene_.height);
+    std::atomic<int> nextRow{0};
+    std::vector<std::uint64_t> samples(threads, 0);
+    std::vector<std::thread> pool;
+    for (int t = 0; t < threads; ++t)
+        pool.emplace_back([&, t] {
+            std::uint64_t count = 0;
+            for (int y; (y = nextRow.fetch_add(1)) < scene_.height;)
+                count += renderRow(y, result.image);
+            samples[t] = count;
+        });
+    for (std::thread& th : pool)
+        th.join();
+    for (std::uint64_t s : samples)
+        result.samples += s;
+    return result;
+}
+
+std::uint64_t Ceiling::renderRow(int y, Image4f& image) const
+{
+    const Camera& cam = scene_.camera;
+    const int width = scene_.width, height = scene_.height;
+    const glm::vec3 position(cam.position), forward(cam.forward()), right(cam.right()), up(cam.up());
+    const float scale = static_cast<float>(cam.parallel ? cam.parallelScale : std::tan(glm::radians(cam.viewAngle) * 0.5));
+    const float aspect = static_cast<float>(width) / static_cast<float>(height);
+    const glm::vec3 origin(volume_.origin), invSpacing(1.0 / volume_.spacing);
+    const glm::ivec3 n = volume_.dims;
+    const glm::vec3 last(n - 1);
+    const float* v = volume_.values.data();
+    const std::size_t nx = static_cast<std::size_t>(n.x), nxy = nx * n.y;
+    const float depth0 = static_cast<float>(plan_.depth(0)), deltaS = static_cast<float>(plan_.deltaS);
+    const int sliceCount = plan_.count;
+    const bool frontToBack = scene_.options.order == Slice3dOptions::Order::FrontToBack;
+    const float ertAlpha = scene_.options.earlyTermination < 1.0 ? static_cast<float>(scene_.options.earlyTermination) : 2.0f;
+    const glm::vec3 background(scene_.background);
+    const int tfCount = static_cast<int>(tfS_.size());
+    const float* tfS = tfS_.data();
+    const glm::vec4* tfValue = tfValue_.data();
+
+    auto sample = [&](const glm::vec3& g) {  // clvr_trilinear, then clvr_tf_eval
+        const int i = std::min(static_cast<int>(g.x), n.x - 2);
+        const int j = std::min(static_cast<int>(g.y), n.y - 2);
+        const int k = std::min(static_cast<int>(g.z), n.z - 2);
+        const float fx = g.x - i, fy = g.y - j, fz = g.z - k;
+        const float* p = v + k * nxy + j * nx + i;
+        const float c00 = p[0] + fx * (p[1] - p[0]);
+        const float c10 = p[nx] + fx * (p[nx + 1] - p[nx]);
+        const float c01 = p[nxy] + fx * (p[nxy + 1] - p[nxy]);
+        const float c11 = p[nxy + nx] + fx * (p[nxy + nx + 1] - p[nxy + nx]);
+        const float c0 = c00 + fy * (c10 - c00), c1 = c01 + fy * (c11 - c01);
+        const float s = c0 + fz * (c1 - c0);
+        if (!(s > tfS[0]))
+            return tfValue[0];
+        if (s >= tfS[tfCount - 1])
+            return tfValue[tfCount - 1];
+        int m = 1;
+        while (tfS[m] <= s)
+            ++m;
+        const float t = (s - tfS[m - 1]) / (tfS[m] - tfS[m - 1]);
+        return tfValue[m - 1] + t * (tfValue[m] - tfValue[m - 1]);  // (r, g, b, tau)
+    };
+    auto inside = [&](const glm::vec3& g) {
+        return g.x >= 0.0f && g.y >= 0.0f && g.z >= 0.0f && g.x <= last.x && g.y <= last.y && g.z <= last.z;
+    };
+
+    std::uint64_t taken = 0;
+    for (int x = 0; x < width; ++x) {
+        // The ray o + z d, z the eye depth (dot(d, forward) = 1): slice3d_ray and slice3d_stretch.
+        const float ndcX = (x + 0.5f) / width * 2.0f - 1.0f, ndcY = 1.0f - (y + 0.5f) / height * 2.0f;
+        const float sx = ndcX * scale * aspect, sy = ndcY * scale;
+        glm::vec3 o = position, d = forward + sx * right + sy * up;
+        float stretch = std::sqrt(1.0f + sx * sx + sy * sy);
+        if (cam.parallel) {
+            o = position + sx * right + sy * up;
+            d = forward;
+            stretch = 1.0f;
+        }
+        const float delta = deltaS * stretch;  // ray length per slice
+        const glm::vec3 go = (o - origin) * invSpacing, gd = d * invSpacing;
+
+        // Depth interval inside the grid bounds, widened by one slice each way.
+        float zin = -std::numeric_limits<float>::infinity(), zout = std::numeric_limits<float>::infinity();
+        for (int a = 0; a < 3; ++a) {
+            if (gd[a] == 0.0f) {
+                if (go[a] < 0.0f || go[a] > last[a])
+                    zout = -std::numeric_limits<float>::infinity();
+                continue;
+            }
+            const float t0 = (0.0f - go[a]) / gd[a], t1 = (last[a] - go[a]) / gd[a];
+            zin = std::max(zin, std::min(t0, t1));
+            zout = std::min(zout, std::max(t0, t1));
+        }
+        int kLo = 0, kHi = -1;
+        if (zin <= zout) {
+            const float cnt = static_cast<float>(sliceCount);
+            kLo = static_cast<int>(std::clamp(std::ceil((zin - depth0) / deltaS) - 1.0f, 0.0f, cnt));
+            kHi = static_cast<int>(std::clamp(std::floor((zout - depth0) / deltaS) + 1.0f, -1.0f, cnt - 1.0f));
+        }
+
+        glm::vec3 c(0.0f);
+        float alphaAcc = 0.0f;
+        if (frontToBack) {
+            float transmittance = 1.0f;
+            for (int k = kLo; k <= kHi; ++k) {
+                const glm::vec3 g = go + (depth0 + k * deltaS) * gd;
+                if (!inside(g))
+                    continue;
+                ++taken;
+                const glm::vec4 ct = sample(g);
+                const float alpha = 1.0f - std::exp(-ct.w * delta);  // Eq. 1 of seeds/001 per slab
+                c += (transmittance * alpha) * glm::vec3(ct);
+                transmittance *= 1.0f - alpha;
+                if (1.0f - transmittance >= ertAlpha)
+                    break;
+            }
+            alphaAcc = 1.0f - transmittance;
+        } else {
+            for (int k = kHi; k >= kLo; --k) {
+                const glm::vec3 g = go + (depth0 + k * deltaS) * gd;
+                if (!inside(g))
+                    continue;
+                ++taken;
+                const glm::vec4 ct = sample(g);
+                const float alpha = 1.0f - std::exp(-ct.w * delta);
+                c = glm::vec3(ct) * alpha + (1.0f - alpha) * c;
+                alphaAcc = alpha + (1.0f - alpha) * alphaAcc;
+            }
+        }
+        image.at(x, y) = glm::vec4(c + (1.0f - alphaAcc) * background, alphaAcc);
+    }
+    return taken;
+}
+
+}  // namespace clvr::tools
