@@ -17,8 +17,9 @@ typedef struct {
     constant float4* uniforms;
 } ClFragmentResources;
 
-/* Defined by the fragment program appended after this file. Returns 0 to discard. */
-int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* color);
+/* Defined by the fragment program appended after this file. Returns 0 to discard. Always inlined,
+ * so that the fragment never goes through memory and unused attributes are never interpolated. */
+__attribute__((always_inline)) int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* color);
 
 int clvr_compare_float(uint func, float a, float b)
 {
