@@ -100,6 +100,14 @@ std::optional<double> parseDouble(const std::string& s)
     return v;
 }
 
+// A number as a person would write it: 0.5, -1, nan (std::to_string gives 0.500000).
+std::string num(double v)
+{
+    std::ostringstream s;
+    s << v;
+    return s.str();
+}
+
 std::string dimsText(const std::vector<long long>& sizes)
 {
     std::string s;
@@ -849,7 +857,7 @@ Volume readNrrd(const fs::path& path)
         for (int a = 0; a < 3; ++a) {
             const double s = (*h.spacings)[skipAxes + static_cast<std::size_t>(a)];
             if (!(s > 0.0) || !std::isfinite(s))
-                throw InputError(source + ": spacing of axis " + std::to_string(a) + " is " + std::to_string(s) +
+                throw InputError(source + ": spacing of axis " + std::to_string(a) + " is " + num(s) +
                                  ", must be a positive finite number");
             v.spacing[a] = s;
         }
@@ -1056,7 +1064,7 @@ Volume readVtkStructuredPoints(const fs::path& path)
                          dimsText(*dims) + " = " + std::to_string(count));
     for (int a = 0; a < 3; ++a)
         if (!(spacing[a] > 0.0))
-            throw InputError(source + ": spacing of axis " + std::to_string(a) + " is " + std::to_string(spacing[a]) +
+            throw InputError(source + ": spacing of axis " + std::to_string(a) + " is " + num(spacing[a]) +
                              ", must be positive");
 
     t = nextTokens();

@@ -783,15 +783,21 @@ TEST(VolumeIo, GarbageNeverCrashes)
 {
     TempDir dir;
     clvr::test::Rng rng(20261122);
+    const int nrrdHeaderSize = static_cast<int>(nrrdHeader("short", "\n").size());
+    const int vtkHeaderSize = static_cast<int>(vtkHeader("BINARY", "short").size());
     const std::string validNrrd = nrrdHeader("short", "\n") + std::string(240, '\1');
     const std::string validVtk = vtkHeader("BINARY", "short") + std::string(240, '\1');
-    for (int trial = 0; trial < 300; ++trial) {
+    const char digits[] = "0123456789-.9e";
+    for (int trial = 0; trial < 600; ++trial) {
         std::string nrrd = validNrrd, vtk = validVtk;
+        // Odd trials change header bytes only, mostly into digits, where the sizes and spacings live.
+        const bool header = trial % 2 == 1;
         for (int m = 0; m < 1 + trial % 5; ++m) {
-            nrrd[static_cast<std::size_t>(rng.integer(9, static_cast<int>(nrrd.size()) - 1))] =
-                static_cast<char>(rng.integer(0, 255));
-            vtk[static_cast<std::size_t>(rng.integer(27, static_cast<int>(vtk.size()) - 1))] =
-                static_cast<char>(rng.integer(0, 255));
+            const char c = header && m % 2 == 0 ? digits[rng.integer(0, 13)] : static_cast<char>(rng.integer(0, 255));
+            nrrd[static_cast<std::size_t>(
+                rng.integer(9, header ? nrrdHeaderSize - 1 : static_cast<int>(nrrd.size()) - 1))] = c;
+            vtk[static_cast<std::size_t>(
+                rng.integer(27, header ? vtkHeaderSize - 1 : static_cast<int>(vtk.size()) - 1))] = c;
         }
         if (trial % 7 == 0) {
             nrrd.resize(static_cast<std::size_t>(rng.integer(0, static_cast<int>(nrrd.size()))));
