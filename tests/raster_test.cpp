@@ -201,6 +201,7 @@ TEST(RasterConformance, RandomTrianglesAndStatesMatchReference)
     Rng rng(20240611);
     const int sizes[][2] = {{37, 23}, {61, 45}};
     std::size_t tiesTotal = 0, pixelsTotal = 0;
+    std::uint64_t fragmentsTotal = 0;
     for (int round = 0; round < 16; ++round) {
         SCOPED_TRACE("round " + std::to_string(round));
         const int width = sizes[round % 2][0], height = sizes[round % 2][1];
@@ -213,7 +214,7 @@ TEST(RasterConformance, RandomTrianglesAndStatesMatchReference)
         ref::Planes coverWant(width, height);
         TieFinder ties(std::size_t(width) * height);
 
-        const int draws = rng.integer(1, 3);
+        const int draws = rng.integer(2, 3);
         for (int d = 0; d < draws; ++d) {
             raster::DrawState state;
             state.fragment = randomState(rng);
@@ -223,13 +224,14 @@ TEST(RasterConformance, RandomTrianglesAndStatesMatchReference)
                 state.viewport = {rng.integer(-8, 8), rng.integer(-8, 8), rng.integer(10, width), rng.integer(10, height),
                                   float(rng.uniform(0, 0.3)), float(rng.uniform(0.6, 1.0))};
             const auto topology = static_cast<raster::Topology>(rng.integer(0, 2));
-            const std::vector<raster::Vertex> v = randomVertices(rng, rng.integer(3, 12));
+            const std::vector<raster::Vertex> v = randomVertices(rng, rng.integer(12, 36));
 
             markTies(ties, want, state, topology, v);
             const raster::DrawStats got = raster::draw(device, fb, state, topology, v);
             const raster::DrawStats expect = ref::draw(want, state, topology, v);
             EXPECT_EQ(got.triangles, expect.triangles);
             EXPECT_EQ(got.fragments, expect.fragments);
+            fragmentsTotal += got.fragments;
 
             raster::draw(device, cover, coverageCountState(state), topology, v);
             ref::draw(coverWant, coverageCountState(state), topology, v);
@@ -243,6 +245,7 @@ TEST(RasterConformance, RandomTrianglesAndStatesMatchReference)
         EXPECT_TRUE(planesNear(fb, device, want, ties.ties));
     }
     EXPECT_LE(tiesTotal, pixelsTotal / 200) << "near-tie pixels are excluded from the comparison; they must be rare";
+    EXPECT_GT(fragmentsTotal, pixelsTotal) << "the random scenes must cover a good part of the frame buffers";
     device.takePassTimes();
 }
 
