@@ -39,11 +39,13 @@ void writeImage(const std::string& path, const Image4f& image)
     const int w = image.width(), h = image.height();
     bool ok = false;
     if (ext == ".png") {
-        OIIO::ImageSpec spec(w, h, 4, OIIO::TypeDesc::UINT8);
-        std::vector<unsigned char> bytes(static_cast<std::size_t>(w) * h * 4);
+        // The background is already composited (I + (1 - A) * background), so a PNG is the
+        // opaque RGB picture a person looks at; EXR keeps A for tools that composite again.
+        OIIO::ImageSpec spec(w, h, 3, OIIO::TypeDesc::UINT8);
+        std::vector<unsigned char> bytes(static_cast<std::size_t>(w) * h * 3);
         for (std::size_t i = 0; i < image.pixelCount(); ++i)
-            for (int c = 0; c < 4; ++c)
-                bytes[i * 4 + c] = toByte(image.pixels()[i][c]);
+            for (int c = 0; c < 3; ++c)
+                bytes[i * 3 + c] = toByte(image.pixels()[i][c]);
         ok = out->open(tmp.string(), spec) && out->write_image(OIIO::TypeDesc::UINT8, bytes.data());
     } else {
         OIIO::ImageSpec spec(w, h, 4, OIIO::TypeDesc::FLOAT);

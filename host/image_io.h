@@ -1,5 +1,5 @@
-// host/image_io.h — image files through OpenImageIO. PNG: 8-bit, round(clamp(x,0,1)*255), no gamma
-// (DESIGN.md); EXR: float RGBA. Writes go to a temporary file renamed into place, so a failure
+// host/image_io.h — image files through OpenImageIO. PNG: 8-bit RGB, round(clamp(x,0,1)*255), no gamma
+// (DESIGN.md), opaque because the background is already composited; EXR: float RGBA. Writes go to a temporary file renamed into place, so a failure
 // never leaves a partial output file.
 #pragma once
 
