@@ -171,8 +171,57 @@ long clvr_edge(int xa, int ya, int xb, int yb, int px, int py)
     return (long)(xb - xa) * (long)(py - ya) - (long)(yb - ya) * (long)(px - xa);
 }
 
-/* One work-item per pixel of the viewport rectangle (rect_*, clipped to the frame buffer). Tiles of
- * CLVR_TILE_SIZE pixels start at the rectangle's corner; tile t lists triangle indices
+/* One fragment of triangle t at pixel (px, py) with exact edge values e0..e2, through GL's
+ * per-fragment operations against the pixel's color c, depth d and stencil s (kept in registers). */
+__attribute__((always_inline)) void clvr_shade(global const ClTriangle* t, long e0, long e1, long e2, int px, int py,
+                                               const ClFragmentState* fs, const ClBlendState* bs,
+                                               const ClvrBlend* blend, int4 write_mask,
+                                               const ClFragmentResources* resources, float4* c, float* d, uint* s)
+{
+    /* Barycentrics in window space; depth is linear there, attributes perspective-correct:
+     * attr = sum(l_i attr_i / w_i) / sum(l_i / w_i). */
+    const float l0 = (float)e1 * t->inv_area;
+    const float l1 = (float)e2 * t->inv_area;
+    const float l2 = (float)e0 * t->inv_area;
+    ClFragment f;
+    f.window = (float2)((float)px + 0.5f, (float)py + 0.5f);
+    f.depth = l0 * t->depth.x + l1 * t->depth.y + l2 * t->depth.z;
+    f.front_facing = (int)t->front_facing;
+    const float q = 1.0f / (l0 * t->inv_w.x + l1 * t->inv_w.y + l2 * t->inv_w.z);
+    for (int k = 0; k < CLVR_MAX_ATTRIBUTES; ++k)
+        f.attr[k] = (l0 * t->attr_over_w[0][k] + l1 * t->attr_over_w[1][k] + l2 * t->attr_over_w[2][k]) * q;
+
+    float4 src;
+    if (!clvr_fragment(&f, resources, &src))
+        return;
+    if (fs->alpha_test && !clvr_compare_float(fs->alpha_func, src.w, fs->alpha_ref))
+        return;
+    if (fs->stencil_test) {
+        const uint m = fs->stencil_read_mask;
+        if (!clvr_compare_uint(fs->stencil_func, fs->stencil_ref & m, *s & m)) {
+            *s = clvr_stencil_op(fs->stencil_sfail, *s, fs->stencil_ref, fs->stencil_write_mask);
+            return;
+        }
+    }
+    if (fs->depth_test) {
+        if (!clvr_compare_float(fs->depth_func, f.depth, *d)) {
+            if (fs->stencil_test)
+                *s = clvr_stencil_op(fs->stencil_dpfail, *s, fs->stencil_ref, fs->stencil_write_mask);
+            return;
+        }
+        if (fs->depth_write)
+            *d = f.depth;
+    }
+    if (fs->stencil_test)
+        *s = clvr_stencil_op(fs->stencil_dppass, *s, fs->stencil_ref, fs->stencil_write_mask);
+    const float4 blended = bs->enabled ? clvr_blend(blend, src, *c) : src;
+    *c = select(*c, blended, write_mask);
+}
+
+/* One work-item per CLVR_PIXELS_PER_ITEM horizontally adjacent pixels of the viewport rectangle
+ * (rect_*, clipped to the frame buffer): independent pixels give the CPU instruction-level
+ * parallelism and share each triangle's loads. Tiles of CLVR_TILE_SIZE pixels start at the
+ * rectangle's corner, so a work-item's pixels share a tile; tile t lists triangle indices
  * tile_tris[tile_start[t] .. tile_start[t+1]) in submission order. fragment_counts[row] receives
  * the covered-pixel count of that rectangle row. */
 kernel void raster_fragments(global float4* color, global float* depth, global uchar* stencil, const int fb_width,
@@ -183,19 +232,20 @@ kernel void raster_fragments(global float4* color, global float* depth, global u
                              global const float* buffer2, global const float* buffer3,
                              global uint* fragment_counts)
 {
-    CLVR_GUARD_2D(rect_w, rect_h);
-    const int gx = (int)get_global_id(0);
+    CLVR_GUARD_2D((rect_w + CLVR_PIXELS_PER_ITEM - 1) / CLVR_PIXELS_PER_ITEM, rect_h);
+    const int gx0 = (int)get_global_id(0) * CLVR_PIXELS_PER_ITEM;
     const int gy = (int)get_global_id(1);
-    const int tile = (gy / CLVR_TILE_SIZE) * tiles_x + gx / CLVR_TILE_SIZE;
+    const int tile = (gy / CLVR_TILE_SIZE) * tiles_x + gx0 / CLVR_TILE_SIZE;
     const uint begin = tile_start[tile];
     const uint end = tile_start[tile + 1];
     if (begin == end)
         return;
 
-    const int px = rect_x + gx;
+    const int px0 = rect_x + gx0;
     const int py = rect_y + gy;
-    const size_t pixel = (size_t)py * (size_t)fb_width + (size_t)px;
-    const int sx = px * CLVR_SUBPIXEL_SCALE + CLVR_SUBPIXEL_SCALE / 2;  /* pixel center */
+    const int count = min(CLVR_PIXELS_PER_ITEM, rect_w - gx0);
+    const size_t pixel0 = (size_t)py * (size_t)fb_width + (size_t)px0;
+    const int sx0 = px0 * CLVR_SUBPIXEL_SCALE + CLVR_SUBPIXEL_SCALE / 2;  /* first pixel center */
     const int sy = py * CLVR_SUBPIXEL_SCALE + CLVR_SUBPIXEL_SCALE / 2;
 
     ClFragmentResources resources;
@@ -204,70 +254,54 @@ kernel void raster_fragments(global float4* color, global float* depth, global u
     resources.buffer[2] = buffer2;
     resources.buffer[3] = buffer3;
     resources.uniforms = uniforms;
-
     const ClvrBlend blend = clvr_blend_setup(&bs);
     const int4 write_mask = (int4)((fs.color_mask & CLVR_MASK_R) ? -1 : 0, (fs.color_mask & CLVR_MASK_G) ? -1 : 0,
                                    (fs.color_mask & CLVR_MASK_B) ? -1 : 0, (fs.color_mask & CLVR_MASK_A) ? -1 : 0);
-    float4 c = color[pixel];
-    float d = depth[pixel];
-    uint s = stencil[pixel];
+
+    float4 c[CLVR_PIXELS_PER_ITEM];
+    float d[CLVR_PIXELS_PER_ITEM];
+    uint s[CLVR_PIXELS_PER_ITEM];
     uint covered = 0;
+#pragma unroll
+    for (int p = 0; p < CLVR_PIXELS_PER_ITEM; ++p) {
+        const size_t i = pixel0 + (size_t)min(p, count - 1);  /* past the rectangle: a harmless duplicate */
+        c[p] = color[i];
+        d[p] = depth[i];
+        s[p] = stencil[i];
+    }
 
     for (uint i = begin; i < end; ++i) {
         global const ClTriangle* t = tris + tile_tris[i];
-        /* e0: edge 0->1 (opposite vertex 2), e1: edge 1->2 (opposite 0), e2: edge 2->0 (opposite 1). */
-        const long e0 = clvr_edge(t->x[0], t->y[0], t->x[1], t->y[1], sx, sy);
-        const long e1 = clvr_edge(t->x[1], t->y[1], t->x[2], t->y[2], sx, sy);
-        const long e2 = clvr_edge(t->x[2], t->y[2], t->x[0], t->y[0], sx, sy);
-        /* Top-left rule: a pixel center on an edge belongs to the triangle only for a top or left edge. */
-        if (e0 + t->bias[0] < 0 || e1 + t->bias[1] < 0 || e2 + t->bias[2] < 0)
-            continue;
-        ++covered;
-
-        /* Barycentrics in window space; depth is linear there, attributes perspective-correct. */
-        const float l0 = (float)e1 * t->inv_area;
-        const float l1 = (float)e2 * t->inv_area;
-        const float l2 = (float)e0 * t->inv_area;
-        ClFragment f;
-        f.window = (float2)((float)px + 0.5f, (float)py + 0.5f);
-        f.depth = l0 * t->depth.x + l1 * t->depth.y + l2 * t->depth.z;
-        f.front_facing = (int)t->front_facing;
-        /* attr = sum(l_i attr_i / w_i) / sum(l_i / w_i) */
-        const float q = 1.0f / (l0 * t->inv_w.x + l1 * t->inv_w.y + l2 * t->inv_w.z);
-        for (int k = 0; k < CLVR_MAX_ATTRIBUTES; ++k)
-            f.attr[k] = (l0 * t->attr_over_w[0][k] + l1 * t->attr_over_w[1][k] + l2 * t->attr_over_w[2][k]) * q;
-
-        float4 src;
-        if (!clvr_fragment(&f, &resources, &src))
-            continue;
-        if (fs.alpha_test && !clvr_compare_float(fs.alpha_func, src.w, fs.alpha_ref))
-            continue;
-        if (fs.stencil_test) {
-            const uint m = fs.stencil_read_mask;
-            if (!clvr_compare_uint(fs.stencil_func, fs.stencil_ref & m, s & m)) {
-                s = clvr_stencil_op(fs.stencil_sfail, s, fs.stencil_ref, fs.stencil_write_mask);
-                continue;
+        /* e0: edge 0->1 (opposite vertex 2), e1: edge 1->2 (opposite 0), e2: edge 2->0 (opposite 1);
+         * one pixel to the right adds -(y_b - y_a) * CLVR_SUBPIXEL_SCALE. */
+        long e0 = clvr_edge(t->x[0], t->y[0], t->x[1], t->y[1], sx0, sy);
+        long e1 = clvr_edge(t->x[1], t->y[1], t->x[2], t->y[2], sx0, sy);
+        long e2 = clvr_edge(t->x[2], t->y[2], t->x[0], t->y[0], sx0, sy);
+        const long step0 = -(long)(t->y[1] - t->y[0]) * CLVR_SUBPIXEL_SCALE;
+        const long step1 = -(long)(t->y[2] - t->y[1]) * CLVR_SUBPIXEL_SCALE;
+        const long step2 = -(long)(t->y[0] - t->y[2]) * CLVR_SUBPIXEL_SCALE;
+#pragma unroll
+        for (int p = 0; p < CLVR_PIXELS_PER_ITEM; ++p) {
+            /* Top-left rule: a pixel center on an edge belongs to the triangle only for a top or left edge. */
+            if (p < count && e0 + t->bias[0] >= 0 && e1 + t->bias[1] >= 0 && e2 + t->bias[2] >= 0) {
+                ++covered;
+                clvr_shade(t, e0, e1, e2, px0 + p, py, &fs, &bs, &blend, write_mask, &resources, &c[p], &d[p], &s[p]);
             }
+            e0 += step0;
+            e1 += step1;
+            e2 += step2;
         }
-        if (fs.depth_test) {
-            if (!clvr_compare_float(fs.depth_func, f.depth, d)) {
-                if (fs.stencil_test)
-                    s = clvr_stencil_op(fs.stencil_dpfail, s, fs.stencil_ref, fs.stencil_write_mask);
-                continue;
-            }
-            if (fs.depth_write)
-                d = f.depth;
-        }
-        if (fs.stencil_test)
-            s = clvr_stencil_op(fs.stencil_dppass, s, fs.stencil_ref, fs.stencil_write_mask);
-        const float4 blended = bs.enabled ? clvr_blend(&blend, src, c) : src;
-        c = select(c, blended, write_mask);
     }
 
     if (covered) {
-        color[pixel] = c;
-        depth[pixel] = d;
-        stencil[pixel] = (uchar)s;
+#pragma unroll
+        for (int p = 0; p < CLVR_PIXELS_PER_ITEM; ++p) {
+            if (p < count) {
+                color[pixel0 + p] = c[p];
+                depth[pixel0 + p] = d[p];
+                stencil[pixel0 + p] = (uchar)s[p];
+            }
+        }
         atomic_add(fragment_counts + gy, covered);
     }
 }

@@ -23,8 +23,10 @@ typedef float cl_float;
  * coverage is decided by exact integer edge functions on the host, the device and the reference. */
 #define CLVR_SUBPIXEL_BITS 8
 #define CLVR_SUBPIXEL_SCALE 256
-/* Triangles are binned to square screen tiles of this many pixels. */
+/* Triangles are binned to square screen tiles of this many pixels; one work-item shades this many
+ * horizontally adjacent pixels of a tile (CLVR_TILE_SIZE is a multiple of it). */
 #define CLVR_TILE_SIZE 16
+#define CLVR_PIXELS_PER_ITEM 4
 
 /* CompareFunc, StencilOp, BlendEquation and BlendFactor values: the host's enum classes. */
 #define CLVR_FUNC_NEVER 0u

@@ -326,7 +326,9 @@ DrawStats draw(Device& device, Framebuffer& fb, const DrawState& state, Topology
         }
     }
     k.setArg(arg++, countBuffer);
-    device.launch("raster: fragments", k, static_cast<std::size_t>(rect.width), static_cast<std::size_t>(rect.height));
+    static_assert(CLVR_TILE_SIZE % CLVR_PIXELS_PER_ITEM == 0);
+    const std::size_t items = (static_cast<std::size_t>(rect.width) + CLVR_PIXELS_PER_ITEM - 1) / CLVR_PIXELS_PER_ITEM;
+    device.launch("raster: fragments", k, items, static_cast<std::size_t>(rect.height));
 
     for (cl_uint c : device.download<cl_uint>(countBuffer, zeros.size()))
         stats.fragments += c;
