@@ -143,9 +143,9 @@ std::string si(double v)  // 1.23e+08 -> "123.0 M"
     return fixed(v, 1) + unit[u];
 }
 
-// The plain C++ ceiling loop on the same scene (slice3d only): timing and image difference.
-nlohmann::json runCeiling(const Scene& scene, const Volume& volume, const Camera& camera, const Image4f& clvrImage,
-                          double clvrSamplesPerS, const fs::path& imagePath)
+// The plain C++ ceiling loop on the same scene (slice3d only). Its frames are interleaved with clvr's
+// (see bench()), so that both see the same load on a shared machine.
+std::unique_ptr<Ceiling> makeCeiling(const Scene& scene, const Volume& volume, const Camera& camera)
 {
     CeilingScene cs;
     cs.camera = camera;
@@ -153,22 +153,23 @@ nlohmann::json runCeiling(const Scene& scene, const Volume& volume, const Camera
     cs.height = scene.image.height;
     cs.background = scene.image.background;
     cs.options = parseSlice3dOptions(scene.options);
-    const Ceiling ceiling(volume, scene.transferFunction, cs);
-    const int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-    CeilingResult first = ceiling.render(threads);  // warms caches and pages
-    std::vector<double> ms;
-    for (int i = 0; i < 3; ++i) {
-        const auto t0 = Clock::now();
-        first = ceiling.render(threads);
-        ms.push_back(msSince(t0));
-    }
+    return std::make_unique<Ceiling>(volume, scene.transferFunction, cs);
+}
+
+nlohmann::json ceilingReport(const Ceiling& ceiling, int threads, const CeilingResult& result,
+                             const std::vector<double>& ms, const Image4f& clvrImage, double clvrSamplesPerS,
+                             const fs::path& imagePath)
+{
     const Spread s = spread(ms);
-    const double samplesPerS = first.samples / (s.median * 1e-3);
-    writeImage(imagePath.string(), first.image);
-    const ImageDiff d = imageDiff(clvrImage, first.image);
+    const double samplesPerS = result.samples / (s.median * 1e-3);
+    writeImage(imagePath.string(), result.image);
+    const ImageDiff d = imageDiff(clvrImage, result.image);
     return {{"threads", threads},
             {"frame_ms", s.median},
-            {"samples", first.samples},
+            {"frame_ms_min", s.min},
+            {"frame_ms_max", s.max},
+            {"frame_ms_all", ms},
+            {"samples", result.samples},
             {"samples_per_s", samplesPerS},
             {"clvr_ratio", clvrSamplesPerS / samplesPerS},
             {"slices", ceiling.plan().count},
@@ -314,7 +315,15 @@ int bench(const BenchOptions& options)
         const double firstFrameMs = msSince(t0);
         const double compileMs = device.compileMs() - compile0;
 
-        std::vector<double> ms, statsMs;
+        // The ceiling's first frame warms its caches; then clvr and ceiling frames alternate.
+        const std::unique_ptr<Ceiling> ceiling =
+            scene.technique == "slice3d" ? makeCeiling(scene, volume, camera) : nullptr;
+        const int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+        CeilingResult ceilingResult;
+        if (ceiling)
+            ceilingResult = ceiling->render(threads);
+
+        std::vector<double> ms, statsMs, ceilingMs;
         FrameStats stats;
         Image4f image;
         for (int i = 0; i < frames; ++i) {
@@ -323,6 +332,11 @@ int bench(const BenchOptions& options)
             image = renderer->render(stats);
             ms.push_back(msSince(t0));
             statsMs.push_back(stats.frameMs);
+            if (ceiling) {
+                t0 = Clock::now();
+                ceilingResult = ceiling->render(threads);
+                ceilingMs.push_back(msSince(t0));
+            }
         }
         const Spread s = spread(ms);
         const double samplesPerS = stats.samples / (s.median * 1e-3);
@@ -369,12 +383,13 @@ int bench(const BenchOptions& options)
                   << " bytes/voxel (" << si(static_cast<double>(resident)) << "B)\n"
                   << std::flush;
 
-        if (scene.technique == "slice3d") {
-            r["ceiling"] = runCeiling(scene, volume, camera, image, samplesPerS, prefix.string() + ".ceiling.png");
+        if (ceiling) {
+            r["ceiling"] = ceilingReport(*ceiling, threads, ceilingResult, ceilingMs, image, samplesPerS,
+                                         prefix.string() + ".ceiling.png");
             const nlohmann::json& c = r["ceiling"];
             std::cout << "  ceiling      " << fixed(c["frame_ms"].get<double>(), 1) << " ms, "
                       << si(c["samples_per_s"].get<double>()) << " samples/s (" << c["threads"].get<int>()
-                      << " threads); clvr at " << fixed(100.0 * c["clvr_ratio"].get<double>(), 1)
+                      << " threads, interleaved with clvr's); clvr at " << fixed(100.0 * c["clvr_ratio"].get<double>(), 1)
                       << "% of it; image |diff| max " << fixed(c["image_diff_vs_clvr"]["max"].get<double>(), 4)
                       << ", mean " << fixed(c["image_diff_vs_clvr"]["mean"].get<double>(), 5) << '\n'
                       << std::flush;
