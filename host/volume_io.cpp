@@ -598,7 +598,9 @@ NrrdHeader readNrrdHeader(const fs::path& path)
             h.dataFiles.push_back(relative(words[0]));
         } else if (words.size() == 4 || words.size() == 5) {
             const auto lo = parseInteger(words[1]), hi = parseInteger(words[2]), step = parseInteger(words[3]);
-            if (!lo || !hi || !step || *step == 0 || (*hi - *lo) / *step < 0)
+            constexpr long long kMaxIndex = 1LL << 40;  // keeps the arithmetic below far from overflow
+            auto inRange = [&](const std::optional<long long>& x) { return x && *x > -kMaxIndex && *x < kMaxIndex; };
+            if (!inRange(lo) || !inRange(hi) || !inRange(step) || *step == 0 || (*hi - *lo) / *step < 0)
                 throw InputError(source + ": data file " + shown(*dataFileValue) +
                                  " is not \"<format> <min> <max> <step> [<subdim>]\"");
             const std::uint64_t count = static_cast<std::uint64_t>((*hi - *lo) / *step) + 1;
@@ -656,7 +658,10 @@ void readNrrdData(const NrrdHeader& h, const fs::path& file, std::uint64_t start
     const Endian endian = h.endian.value_or(Endian::Little);
     auto tooShort = [&](std::uint64_t available) {
         return InputError(source + ": " + sizeText + ", file has " + std::to_string(available) + " bytes" +
-                          (pos ? " after " + std::to_string(pos) + " bytes of header and skips" : ""));
+                          (pos == 0                               ? std::string()
+                           : h.byteSkip == 0 && h.lineSkip == 0 ? " after the " + std::to_string(pos) + "-byte header"
+                                                                : " after " + std::to_string(pos) +
+                                                                      " bytes of header and skips"));
     };
 
     if (*h.encoding == NrrdEncoding::Raw) {

@@ -625,6 +625,9 @@ TEST(VolumeIo, NrrdHeaderErrors)
     EXPECT_TRUE(expectError("NRRD0004\ntype: uchar\ndimension: 3\nsizes: 5 4 6\nencoding: raw\n", {"no data file"}));
     EXPECT_TRUE(expectError(nrrdHeader("uchar", "data file: f%s.raw 1 6 1\n"), {"data file format"}));
     EXPECT_TRUE(expectError(nrrdHeader("uchar", "data file: f%d.raw 1 6 0\n"), {"data file"}));
+    EXPECT_TRUE(expectError(nrrdHeader("uchar", "data file: f%d.raw -9223372036854775808 9223372036854775807 1\n"),
+                            {"data file"}));
+    EXPECT_TRUE(expectError(nrrdHeader("uchar", "data file: f%d.raw 1 100000000 1\n"), {"too many files"}));
     EXPECT_TRUE(expectError(nrrdHeader("uchar", "data file: f%d.raw 1 7 1\n"), {"do not split evenly"}));
     EXPECT_TRUE(expectError(nrrdHeader("uchar", "data file: LIST\n"), {"LIST names no files"}));
     EXPECT_TRUE(expectError(nrrdHeader("uchar", "data file: a b\n"), {"data file"}));
