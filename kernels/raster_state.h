@@ -26,7 +26,7 @@ typedef float cl_float;
 /* Triangles are binned to square screen tiles of this many pixels; one work-item shades this many
  * horizontally adjacent pixels of a tile (CLVR_TILE_SIZE is a multiple of it). */
 #define CLVR_TILE_SIZE 16
-#define CLVR_PIXELS_PER_ITEM 4
+#define CLVR_PIXELS_PER_ITEM 8
 
 /* CompareFunc, StencilOp, BlendEquation and BlendFactor values: the host's enum classes. */
 #define CLVR_FUNC_NEVER 0u
