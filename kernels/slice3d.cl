@@ -48,7 +48,8 @@ float slice3d_stretch(const float2 ndc, const float4 params)
 /* One work-item per pixel: slices k = 0 .. slice_count-1 at eye depth depth0 + k * delta_s. Only the
  * slices whose ray point lies in the grid bounds are sampled (the rest are empty, DESIGN.md); their
  * number goes to samples[pixel]. Back to front: c = C alpha + (1 - alpha) c (the paper's blending);
- * front to back: c += T alpha C, T *= 1 - alpha, stopping once 1 - T >= ert_alpha. The pixel is
+ * front to back: c += T alpha C, T *= 1 - alpha, stopping once 1 - T >= ert_alpha. alpha =
+ * 1 - exp(-tau Delta), computed as 1 - exp2(tau * (-Delta log2 e)). The pixel is
  * c + (1 - A) background, A. */
 kernel void slice3d_fused(global float4* out, global uint* samples, const int width, const int height,
                           global const float* volume, const int4 dims, const float4 grid_origin,
@@ -64,6 +65,7 @@ kernel void slice3d_fused(global float4* out, global uint* samples, const int wi
     float3 o, d;
     slice3d_ray(ndc, cam_position, cam_forward, cam_right, cam_up, cam_params, &o, &d);
     const float delta = delta_s * slice3d_stretch(ndc, cam_params);  /* ray length per slice */
+    const float neg_delta_log2e = -delta * M_LOG2E_F;                /* exp(-tau delta) = exp2(tau * this) */
     const float3 go = (o - grid_origin.xyz) * inv_spacing.xyz;     /* grid coordinates */
     const float3 gd = d * inv_spacing.xyz;
 
@@ -102,7 +104,7 @@ kernel void slice3d_fused(global float4* out, global uint* samples, const int wi
                 continue;
             ++taken;
             const float4 ct = clvr_tf_eval(tf, tf_count, clvr_trilinear(volume, dims, g));
-            const float alpha = 1.0f - exp(-ct.w * delta);
+            const float alpha = 1.0f - exp2(ct.w * neg_delta_log2e);
             c += (transmittance * alpha) * ct.xyz;
             transmittance *= 1.0f - alpha;
             if (1.0f - transmittance >= ert_alpha)
@@ -116,7 +118,7 @@ kernel void slice3d_fused(global float4* out, global uint* samples, const int wi
                 continue;
             ++taken;
             const float4 ct = clvr_tf_eval(tf, tf_count, clvr_trilinear(volume, dims, g));
-            const float alpha = 1.0f - exp(-ct.w * delta);
+            const float alpha = 1.0f - exp2(ct.w * neg_delta_log2e);
             c = ct.xyz * alpha + (1.0f - alpha) * c;
             alpha_acc = alpha + (1.0f - alpha) * alpha_acc;
         }

@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 
@@ -380,10 +381,11 @@ TEST(Slice3dFused, EarlyTerminationChangesPixelsByAtMostOneMinusThreshold)
 
 // The pass-by-pass path (slice polygons through raster::draw, fragment program, GL blending) is the
 // specification of the fused kernel. They sample the same points up to float rounding of the
-// perspective-correct world position, so pixels agree to ~1e-5, except where a sample lies on the
-// grid bounds to within rounding: one path may take it and the other not, a difference of at most
-// one slice's opacity 1 - exp(-tauMax Delta). Asserted: that max, mean 2e-4, and at most 1% of the
-// pixels differing by more than 1e-3.
+// perspective-correct world position, so pixels agree to ~1e-5, except where a pixel center lies
+// within the rasterizer's sub-pixel precision of a slice polygon's edge (a ray grazing a box face):
+// one path may take that sample and the other not, a difference of at most one slice's opacity
+// 1 - exp(-tauMax Delta). Asserted: that max, mean 2e-4, and at most 1% of the pixels differing by
+// more than 1e-3 (measured: 1 to 2 of 4096).
 TEST(Slice3dRaster, MatchesFused)
 {
     for (const Camera& camera : {perspectiveCamera(), parallelCamera()}) {
@@ -465,7 +467,10 @@ TEST(Slice3dRenderer, AsymmetricBlobLandsUpperLeft)
 TEST(Slice3dBenchmark, DISABLED_MarschnerLobb256Image512Slices256)
 {
     const Volume volume = generateVolume("marschner-lobb", {256, 256, 256});
+    const char* only = std::getenv("CLVR_BENCH_PATH");  // "fused" or "raster": just that one
     for (const char* path : {"fused", "raster"}) {
+        if (only && std::string(only) != path)
+            continue;
         const Scene scene = makeScene(perspectiveCamera(), mlTransferFunction(), 512, {{"slices", 256}, {"path", path}});
         auto renderer = makeRenderer(test::device(), scene, volume);
         std::vector<double> frame, device;
