@@ -258,6 +258,27 @@ DrawStats draw(Device& device, Framebuffer& fb, const DrawState& state, Topology
     if (binned.empty() || rect.width == 0 || rect.height == 0)
         return stats;
 
+    // A tile is skipped when one edge function (with its fill-rule bias) is negative at all four
+    // corner pixel centers of the tile's part of the rectangle: exact, so no covered center is lost.
+    const auto touches = [&](const ClTriangle& t, int tx, int ty) {
+        const std::int64_t x0 = rect.x + tx * CLVR_TILE_SIZE, y0 = rect.y + ty * CLVR_TILE_SIZE;
+        const std::int64_t x1 = std::min<std::int64_t>(x0 + CLVR_TILE_SIZE, rect.x + rect.width) - 1;
+        const std::int64_t y1 = std::min<std::int64_t>(y0 + CLVR_TILE_SIZE, rect.y + rect.height) - 1;
+        const std::int64_t half = CLVR_SUBPIXEL_SCALE / 2;
+        const std::int64_t cx[2] = {x0 * CLVR_SUBPIXEL_SCALE + half, x1 * CLVR_SUBPIXEL_SCALE + half};
+        const std::int64_t cy[2] = {y0 * CLVR_SUBPIXEL_SCALE + half, y1 * CLVR_SUBPIXEL_SCALE + half};
+        for (int j = 0; j < 3; ++j) {
+            const std::int64_t xa = t.x[j], ya = t.y[j], xb = t.x[(j + 1) % 3], yb = t.y[(j + 1) % 3];
+            bool outside = true;
+            for (std::int64_t px : cx)
+                for (std::int64_t py : cy)
+                    outside = outside && (xb - xa) * (py - ya) - (yb - ya) * (px - xa) + t.bias[j] < 0;
+            if (outside)
+                return false;
+        }
+        return true;
+    };
+
     // Tile lists in submission order: count, prefix sum, fill.
     const std::size_t tileCount = static_cast<std::size_t>(tilesX) * tilesY;
     std::vector<cl_uint> tileStart(tileCount + 1, 0);
@@ -265,7 +286,8 @@ DrawStats draw(Device& device, Framebuffer& fb, const DrawState& state, Topology
     for (const Binned& b : binned)
         for (int ty = b.tileY0; ty <= b.tileY1; ++ty)
             for (int tx = b.tileX0; tx <= b.tileX1; ++tx)
-                ++tileStart[static_cast<std::size_t>(ty) * tilesX + tx + 1];
+                if (touches(b.triangle, tx, ty))
+                    ++tileStart[static_cast<std::size_t>(ty) * tilesX + tx + 1];
     for (std::size_t i = 0; i < tileCount; ++i) {
         entries += tileStart[i + 1];
         if (entries > std::numeric_limits<cl_uint>::max())
@@ -281,7 +303,8 @@ DrawStats draw(Device& device, Framebuffer& fb, const DrawState& state, Topology
         triangles.push_back(b.triangle);
         for (int ty = b.tileY0; ty <= b.tileY1; ++ty)
             for (int tx = b.tileX0; tx <= b.tileX1; ++tx)
-                tileTris[cursor[static_cast<std::size_t>(ty) * tilesX + tx]++] = index;
+                if (touches(b.triangle, tx, ty))
+                    tileTris[cursor[static_cast<std::size_t>(ty) * tilesX + tx]++] = index;
     }
 
     std::vector<cl_float4> uniforms(std::max<std::size_t>(program.uniforms.size(), 1), cl_float4{{0, 0, 0, 0}});
