@@ -75,7 +75,16 @@ Image4f renderScene(const Scene& scene, const Volume& volume, FrameStats* statsO
 
 Image4d reference(const Scene& scene, const Volume& volume)
 {
-    return referenceIntegral(volume, scene.transferFunction, *scene.camera, scene.image);
+    ReferenceStats stats;
+    ReferenceOptions options;
+    options.stats = &stats;
+    Image4d image = referenceIntegral(volume, scene.transferFunction, *scene.camera, scene.image, options);
+    std::printf("[ measured ] reference: %llu rays, %llu samples, up to %d segments per ray, last change %.2g, "
+                "%llu rays not converged\n",
+                static_cast<unsigned long long>(stats.rays), static_cast<unsigned long long>(stats.samples),
+                stats.maxSegments, stats.maxResidual, static_cast<unsigned long long>(stats.raysNotConverged));
+    EXPECT_EQ(stats.raysNotConverged, 0u);
+    return image;
 }
 
 const Volume& marschnerLobb41()
