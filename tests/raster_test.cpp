@@ -539,6 +539,7 @@ TEST(RasterClipping, UserPlaneHalvesAQuad)
     fb.clearColor(device, glm::vec4(0.0f));
     const raster::DrawStats stats = raster::draw(device, fb, s, raster::Topology::Triangles, quad);
     EXPECT_EQ(stats.fragments, std::uint64_t((w - 18) * h));
+    EXPECT_EQ(stats.triangles, 3u) << "one triangle is cut to a quad (2 triangles), the other to a triangle";
     const clvr::Image4f image = fb.readColor(device);
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x)
