@@ -79,6 +79,7 @@ Volume generateVolume(const std::string& name, glm::ivec3 dims)
     if (count > (std::uint64_t(1) << 34))
         throw InputError(source + ": " + std::to_string(dims.x) + "x" + std::to_string(dims.y) + "x" +
                          std::to_string(dims.z) + " is too large (more than 2^34 grid points)");
+    checkHostMemoryForVoxels(source, count);
 
     Volume v;
     v.dims = dims;

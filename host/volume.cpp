@@ -5,8 +5,22 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unistd.h>
 
 namespace clvr {
+
+void checkHostMemoryForVoxels(const std::string& source, std::uint64_t voxels)
+{
+    const long pages = ::sysconf(_SC_PHYS_PAGES), pageSize = ::sysconf(_SC_PAGE_SIZE);
+    if (pages <= 0 || pageSize <= 0)
+        return;  // unknown: let the allocation decide
+    const std::uint64_t physical = static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(pageSize);
+    const std::uint64_t needed = voxels * sizeof(float);
+    if (needed > physical / 2)
+        throw InputError(source + ": " + std::to_string(voxels) + " grid points need " +
+                         std::to_string(needed >> 20) + " MiB as float32, more than half of this machine's " +
+                         std::to_string(physical >> 20) + " MiB of memory");
+}
 
 std::optional<double> Volume::sample(const glm::dvec3& p) const
 {

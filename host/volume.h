@@ -5,11 +5,16 @@
 #include <glm/glm.hpp>
 
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
 
 namespace clvr {
+
+// Throws InputError (naming `source`) when `voxels` float values would not fit in half of this
+// machine's physical memory: a volume that large would be killed by the OOM killer, not reported.
+void checkHostMemoryForVoxels(const std::string& source, std::uint64_t voxels);
 
 struct Volume {
     glm::ivec3 dims{0};

@@ -140,6 +140,7 @@ std::uint64_t checkedVoxelCount(const std::string& source, const std::vector<lon
         throw InputError(source + ": " + dimsText(sizes) + " is too large (" +
                          (overflow ? std::string("the product overflows") : std::to_string(count) + " grid points") +
                          ", the limit is 2^34)");
+    checkHostMemoryForVoxels(source, count);
     return count;
 }
 

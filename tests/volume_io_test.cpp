@@ -685,10 +685,15 @@ TEST(VolumeIo, NrrdGzipTruncatedOrCorrupt)
     writeFile(dir / "short.nrrd", header + gzip(data.substr(0, 400)));
     EXPECT_TRUE(throwsInputError([&] { clvr::readNrrd(dir / "short.nrrd"); },
                                  {"short.nrrd", "decompresses to 400 bytes", "480 bytes"}));
-    // A tiny file claiming a huge volume is refused before anything that size is allocated.
-    writeFile(dir / "huge.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2048 2048 2048\nendian: little\n"
+    // A tiny file claiming a large volume is refused before anything that size is allocated
+    // (512^3 floats = 512 MiB fits this machine's memory, so the gzip cap is what refuses it)...
+    writeFile(dir / "huge.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 512 512 512\nendian: little\n"
                                  "encoding: gzip\n\n" + z);
     EXPECT_TRUE(throwsInputError([&] { clvr::readNrrd(dir / "huge.nrrd"); }, {"huge.nrrd", "truncated"}));
+    // ... and one larger than half the machine's memory by the host-memory check.
+    writeFile(dir / "huger.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 4096 2048 1024\nendian: little\n"
+                                  "encoding: gzip\n\n" + z);
+    EXPECT_TRUE(throwsInputError([&] { clvr::readNrrd(dir / "huger.nrrd"); }, {"huger.nrrd", "MiB of memory"}));
 }
 
 TEST(VolumeIo, NanAndInfinityInFloatData)
