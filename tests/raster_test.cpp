@@ -3,6 +3,7 @@
 // exact, color and depth within stated float tolerances, fill rule, clipping, perspective, order.
 #include "raster/rasterizer.h"
 #include "raster/reference/rasterizer.h"
+#include "raster/texture.h"
 #include "tests/test_util.h"
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -696,6 +697,59 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < 12; ++x)
             ASSERT_EQ(image.at(x, y), glm::vec4(0.0f)) << "not discarded at " << x << "," << y;
+    device.takePassTimes();
+}
+
+TEST(RasterFragmentProgram, SamplesATextureThroughTextureH)
+{
+    clvr::Device& device = clvr::test::device();
+    const int w = 40, h = 24;  // even sizes: a texel boundary at a pixel center would need 4 (x + 0.5) / w integral
+    // A 4x4 NEAREST texture holding its texel index; texture coordinates run 0..1 across the screen
+    // (v = 0 at the top row), so pixel (x, y) reads texel (floor(4 (x + 0.5) / w), floor(4 (y + 0.5) / h)).
+    // Every pixel center is half a pixel from a texel boundary, so float rounding cannot move a lookup.
+    std::vector<float> texels(16);
+    for (int i = 0; i < 16; ++i)
+        texels[i] = float(i);
+    raster::TextureDesc desc;
+    desc.width = desc.height = 4;
+    desc.filter = raster::Filter::Nearest;
+    raster::Texture texture(device, desc, texels);
+    const ClTexture t = texture.toCl();
+    raster::FragmentProgram program;
+    program.source = R"(
+int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* color)
+{
+    ClTexture t;
+    t.width = (uint)r->uniforms[0].x;
+    t.height = (uint)r->uniforms[0].y;
+    t.depth = (uint)r->uniforms[0].z;
+    t.channels = (uint)r->uniforms[0].w;
+    t.filter = (uint)r->uniforms[1].x;
+    t.wrap = (uint)r->uniforms[1].y;
+    t.pad0 = t.pad1 = 0u;
+    t.border = (float4)(0.0f);
+    *color = clvr_tex2d(r->buffer[0], t, f->attr[1].xy);
+    return 1;
+}
+)";
+    program.uniforms = {glm::vec4(t.width, t.height, t.depth, t.channels), glm::vec4(t.filter, t.wrap, 0, 0)};
+    program.buffers[0] = texture.buffer();
+    std::vector<raster::Vertex> quad;
+    for (glm::vec2 p : {glm::vec2(-1, -1), glm::vec2(1, -1), glm::vec2(1, 1), glm::vec2(-1, -1), glm::vec2(1, 1), glm::vec2(-1, 1)}) {
+        raster::Vertex v;
+        v.position = glm::vec4(p, 0.0f, 1.0f);
+        v.attributes[1] = glm::vec4((p.x + 1) / 2, (1 - p.y) / 2, 0, 0);
+        quad.push_back(v);
+    }
+    raster::Framebuffer fb(device, w, h);
+    fb.clearColor(device, glm::vec4(-1.0f));
+    raster::draw(device, fb, raster::DrawState{}, raster::Topology::Triangles, quad, program);
+    const clvr::Image4f image = fb.readColor(device);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const int i = int(4 * (y + 0.5) / h) * 4 + int(4 * (x + 0.5) / w);
+            ASSERT_EQ(image.at(x, y), glm::vec4(float(i))) << x << "," << y;
+        }
     device.takePassTimes();
 }
 
