@@ -421,6 +421,30 @@ TEST(Slice3dRaster, MatchesFused)
     }
 }
 
+// A camera inside the volume: slices start at the camera (depth 0), on both paths, and the
+// reference integrates from the camera on. Same tolerances as above (slice_spacing instead of a count).
+TEST(Slice3dFused, CameraInsideVolumeMatchesReference)
+{
+    Camera camera;
+    camera.position = {0.2, 0.1, 0.45};
+    camera.focalPoint = {-0.1, -0.2, -1.0};
+    camera.viewAngle = 70.0;
+    const Scene scene = makeScene(camera, mlTransferFunction(), 48, {{"slice_spacing", 0.008}});
+    checkAgainstReference(scene, marschnerLobb41(), 8.0, "ml41_inside");
+    FrameStats stats;
+    Scene raster = scene;
+    raster.options["path"] = "raster";
+    const Image4f fused = renderScene(scene, marschnerLobb41(), &stats);
+    ASSERT_EQ(stats.passes.size(), 1u);
+    EXPECT_EQ(stats.passes[0].name, "slice3d: fused");
+    EXPECT_DOUBLE_EQ(stats.extra["slice_spacing"].get<double>(), 0.008);
+    const Image4f viaRaster = renderScene(raster, marschnerLobb41());
+    const test::ImageError e = test::imageError(viaRaster, toDouble(fused));
+    report("camera inside: raster vs fused", e);
+    EXPECT_TRUE(test::imagesNear(viaRaster, toDouble(fused),
+                                 {.maxAbs = 1.0 - std::exp(-8.0 * maxSliceLength(scene, marschnerLobb41())), .meanAbs = 2e-4}));
+}
+
 // DESIGN.md: two runs give identical bits (same renderer twice, and a fresh one).
 TEST(Slice3dRenderer, RendersAreBitIdentical)
 {
