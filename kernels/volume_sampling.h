@@ -25,10 +25,12 @@ float clvr_trilinear(global const float* v, const int4 dims, const float3 g)
     const uint nx = (uint)dims.x;
     const uint nxy = nx * (uint)dims.y;
     global const float* p = v + ((uint)k * nxy + (uint)j * nx + (uint)i);
-    const float c00 = p[0] + fx * (p[1] - p[0]);
-    const float c10 = p[nx] + fx * (p[nx + 1] - p[nx]);
-    const float c01 = p[nxy] + fx * (p[nxy + 1] - p[nxy]);
-    const float c11 = p[nxy + nx] + fx * (p[nxy + nx + 1] - p[nxy + nx]);
+    const float2 a00 = vload2(0, p), a10 = vload2(0, p + nx);  /* (i, i+1) pairs, x fastest */
+    const float2 a01 = vload2(0, p + nxy), a11 = vload2(0, p + nxy + nx);
+    const float c00 = a00.x + fx * (a00.y - a00.x);
+    const float c10 = a10.x + fx * (a10.y - a10.x);
+    const float c01 = a01.x + fx * (a01.y - a01.x);
+    const float c11 = a11.x + fx * (a11.y - a11.x);
     const float c0 = c00 + fy * (c10 - c00);
     const float c1 = c01 + fy * (c11 - c01);
     return c0 + fz * (c1 - c0);
