@@ -316,8 +316,11 @@ int bench(const BenchOptions& options)
         const double compileMs = device.compileMs() - compile0;
 
         // The ceiling's first frame warms its caches; then clvr and ceiling frames alternate.
+        // The ceiling mirrors slice3d's fused path only (the raster path counts fragments, not samples).
         const std::unique_ptr<Ceiling> ceiling =
-            scene.technique == "slice3d" ? makeCeiling(scene, volume, camera) : nullptr;
+            scene.technique == "slice3d" && parseSlice3dOptions(scene.options).path == Slice3dOptions::Path::Fused
+                ? makeCeiling(scene, volume, camera)
+                : nullptr;
         const int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
         CeilingResult ceilingResult;
         if (ceiling)
