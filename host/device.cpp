@@ -101,6 +101,36 @@ const Found& pick(const std::vector<Found>& found, const std::string& spec)
     throw DeviceError(source + " \"" + rule + "\" matches no OpenCL device (see clvr info)");
 }
 
+// $CLVR_DEVICE_MEMORY_LIMIT: bytes with an optional K, M or G suffix (powers of 1024); 0 when unset.
+cl_ulong memoryLimitFromEnvironment()
+{
+    const char* env = std::getenv("CLVR_DEVICE_MEMORY_LIMIT");
+    if (!env || !*env)
+        return 0;
+    const std::string text(env);
+    std::size_t used = 0;
+    unsigned long long value = 0;
+    try {
+        value = std::stoull(text, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    unsigned shift = 0;
+    if (used > 0 && used + 1 == text.size()) {
+        switch (std::toupper(static_cast<unsigned char>(text.back()))) {
+        case 'K': shift = 10; break;
+        case 'M': shift = 20; break;
+        case 'G': shift = 30; break;
+        default: used = 0;
+        }
+        if (used)
+            used = text.size();
+    }
+    if (used != text.size() || value == 0 || value > (~0ull >> shift))
+        throw InputError("CLVR_DEVICE_MEMORY_LIMIT \"" + text + "\": want a positive byte count like 512M or 2G");
+    return static_cast<cl_ulong>(value) << shift;
+}
+
 std::string mib(cl_ulong bytes)
 {
     return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB";
@@ -126,6 +156,11 @@ Device::Device(const std::string& spec)
     const std::vector<Found> found = enumerate();
     const Found& chosen = pick(found, spec);
     listing_ = chosen.listing;
+    // A user-set cap on device memory (shared GPUs on a cluster node; tests of the out-of-memory path).
+    if (const cl_ulong limit = memoryLimitFromEnvironment()) {
+        listing_.globalMemBytes = std::min(listing_.globalMemBytes, limit);
+        listing_.maxAllocBytes = std::min(listing_.maxAllocBytes, limit);
+    }
     device_ = chosen.device;
     context_ = cl::Context(device_);
     queue_ = cl::CommandQueue(context_, device_, CL_QUEUE_PROFILING_ENABLE);

@@ -44,7 +44,8 @@ struct PassTime {
 
 class Device {
 public:
-    // Opens the device chooseDevice(spec) names, with a profiling in-order queue.
+    // Opens the device chooseDevice(spec) names, with a profiling in-order queue. $CLVR_DEVICE_MEMORY_LIMIT
+    // (bytes, or with a K/M/G suffix) caps the memory buffer() allows; InputError if it is malformed.
     explicit Device(const std::string& spec = "");
 
     const cl::Context& context() const { return context_; }

@@ -166,3 +166,10 @@ expect_error(3 ${out} "--device \"no-such-device\" matches no OpenCL device"
 file(MAKE_DIRECTORY "${WORK}/empty-icd")
 expect_error(3 ${out} "no OpenCL device"
   ${CMAKE_COMMAND} -E env OCL_ICD_VENDORS=${WORK}/empty-icd ${CLVR} render -o ${out} ${SMALL})
+# Out of device memory: CLVR_DEVICE_MEMORY_LIMIT makes the device report 1 MiB, less than the default
+# scene's 128^3 float volume (8 MiB): the upload is refused with one line naming what did not fit.
+expect_error(3 ${out} "out of device memory: .*volume.*needs 8 MiB"
+  ${CMAKE_COMMAND} -E env CLVR_DEVICE_MEMORY_LIMIT=1M ${CLVR} render -o ${out} ${SMALL})
+# A malformed limit is bad input.
+expect_error(2 ${out} "CLVR_DEVICE_MEMORY_LIMIT"
+  ${CMAKE_COMMAND} -E env CLVR_DEVICE_MEMORY_LIMIT=lots ${CLVR} render -o ${out} ${SMALL})
