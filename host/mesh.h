@@ -31,7 +31,11 @@ struct TetMesh {
 // Validates and normalizes a mesh in place: InputError naming the first offending cell for an index
 // out of range, NaN/infinite coordinates or scalars, a scalar count that differs from the point count;
 // inverted tetrahedra are reoriented; zero-volume ones (|6V| <= 1e-12 * scale^3) are counted and dropped.
+// Positive orientation means signedVolume6(p0, p1, p2, p3) > 0 for the tetrahedron's points in order.
 void checkMesh(TetMesh& mesh);
+
+// Six times the signed volume of (p0, p1, p2, p3): dot(p1 - p0, cross(p2 - p0, p3 - p0)).
+double signedVolume6(const glm::dvec3& p0, const glm::dvec3& p1, const glm::dvec3& p2, const glm::dvec3& p3);
 
 // Cell adjacency: neighbor[t][i] is the tetrahedron across face i of t, or -1 on the boundary.
 // Faces are matched by their points' positions (coincident points are welded), so curvilinear grids
