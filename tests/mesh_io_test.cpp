@@ -5,6 +5,7 @@
 #include "host/errors.h"
 #include "host/mesh.h"
 #include "host/mesh_io.h"
+#include "host/tetgen_mesher.h"
 #include "tests/test_util.h"
 
 #include <gtest/gtest.h>
@@ -20,6 +21,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <numbers>
 #include <sstream>
 
 namespace fs = std::filesystem;
@@ -381,4 +383,99 @@ TEST(MeshIo, MalformedPlot3d)
     expectError([&] { clvr::readPlot3d(dir / "x.bin", dir / "q.bin"); }, "", "x.bin");
     writeFile(dir / "x.bin", "abc");
     expectError([&] { clvr::readPlot3d(dir / "x.bin", dir / "q.bin"); }, "too short", "x.bin");
+}
+
+// ---------------------------------------------------------------------------------------------------
+// TetGen as a library (`clvr mesh`): closed surfaces written here, meshed, written and read back.
+
+namespace {
+
+// Volume enclosed by a closed, outward-oriented triangle surface (divergence theorem).
+double enclosedVolume(const std::vector<glm::dvec3>& p, const std::vector<glm::uvec3>& tris)
+{
+    double v = 0;
+    for (const auto& t : tris)
+        v += glm::dot(p[t[0]], glm::cross(p[t[1]], p[t[2]])) / 6.0;
+    return v;
+}
+
+void expectGoodMesh(const TetMesh& m, double volume, double tolerance)
+{
+    EXPECT_GT(m.tets.size(), 0u);
+    EXPECT_EQ(m.tetsDegenerate, 0u);
+    for (const auto& c : m.tets)
+        ASSERT_GT(clvr::signedVolume6(m.points[c[0]], m.points[c[1]], m.points[c[2]], m.points[c[3]]), 0.0);
+    EXPECT_NEAR(totalVolume(m), volume, tolerance);
+    const clvr::TetTopology topo = clvr::buildTopology(m);
+    EXPECT_GT(topo.boundary.size(), 0u);
+}
+
+}  // namespace
+
+TEST(MeshIo, TetgenMesherTorusOffRoundTrip)
+{
+    TempDir dir;
+    const int n = 24, m = 12;
+    const double R = 0.6, r = 0.25;
+    std::vector<glm::dvec3> pts;
+    std::vector<glm::uvec3> tris;
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < m; ++j) {
+            const double a = 2 * std::numbers::pi * i / n, b = 2 * std::numbers::pi * j / m;
+            pts.push_back({(R + r * std::cos(b)) * std::cos(a), (R + r * std::cos(b)) * std::sin(a), r * std::sin(b)});
+        }
+    auto id = [&](int i, int j) { return static_cast<unsigned>((i % n) * m + (j % m)); };
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < m; ++j) {
+            tris.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+            tris.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+        }
+    std::ostringstream off;
+    off.precision(17);
+    off << "OFF\n" << pts.size() << ' ' << tris.size() << " 0\n";
+    for (const auto& p : pts)
+        off << p.x << ' ' << p.y << ' ' << p.z << '\n';
+    for (const auto& t : tris)
+        off << "3 " << t[0] << ' ' << t[1] << ' ' << t[2] << '\n';
+    writeFile(dir / "torus.off", off.str());
+    const double volume = std::abs(enclosedVolume(pts, tris));
+
+    clvr::MesherOptions options;
+    options.quality = 1.5;
+    options.maxVolume = 0.002;
+    options.scalar = "blobs";
+    const TetMesh meshed = clvr::meshSurface(dir / "torus.off", options);
+    expectGoodMesh(meshed, volume, 1e-9 * volume);
+    clvr::writeTetgen(meshed, dir / "torus");
+    const TetMesh back = clvr::loadMesh({{"file", "torus.ele"}}, dir.path());
+    expectSame(meshed, back);
+    expectGoodMesh(back, volume, 1e-9 * volume);
+    std::printf("torus: %zu points, %zu tets, volume %.6f (surface encloses %.6f)\n", back.points.size(),
+                back.tets.size(), totalVolume(back), volume);
+}
+
+TEST(MeshIo, TetgenMesherLBlockPoly)
+{
+    TempDir dir;
+    // The L profile (0,0) (2,0) (2,1) (1,1) (1,2) (0,2) extruded over z in [0,1]: volume 3.
+    writeFile(dir / "l.poly", "12 3 0 0\n"
+                              "0 0 0 0\n1 2 0 0\n2 2 1 0\n3 1 1 0\n4 1 2 0\n5 0 2 0\n"
+                              "6 0 0 1\n7 2 0 1\n8 2 1 1\n9 1 1 1\n10 1 2 1\n11 0 2 1\n"
+                              "8 0\n"
+                              "1\n6 0 1 2 3 4 5\n1\n6 6 7 8 9 10 11\n"
+                              "1\n4 0 1 7 6\n1\n4 1 2 8 7\n1\n4 2 3 9 8\n1\n4 3 4 10 9\n1\n4 4 5 11 10\n1\n4 5 0 6 11\n"
+                              "0\n0\n");
+    clvr::MesherOptions options;
+    options.maxVolume = 0.01;
+    const TetMesh meshed = clvr::meshSurface(dir / "l.poly", options);
+    expectGoodMesh(meshed, 3.0, 1e-12);
+    EXPECT_GT(meshed.tets.size(), 300u);  // the volume bound is honored
+    clvr::writeTetgen(meshed, dir / "l");
+    expectGoodMesh(clvr::loadMesh({{"file", "l.node"}}, dir.path()), 3.0, 1e-12);
+
+    expectError([&] { clvr::meshSurface(dir / "l.ply", options); }, "no such file", "l.ply");
+    writeFile(dir / "bad.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");  // one triangle: not closed
+    expectError([&] { clvr::meshSurface(dir / "bad.off", options); }, "the surface is flat", "bad.off");
+    options.scalar = "nosuch";
+    expectError([&] { clvr::meshSurface(dir / "l.poly", options); }, "neither a generator");
 }

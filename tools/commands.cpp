@@ -53,6 +53,10 @@ std::string techniqueList()
 
 }  // namespace
 
+// `clvr mesh` (tools/mesh_command.cpp).
+CLI::App* addMeshCommand(CLI::App& app);
+int runMeshCommand();
+
 int run(int argc, char** argv)
 {
     CLI::App app{"clvr: OpenCL volume renderer (docs/cli.md)", "clvr"};
@@ -97,11 +101,14 @@ int run(int argc, char** argv)
     benchCommand->add_flag("--peer", benchOptions.peer, "also render each scene with VTK (tools/peer_vtk.py)");
 #endif
 
+    CLI::App* meshCommand = addMeshCommand(app);
+
     // CLI11 would only say "A subcommand is required" for a misspelt one.
     const std::string first = argc > 1 ? argv[1] : "";
-    if (!first.empty() && first[0] != '-' && first != "render" && first != "info" && first != "bench")
+    if (!first.empty() && first[0] != '-' && first != "render" && first != "info" && first != "bench" &&
+        first != "mesh")
         throw InputError("command line: unknown command \"" + std::string(argv[1]) +
-                         "\" (known: render, info, bench; see clvr --help)");
+                         "\" (known: render, info, bench, mesh; see clvr --help)");
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -117,6 +124,8 @@ int run(int argc, char** argv)
         return tools::render(renderOptions);
     if (*infoCommand)
         return info(infoDevice);
+    if (*meshCommand)
+        return runMeshCommand();
 #if CLVR_HAVE_BENCH
     if (*benchCommand)
         return bench(benchOptions);
