@@ -368,6 +368,16 @@ public:
         return *v;
     }
 
+    // Lines up to and including the next blank one (or the end of the file).
+    void skipBlock()
+    {
+        while (pos_ < data_.size()) {
+            const std::string line = rawLine();
+            if (std::all_of(line.begin(), line.end(), [](char c) { return std::isspace(static_cast<unsigned char>(c)); }))
+                return;
+        }
+    }
+
     VtkType type(const std::string& name) const
     {
         if (lower(name) == "bit")
@@ -614,19 +624,8 @@ TetMesh readVtkUnstructured(const fs::path& path, const std::string& scalar)
             argCount(line, 3);
             dataArray(line[1], 1, sectionCount, in.type(line[2]), line[0] + " " + line[1]);
         } else if (key == "metadata") {
-            // VTK 9's METADATA block (COMPONENT_NAMES, INFORMATION) ends with a blank line: skip its lines.
-            for (;;) {
-                auto l = in.headerLine();
-                if (l.empty())
-                    break;
-                const std::string k = lower(l[0]);
-                if (k == "information" || k == "component_names" || k == "name" || k == "data" ||
-                    l[0].find('%') != std::string::npos || k.rfind("location", 0) == 0)
-                    continue;
-                if (k == "points" || k == "cells" || k == "cell_types" || k == "point_data" || k == "cell_data" ||
-                    k == "scalars" || k == "field" || k == "vectors" || k == "normals")
-                    throw InputError(in.where() + ": METADATA blocks with arrays are not supported");
-            }
+            // VTK 9's METADATA block (COMPONENT_NAMES, INFORMATION) ends with a blank line: skip it.
+            in.skipBlock();
         } else {
             throw InputError(in.where() + ": unknown keyword " + shown(line[0]) +
                              " in an UNSTRUCTURED_GRID (expected POINTS, CELLS, CELL_TYPES, POINT_DATA, ...)");

@@ -135,6 +135,8 @@ TEST(MeshIo, BluntfinGives224874Tets)
                 static_cast<unsigned long long>(m.tetsReoriented), topo.boundary.size(), m.scalarRange().x,
                 m.scalarRange().y);
     EXPECT_GT(m.scalarRange().x, 0.0);
+    EXPECT_EQ(m.tetsDegenerate, 115u);        // measured: cells where the grid collapses onto itself
+    EXPECT_EQ(topo.boundary.size(), 13438u);  // measured; the block's six sides have 2*2*(39*31*2 + 31*31) = 13,516
     for (const auto& c : m.tets)
         ASSERT_GT(clvr::signedVolume6(m.points[c[0]], m.points[c[1]], m.points[c[2]], m.points[c[3]]), 0.0);
     // Every scalar choice loads; pressure is positive in this flow.
@@ -264,6 +266,49 @@ TEST(MeshIo, VtkHexahedraAndWedgesAreSplit)
     EXPECT_EQ(w.tetsDegenerate, 0u);
     EXPECT_NEAR(totalVolume(w), 1.0, 1e-14);
     EXPECT_EQ(clvr::buildTopology(w).boundary.size(), 12u);  // the diagonal plane is interior and conforming
+}
+
+// VTK 9's file version 5.1: OFFSETS and CONNECTIVITY arrays, METADATA blocks; BINARY as well.
+TEST(MeshIo, VtkVersion51)
+{
+    TempDir dir;
+    writeFile(dir / "v5.vtk", "# vtk DataFile Version 5.1\nvtk output\nASCII\nDATASET UNSTRUCTURED_GRID\n"
+                              "POINTS 5 float\n0 0 0 1 0 0 0 1 0\n0 0 1 1 1 1\n"
+                              "METADATA\nINFORMATION 1\nNAME L2_NORM_RANGE LOCATION vtkDataArray\nDATA 2 0 1.7\n\n"
+                              "CELLS 3 8\nOFFSETS vtktypeint64\n0 4 8\nCONNECTIVITY vtktypeint64\n0 1 2 3\n1 2 3 4\n"
+                              "CELL_TYPES 2\n10\n10\n\nCELL_DATA 2\nFIELD FieldData 1\nid 1 2 int\n7 8\n"
+                              "POINT_DATA 5\nFIELD FieldData 2\nvel 3 5 float\n0 0 0 0 0 0 0 0 0 0 0 0 0 0 0\n"
+                              "temp 1 5 double\n1 2 3 4 5\nMETADATA\nCOMPONENT_NAMES\nT\n\n");
+    TetMesh m = clvr::loadMesh({{"file", "v5.vtk"}}, dir.path());
+    EXPECT_EQ(m.tetsRead, 2u);
+    EXPECT_EQ(m.scalars, (std::vector<double>{1, 2, 3, 4, 5}));
+
+    // The same in BINARY (big-endian int64 offsets and connectivity).
+    auto be = [](auto v) {
+        std::string b(sizeof(v), '\0');
+        std::memcpy(b.data(), &v, sizeof(v));
+        if constexpr (std::endian::native == std::endian::little)
+            std::reverse(b.begin(), b.end());
+        return b;
+    };
+    std::string bin = "# vtk DataFile Version 5.1\nvtk output\nBINARY\nDATASET UNSTRUCTURED_GRID\nPOINTS 5 double\n";
+    for (double v : {0., 0., 0., 1., 0., 0., 0., 1., 0., 0., 0., 1., 1., 1., 1.})
+        bin += be(v);
+    bin += "\nCELLS 3 8\nOFFSETS vtktypeint64\n";
+    for (std::int64_t v : {0, 4, 8})
+        bin += be(v);
+    bin += "\nCONNECTIVITY vtktypeint64\n";
+    for (std::int64_t v : {0, 1, 2, 3, 1, 2, 3, 4})
+        bin += be(v);
+    bin += "\nCELL_TYPES 2\n" + be(std::int32_t(10)) + be(std::int32_t(10)) + "\nPOINT_DATA 5\nSCALARS t float 1\nLOOKUP_TABLE default\n";
+    for (float v : {1.f, 2.f, 3.f, 4.f, 5.f})
+        bin += be(v);
+    bin += "\n";
+    writeFile(dir / "b5.vtk", bin);
+    TetMesh b = clvr::loadMesh({{"file", "b5.vtk"}, {"scalar", "t"}}, dir.path());
+    EXPECT_EQ(b.tetsRead, 2u);
+    EXPECT_EQ(b.scalars, (std::vector<double>{1, 2, 3, 4, 5}));
+    EXPECT_EQ(b.points, m.points);
 }
 
 TEST(MeshIo, SceneObjectKeys)
