@@ -1066,6 +1066,9 @@ TetMesh loadMesh(const nlohmann::json& spec, const fs::path& baseDir)
             throw InputError(file.string() + ": unknown mesh format " + shown(ext) + " (.node, .ele, .vtk, .off, or PLOT3D with q_file)");
     }
     checkMesh(mesh);
+    if (mesh.tets.empty())
+        throw InputError(mesh.source + ": no tetrahedra left (" + std::to_string(mesh.tetsRead) + " read, " +
+                         std::to_string(mesh.tetsDegenerate) + " of zero volume)");
     return mesh;
 }
 

@@ -355,6 +355,10 @@ TEST(MeshIo, MalformedTetgen)
     writeFile(dir / "t.node", "4 3 1 0\n0 0 0 0 1\n1 1 0 0 nan\n2 0 1 0 1\n3 0 0 1 1\n");
     writeFile(dir / "t.ele", "1 4 0\n0 0 1 2 3\n");
     expectError([&] { clvr::loadMesh({{"file", "t.ele"}}, dir.path()); }, "tetrahedron 0 has point 1 with a non-finite scalar");
+    writeFile(dir / "t.node", "4 3 1 0\n0 0 0 0 1\n1 1 0 0 1\n2 0 1 0 1\n3 1 1 0 1\n");  // all in z = 0
+    writeFile(dir / "t.ele", "1 4 0\n0 0 1 2 3\n");
+    expectError([&] { clvr::loadMesh({{"file", "t.ele"}}, dir.path()); }, "no tetrahedra left (1 read, 1 of zero volume)",
+                "t.ele");
     writeFile(dir / "t.node", "4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n");
     expectError([&] { clvr::readTetgen(dir / "t.ele"); }, "no node attributes", "t.node");
 }
