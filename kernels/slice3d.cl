@@ -45,15 +45,91 @@ float slice3d_stretch(const float2 ndc, const float4 params)
 
 #ifndef CLVR_SLICE3D_FRAGMENT
 
+/* Empty-space skipping (docs/slice3d.md). The grid's cells are grouped in bricks of
+ * B = 2^SLICE3D_BRICK_SHIFT = 4 cells per axis (host: kBrickCells); brick b covers the cells
+ * [Bb, Bb + B), i.e. the grid points [Bb, Bb + B] (one point of overlap with its neighbour), so every
+ * trilinear footprint lies in the brick of its lower corner. A brick is empty when the transfer function's tau is exactly 0 for
+ * every value the trilinear interpolation can produce in it (host: min-max of its points); a sample
+ * there has alpha = 1 - exp2(0) = 0 and leaves the pixel unchanged bit for bit.
+ * space[brick] = 0 for a brick that is not empty, else r + 1 where every brick within Chebyshev
+ * distance r (bricks outside the grid count as empty) is empty: one run steps over that cube. */
+#define SLICE3D_BRICK_SHIFT 2
+
+/* Grid coordinates of slice k's sample: the one expression used for every sample position, so that
+ * the run ends found by slice3d_empty_run are the positions the main loop would compute. Each
+ * coordinate is a monotonic function of k (every rounded operation is), hence so are the inside
+ * test and the brick index per axis: two samples in the same box of bricks enclose only samples in it. */
+float3 slice3d_point(const float3 go, const float3 gd, const float depth0, const float delta_s, const int k)
+{
+    return go + (depth0 + (float)k * delta_s) * gd;
+}
+
+/* Brick (x, y, z) of the cell clvr_trilinear uses at g (its lower corner, clamped to n - 2). */
+int4 slice3d_brick(const float3 g, const int4 dims)
+{
+    return (int4)(min((int)g.x, dims.x - 2), min((int)g.y, dims.y - 2), min((int)g.z, dims.z - 2), 0) >>
+           SLICE3D_BRICK_SHIFT;
+}
+
+/* 1 if slice k's sample is inside the grid and its brick within Chebyshev distance r of brick b. */
+int slice3d_in_cube(const float3 go, const float3 gd, const float depth0, const float delta_s, const int k,
+                    const int4 dims, const int4 b, const int r)
+{
+    const float3 g = slice3d_point(go, gd, depth0, delta_s, k);
+    if (!clvr_grid_inside(g, dims))
+        return 0;
+    const uint4 c = abs_diff(slice3d_brick(g, dims), b);
+    return max(c.x, max(c.y, c.z)) <= (uint)r;
+}
+
+/* Slice k's sample lies in brick b, and every brick within Chebyshev distance r of b is empty;
+ * walking in direction step (+1 or -1) towards k_end, the last slice whose sample is still inside
+ * the grid and in that cube of bricks. The ray's exit from the cube's box (clipped to the grid; inv_gd
+ * = 1 / gd) gives a candidate, checked with the main loop's own arithmetic (and one slice back if it
+ * fails); by monotonicity every slice between k and it is then in the cube too. Falls back to k. */
+int slice3d_empty_run(const float3 go, const float3 gd, const float3 inv_gd, const float depth0,
+                      const float delta_s, const int k, const int step, const int k_end, const int4 dims,
+                      const int4 b, const int r)
+{
+    const float3 lo = convert_float3(max(b.xyz - r, 0) << SLICE3D_BRICK_SHIFT);
+    const float3 hi = fmin(convert_float3((b.xyz + r + 1) << SLICE3D_BRICK_SHIFT), convert_float3(dims.xyz - 1));
+    /* eye depth where the ray crosses each face it walks towards */
+    const float3 face = (float)step * gd > 0.0f ? hi : lo;
+    const float3 t = (face - go) * inv_gd;
+    float zexit;
+    if (step > 0)
+        zexit = fmin(gd.x != 0.0f ? t.x : INFINITY, fmin(gd.y != 0.0f ? t.y : INFINITY, gd.z != 0.0f ? t.z : INFINITY));
+    else
+        zexit = fmax(gd.x != 0.0f ? t.x : -INFINITY, fmax(gd.y != 0.0f ? t.y : -INFINITY, gd.z != 0.0f ? t.z : -INFINITY));
+    const float kf = (zexit - depth0) / delta_s;
+    int cand;
+    if (step > 0)
+        cand = (int)clamp(floor(kf), (float)k, (float)k_end);
+    else
+        cand = (int)clamp(ceil(kf), (float)k_end, (float)k);
+    for (int tries = 0; tries < 2 && cand != k; ++tries, cand -= step)
+        if (slice3d_in_cube(go, gd, depth0, delta_s, cand, dims, b, r))
+            return cand;
+    return k;
+}
+
+/* space[] of brick b: 0 if not empty, else r + 1 (see above). */
+int slice3d_space(global const uchar* space, const int4 bdims, const int4 b)
+{
+    return space[((uint)b.z * (uint)bdims.y + (uint)b.y) * (uint)bdims.x + (uint)b.x];
+}
+
 /* One work-item per pixel: slices k = 0 .. slice_count-1 at eye depth depth0 + k * delta_s. Only the
  * slices whose ray point lies in the grid bounds are sampled (the rest are empty, DESIGN.md); their
- * number goes to samples[pixel]. Back to front: c = C alpha + (1 - alpha) c (the paper's blending);
- * front to back: c += T alpha C, T *= 1 - alpha, stopping once 1 - T >= ert_alpha. alpha =
- * 1 - exp(-tau Delta), computed as 1 - exp2(tau * (-Delta log2 e)). The pixel is
- * c + (1 - A) background, A. */
-kernel void slice3d_fused(global float4* out, global uint* samples, const int width, const int height,
-                          global const float* volume, const int4 dims, const float4 grid_origin,
+ * number goes to samples[pixel]. With skip != 0, runs of slices in empty bricks are stepped over
+ * (their number goes to skipped[pixel]; they are counted in samples[pixel] too). Back to front:
+ * c = C alpha + (1 - alpha) c (the paper's blending); front to back: c += T alpha C, T *= 1 - alpha,
+ * stopping once 1 - T >= ert_alpha. alpha = 1 - exp(-tau Delta), computed as
+ * 1 - exp2(tau * (-Delta log2 e)). The pixel is c + (1 - A) background, A. */
+kernel void slice3d_fused(global float4* out, global uint* samples, global uint* skipped, const int width,
+                          const int height, global const float* volume, const int4 dims, const float4 grid_origin,
                           const float4 inv_spacing, global const float* tf, const int tf_count,
+                          global const uchar* space, const int4 bdims, const int skip,
                           const float4 cam_position, const float4 cam_forward, const float4 cam_right,
                           const float4 cam_up, const float4 cam_params, const float depth0,
                           const float delta_s, const int slice_count, const int front_to_back,
@@ -68,6 +144,7 @@ kernel void slice3d_fused(global float4* out, global uint* samples, const int wi
     const float neg_delta_log2e = -delta * M_LOG2E_F;                /* exp(-tau delta) = exp2(tau * this) */
     const float3 go = (o - grid_origin.xyz) * inv_spacing.xyz;     /* grid coordinates */
     const float3 gd = d * inv_spacing.xyz;
+    const float3 inv_gd = 1.0f / gd;  /* for empty-space runs only (inf where gd is 0, not used there) */
 
     /* Depth interval of the ray inside the grid bounds (slab test), widened by one slice each way;
      * each sample is still checked, so this only limits the loop. */
@@ -95,13 +172,24 @@ kernel void slice3d_fused(global float4* out, global uint* samples, const int wi
 
     float3 c = (float3)(0.0f);
     float alpha_acc = 0.0f;
-    uint taken = 0;
+    uint taken = 0, stepped_over = 0;
     if (front_to_back) {
         float transmittance = 1.0f;
         for (int k = k_lo; k <= k_hi; ++k) {
-            const float3 g = go + (depth0 + (float)k * delta_s) * gd;
+            const float3 g = slice3d_point(go, gd, depth0, delta_s, k);
             if (!clvr_grid_inside(g, dims))
                 continue;
+            if (skip) {
+                const int4 b = slice3d_brick(g, dims);
+                const int space_b = slice3d_space(space, bdims, b);
+                if (space_b != 0) {
+                    const int run_end = slice3d_empty_run(go, gd, inv_gd, depth0, delta_s, k, 1, k_hi, dims, b,
+                                                          space_b - 1);
+                    stepped_over += (uint)(run_end - k + 1);
+                    k = run_end;
+                    continue;
+                }
+            }
             ++taken;
             const float4 ct = clvr_tf_eval(tf, tf_count, clvr_trilinear(volume, dims, g));
             const float alpha = 1.0f - exp2(ct.w * neg_delta_log2e);
@@ -113,9 +201,20 @@ kernel void slice3d_fused(global float4* out, global uint* samples, const int wi
         alpha_acc = 1.0f - transmittance;
     } else {
         for (int k = k_hi; k >= k_lo; --k) {
-            const float3 g = go + (depth0 + (float)k * delta_s) * gd;
+            const float3 g = slice3d_point(go, gd, depth0, delta_s, k);
             if (!clvr_grid_inside(g, dims))
                 continue;
+            if (skip) {
+                const int4 b = slice3d_brick(g, dims);
+                const int space_b = slice3d_space(space, bdims, b);
+                if (space_b != 0) {
+                    const int run_end = slice3d_empty_run(go, gd, inv_gd, depth0, delta_s, k, -1, k_lo, dims, b,
+                                                          space_b - 1);
+                    stepped_over += (uint)(k - run_end + 1);
+                    k = run_end;
+                    continue;
+                }
+            }
             ++taken;
             const float4 ct = clvr_tf_eval(tf, tf_count, clvr_trilinear(volume, dims, g));
             const float alpha = 1.0f - exp2(ct.w * neg_delta_log2e);
@@ -125,7 +224,8 @@ kernel void slice3d_fused(global float4* out, global uint* samples, const int wi
     }
     const int i = y * width + x;
     out[i] = (float4)(c + (1.0f - alpha_acc) * background.xyz, alpha_acc);
-    samples[i] = taken;
+    samples[i] = taken + stepped_over;
+    skipped[i] = stepped_over;
 }
 
 /* The pass-by-pass path's last pass: premultiplied (I, A) in place -> I + (1 - A) background, A. */

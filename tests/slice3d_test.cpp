@@ -196,7 +196,7 @@ void expectInputError(const json& options, const std::string& fragment)
 TEST(Slice3dOptions, BadOptionsThrowInputErrorNamingTheKey)
 {
     expectInputError({{"foo", 1}},
-                     "options.foo: unknown option for slice3d (known: slices, slice_spacing, order, early_termination, path)");
+                     "options.foo: unknown option for slice3d (known: slices, slice_spacing, order, early_termination, path, empty_space_skipping)");
     expectInputError({{"slices", 0}}, "options.slices");
     expectInputError({{"slices", 65537}}, "options.slices");
     expectInputError({{"slices", 2.5}}, "options.slices");
@@ -237,8 +237,134 @@ TEST(Slice3dRenderer, ResidentBytesAreFloat32Volume)
 {
     auto renderer = makeRenderer(test::device(), makeScene(perspectiveCamera(), mlTransferFunction(), 16),
                                  marschnerLobb41());
-    // 4 bytes per grid point, plus the packed transfer function (3 points: 4 + 12 + 12 floats).
-    EXPECT_EQ(renderer->residentBytes(), 41u * 41u * 41u * 4u + 28u * 4u);
+    // 4 bytes per grid point, plus the packed transfer function (3 points: 4 + 12 + 12 floats), plus
+    // one empty-space byte per brick (40 cells per axis: 10^3 bricks of 4^3 cells).
+    static_assert(kBrickCells == 4);
+    EXPECT_EQ(renderer->residentBytes(), 41u * 41u * 41u * 4u + 28u * 4u + 1000u);
+}
+
+// ---- empty-space skipping ----------------------------------------------------------------------
+
+TEST(Slice3dEmptySpace, TauZeroOnFollowsThePiecewiseLinearTau)
+{
+    // tau 0 up to s = 0.3, rising to 2 at 0.6, back to 0 at 0.8 and beyond.
+    const TransferFunction tf({{0.1, {1, 0, 0}, 0.0}, {0.3, {1, 1, 0}, 0.0}, {0.6, {1, 1, 1}, 2.0},
+                               {0.8, {0, 1, 1}, 0.0}, {0.9, {0, 0, 1}, 0.0}});
+    EXPECT_TRUE(tauZeroOn(tf, -5.0f, 0.05f));  // below s_0: tau_0 held
+    EXPECT_TRUE(tauZeroOn(tf, 0.0f, 0.3f));    // up to the last zero point, inclusive
+    EXPECT_FALSE(tauZeroOn(tf, 0.0f, 0.3001f));
+    EXPECT_FALSE(tauZeroOn(tf, 0.2f, 0.9f));    // the bump inside
+    EXPECT_FALSE(tauZeroOn(tf, 0.61f, 0.62f));  // inside a rising segment
+    EXPECT_TRUE(tauZeroOn(tf, 0.8f, 0.85f));
+    EXPECT_TRUE(tauZeroOn(tf, 0.8f, 100.0f));   // above s_{n-1}: tau_{n-1} = 0 held
+    EXPECT_FALSE(tauZeroOn(tf, 0.79f, 0.85f));
+    const TransferFunction ml = mlTransferFunction();  // tau 0 only at s = 0
+    EXPECT_TRUE(tauZeroOn(ml, -1.0f, 0.0f));
+    EXPECT_FALSE(tauZeroOn(ml, 0.0f, 1e-6f));
+}
+
+TEST(Slice3dEmptySpace, BrickGridHoldsEachBricksMinMaxWithOnePointOverlap)
+{
+    Volume v;
+    v.dims = {19, 17, 9};  // odd sizes: partial last bricks, a last brick of one cell in z
+    v.spacing = glm::dvec3(0.1);
+    v.source = "random";
+    v.values.resize(v.voxelCount());
+    std::uint32_t state = 12345;
+    for (float& x : v.values) {
+        state = state * 1664525u + 1013904223u;
+        x = static_cast<float>(state >> 8) / 16777216.0f;
+    }
+    const BrickGrid grid = buildBrickGrid(v);
+    constexpr int B = kBrickCells;
+    ASSERT_EQ(grid.dims, (glm::ivec3(18, 16, 8) + B - 1) / B);
+    for (int bz = 0; bz < grid.dims.z; ++bz)
+        for (int by = 0; by < grid.dims.y; ++by)
+            for (int bx = 0; bx < grid.dims.x; ++bx) {
+                float mn = 2.0f, mx = -1.0f;
+                for (int k = B * bz; k <= std::min(B * bz + B, v.dims.z - 1); ++k)
+                    for (int j = B * by; j <= std::min(B * by + B, v.dims.y - 1); ++j)
+                        for (int i = B * bx; i <= std::min(B * bx + B, v.dims.x - 1); ++i) {
+                            mn = std::min(mn, v.at(i, j, k));
+                            mx = std::max(mx, v.at(i, j, k));
+                        }
+                const glm::vec2 got = grid.minMax[(bz * grid.dims.y + by) * grid.dims.x + bx];
+                EXPECT_EQ(got, glm::vec2(mn, mx)) << bx << " " << by << " " << bz;
+            }
+}
+
+TEST(Slice3dEmptySpace, RadiiAreChebyshevDistancesToTheNearestNonEmptyBrick)
+{
+    const glm::ivec3 n(7, 5, 3);
+    std::vector<cl_uchar> empty(n.x * n.y * n.z, 1);
+    empty[(1 * n.y + 2) * n.x + 1] = 0;  // one non-empty brick at (1, 2, 1)
+    const std::vector<cl_uchar> space = emptySpaceRadii(n, empty);
+    for (int z = 0; z < n.z; ++z)
+        for (int y = 0; y < n.y; ++y)
+            for (int x = 0; x < n.x; ++x) {
+                const int d = std::max({std::abs(x - 1), std::abs(y - 2), std::abs(z - 1)});
+                EXPECT_EQ(space[(z * n.y + y) * n.x + x], d) << x << " " << y << " " << z;  // r + 1 = d
+            }
+    EXPECT_EQ(emptySpaceRadii({2, 1, 1}, {1, 1}), (std::vector<cl_uchar>{255, 255}));  // all empty: capped
+}
+
+// Skipped samples would have contributed alpha = 1 - exp2(0) = 0 exactly, so the image with
+// skipping must be bit-identical to the one without (memcmp), and the count of samples inside the
+// box the same. Scenes with large zero-tau regions: the sphere field (0 outside the unit sphere) with
+// tau 0 below 0.3, Marschner-Lobb with tau 0 below 0.45, and Marschner-Lobb with its usual transfer
+// function (no empty brick: skipping stays off); both orders, early termination, both cameras, and
+// a perspective camera on the z axis whose center ray runs along grid lines (zero direction
+// components, samples on brick faces).
+TEST(Slice3dEmptySpace, SkippingIsBitIdenticalToTheFullLoop)
+{
+    static const Volume sphere = generateVolume("sphere", {48, 40, 56});
+    const TransferFunction sphereTf({{0.0, {0, 0, 0}, 0.0}, {0.3, {0.2, 0.4, 1}, 0.0}, {0.6, {1, 0.5, 0}, 6.0},
+                                     {1.0, {1, 1, 1}, 12.0}});
+    const TransferFunction mlThreshold({{0.0, {0, 0, 0}, 0.0}, {0.45, {0.3, 0.3, 1}, 0.0}, {1.0, {1, 1, 0.5}, 9.0}});
+    Camera onAxis;
+    onAxis.position = {0.0, 0.0, 3.0};
+    onAxis.focalPoint = {0.0, 0.0, 0.0};
+    onAxis.viewUp = {0.0, 1.0, 0.0};
+    onAxis.viewAngle = 30.0;
+    struct Case {
+        const char* name;
+        const Volume* volume;
+        TransferFunction tf;
+        bool expectSkips;
+    };
+    const Case cases[] = {{"sphere", &sphere, sphereTf, true},
+                          {"ml threshold", &marschnerLobb41(), mlThreshold, true},
+                          {"ml usual", &marschnerLobb41(), mlTransferFunction(), false}};
+    const json orders[] = {{{"slices", 96}},
+                           {{"slices", 96}, {"order", "front-to-back"}},
+                           {{"slices", 128}, {"order", "front-to-back"}, {"early_termination", 0.9}}};
+    for (const Case& c : cases)
+        for (const Camera& camera : {perspectiveCamera(), parallelCamera(), onAxis})
+            for (const json& base : orders) {
+                json on = base, off = base;
+                off["empty_space_skipping"] = false;
+                FrameStats withStats, withoutStats;
+                const Image4f with = renderScene(makeScene(camera, c.tf, 61, on), *c.volume, &withStats);
+                const Image4f without = renderScene(makeScene(camera, c.tf, 61, off), *c.volume, &withoutStats);
+                const std::string label = std::string(c.name) + (camera.parallel ? " parallel " : " perspective ") +
+                                          base.dump();
+                ASSERT_EQ(with.pixelCount(), without.pixelCount());
+                EXPECT_EQ(std::memcmp(with.pixels().data(), without.pixels().data(),
+                                      with.pixelCount() * sizeof(glm::vec4)), 0) << label;
+                EXPECT_EQ(withStats.samples, withoutStats.samples) << label;
+                EXPECT_EQ(withoutStats.extra["samples_skipped"].get<std::uint64_t>(), 0u) << label;
+                const auto skipped = withStats.extra["samples_skipped"].get<std::uint64_t>();
+                EXPECT_EQ(withStats.extra["samples_taken"].get<std::uint64_t>() + skipped, withStats.samples) << label;
+                if (c.expectSkips) {
+                    EXPECT_GT(skipped, withStats.samples / 10) << label;
+                } else {
+                    EXPECT_EQ(skipped, 0u) << label;
+                }
+                if (camera.position == onAxis.position && base.size() == 1)
+                    std::printf("[ measured ] %s: %llu of %llu samples skipped\n", label.c_str(),
+                                static_cast<unsigned long long>(skipped),
+                                static_cast<unsigned long long>(withStats.samples));
+            }
 }
 
 

@@ -18,7 +18,7 @@ namespace clvr {
 namespace {
 
 constexpr int kMaxSlices = 65536;
-constexpr const char* kKnownOptions = "slices, slice_spacing, order, early_termination, path";
+constexpr const char* kKnownOptions = "slices, slice_spacing, order, early_termination, path, empty_space_skipping";
 
 [[noreturn]] void badOption(const std::string& key, const std::string& what)
 {
@@ -51,9 +51,14 @@ private:
     SlicePlan plan_;
     cl::Buffer volume_, tf_;
     std::uint64_t residentBytes_ = 0;
+    // Empty-space skipping (fused path).
+    glm::ivec3 brickDims_{0};
+    cl::Buffer emptyBricks_;
+    std::uint64_t emptyBrickCount_ = 0;
+    double brickSetupMs_ = 0.0;
     // Fused path.
     cl::Kernel fused_;
-    cl::Buffer out_, samples_;
+    cl::Buffer out_, samples_, skipped_;
     // Pass-by-pass path.
     std::unique_ptr<raster::Framebuffer> framebuffer_;
     raster::FragmentProgram fragmentProgram_;
@@ -89,6 +94,16 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
         fused_ = device_.kernel("slice3d.cl", "slice3d_fused");
         out_ = device_.buffer("slice3d image", pixels * sizeof(cl_float4), CL_MEM_WRITE_ONLY);
         samples_ = device_.buffer("slice3d sample counts", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
+        skipped_ = device_.buffer("slice3d skipped sample counts", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
+        // The min-max grid (host) and one flag byte per brick for this transfer function (device).
+        const auto t0 = std::chrono::steady_clock::now();
+        const BrickGrid grid = buildBrickGrid(volume);
+        std::vector<cl_uchar> flags = emptyBricks(grid, scene.transferFunction);
+        brickSetupMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        brickDims_ = grid.dims;
+        emptyBrickCount_ = static_cast<std::uint64_t>(std::count(flags.begin(), flags.end(), cl_uchar(1)));
+        emptyBricks_ = device_.upload("slice3d empty-space radii", emptySpaceRadii(grid.dims, flags));
+        residentBytes_ += flags.size();
     } else {
         framebuffer_ = std::make_unique<raster::Framebuffer>(device_, image_.width, image_.height);
         overBackground_ = device_.kernel("slice3d.cl", "slice3d_over_background");
@@ -146,6 +161,7 @@ Image4f Slice3dRenderer::renderFused(FrameStats& stats)
     int a = 0;
     fused_.setArg(a++, out_);
     fused_.setArg(a++, samples_);
+    fused_.setArg(a++, skipped_);
     fused_.setArg(a++, static_cast<cl_int>(image_.width));
     fused_.setArg(a++, static_cast<cl_int>(image_.height));
     fused_.setArg(a++, volume_);
@@ -154,6 +170,11 @@ Image4f Slice3dRenderer::renderFused(FrameStats& stats)
     fused_.setArg(a++, toCl4(invSpacing));
     fused_.setArg(a++, tf_);
     fused_.setArg(a++, static_cast<cl_int>(tfCount_));
+    fused_.setArg(a++, emptyBricks_);
+    fused_.setArg(a++, cl_int4{{brickDims_.x, brickDims_.y, brickDims_.z, 0}});
+    // Off when asked, or when no brick is empty (then the loop is the plain one).
+    const bool skip = options_.emptySpaceSkipping && emptyBrickCount_ > 0;
+    fused_.setArg(a++, static_cast<cl_int>(skip ? 1 : 0));
     fused_.setArg(a++, toCl4(camera_.position));
     fused_.setArg(a++, toCl4(camera_.forward()));
     fused_.setArg(a++, toCl4(camera_.right()));
@@ -171,7 +192,16 @@ Image4f Slice3dRenderer::renderFused(FrameStats& stats)
     Image4f image(image_.width, image_.height);
     device_.queue().enqueueReadBuffer(out_, CL_FALSE, 0, pixels * sizeof(glm::vec4), image.pixels().data());
     const std::vector<cl_uint> counts = device_.download<cl_uint>(samples_, pixels);
+    const std::vector<cl_uint> skippedCounts = device_.download<cl_uint>(skipped_, pixels);
+    // samples: inside the box (taken + stepped over), as without skipping; the skipped ones apart.
     stats.samples = std::accumulate(counts.begin(), counts.end(), std::uint64_t(0));
+    const std::uint64_t skipped = std::accumulate(skippedCounts.begin(), skippedCounts.end(), std::uint64_t(0));
+    stats.extra["samples_skipped"] = skipped;
+    stats.extra["samples_taken"] = stats.samples - skipped;
+    stats.extra["empty_space_skipping"] = skip;
+    stats.extra["bricks"] = {brickDims_.x, brickDims_.y, brickDims_.z};
+    stats.extra["empty_bricks"] = emptyBrickCount_;
+    stats.extra["brick_setup_ms"] = brickSetupMs_;
     stats.passes = device_.takePassTimes();
     return image;
 }
@@ -269,6 +299,10 @@ Slice3dOptions parseSlice3dOptions(const nlohmann::json& options)
                 o.path = Slice3dOptions::Path::Raster;
             else
                 badOption(key, "must be \"fused\" or \"raster\", got " + value.dump());
+        } else if (key == "empty_space_skipping") {
+            if (!value.is_boolean())
+                badOption(key, "must be true or false, got " + value.dump());
+            o.emptySpaceSkipping = value.get<bool>();
         } else {
             badOption(key, std::string("unknown option for slice3d (known: ") + kKnownOptions + ")");
         }
@@ -355,6 +389,106 @@ std::vector<glm::dvec3> slicePolygon(const glm::dvec3& lo, const glm::dvec3& hi,
                std::atan2(glm::dot(b - centroid, v), glm::dot(b - centroid, u));
     });
     return points;
+}
+
+BrickGrid buildBrickGrid(const Volume& volume)
+{
+    BrickGrid grid;
+    const glm::ivec3 n = volume.dims;
+    grid.dims = (n - 1 + (kBrickCells - 1)) / kBrickCells;  // cells n - 1 per axis
+    grid.minMax.assign(static_cast<std::size_t>(grid.dims.x) * grid.dims.y * grid.dims.z,
+                       glm::vec2(std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity()));
+    // Per row of x: (min, max) over each brick's x range [Bb, Bb + B], then merged into every brick
+    // whose y and z ranges hold the row (2 bricks where j or k is a multiple of B).
+    std::vector<glm::vec2> row(grid.dims.x);
+    for (int k = 0; k < n.z; ++k)
+        for (int j = 0; j < n.y; ++j) {
+            const float* v = volume.values.data() + (static_cast<std::size_t>(k) * n.y + j) * n.x;
+            for (int bx = 0; bx < grid.dims.x; ++bx) {
+                const int i0 = bx * kBrickCells, i1 = std::min(i0 + kBrickCells, n.x - 1);
+                const auto [mn, mx] = std::minmax_element(v + i0, v + i1 + 1);
+                row[bx] = {*mn, *mx};
+            }
+            const int by1 = std::min(j / kBrickCells, grid.dims.y - 1), bz1 = std::min(k / kBrickCells, grid.dims.z - 1);
+            const int by0 = (j % kBrickCells == 0 && j > 0) ? j / kBrickCells - 1 : by1;
+            const int bz0 = (k % kBrickCells == 0 && k > 0) ? k / kBrickCells - 1 : bz1;
+            for (int bz = bz0; bz <= bz1; ++bz)
+                for (int by = by0; by <= by1; ++by) {
+                    glm::vec2* b = grid.minMax.data() + (static_cast<std::size_t>(bz) * grid.dims.y + by) * grid.dims.x;
+                    for (int bx = 0; bx < grid.dims.x; ++bx)
+                        b[bx] = {std::min(b[bx].x, row[bx].x), std::max(b[bx].y, row[bx].y)};
+                }
+        }
+    return grid;
+}
+
+bool tauZeroOn(const TransferFunction& tf, float lo, float hi)
+{
+    // The device compares x with the float control points: find the control points whose values
+    // clvr_tf_eval can use for some x in [lo, hi]: from the segment holding lo (point 0 when
+    // lo <= s_0) to the first point at or above hi (the last point when hi >= s_{n-1}).
+    const auto& p = tf.points();
+    const int n = static_cast<int>(p.size());
+    auto s = [&](int i) { return static_cast<float>(p[i].s); };
+    int first = 0;
+    while (first + 1 < n && s(first + 1) <= lo)
+        ++first;
+    int last = 0;
+    while (last + 1 < n && s(last) < hi)
+        ++last;
+    for (int i = first; i <= last; ++i)
+        if (p[i].tau != 0.0)  // exactly 0 in double: then the packed slopes are exactly 0 too
+            return false;
+    return true;
+}
+
+std::vector<cl_uchar> emptyBricks(const BrickGrid& grid, const TransferFunction& tf)
+{
+    std::vector<cl_uchar> flags(grid.minMax.size(), 0);
+    for (std::size_t b = 0; b < flags.size(); ++b) {
+        const glm::vec2 m = grid.minMax[b];
+        // Trilinear values are convex combinations of the brick's points; in float they can stray a
+        // few ulp outside [min, max]: widen by 2^-16 of the magnitude (far more than that).
+        const float pad = std::ldexp(std::max(std::abs(m.x), std::abs(m.y)), -16) + 1e-30f;
+        flags[b] = tauZeroOn(tf, m.x - pad, m.y + pad) ? 1 : 0;
+    }
+    return flags;
+}
+
+std::vector<cl_uchar> emptySpaceRadii(const glm::ivec3& brickDims, const std::vector<cl_uchar>& empty)
+{
+    // value(b) = 1 + min over b's 27-neighbourhood of value(n) for an empty brick (outside the grid:
+    // unbounded), 0 for one that is not: iterated to the fixed point, one ring per pass.
+    std::vector<cl_uchar> space(empty.size());
+    for (std::size_t b = 0; b < empty.size(); ++b)
+        space[b] = empty[b] ? 255 : 0;
+    const glm::ivec3 n = brickDims;
+    auto at = [&](int x, int y, int z) { return (static_cast<std::size_t>(z) * n.y + y) * n.x + x; };
+    for (bool changed = true; changed;) {
+        changed = false;
+        std::vector<cl_uchar> next = space;
+        for (int z = 0; z < n.z; ++z)
+            for (int y = 0; y < n.y; ++y)
+                for (int x = 0; x < n.x; ++x) {
+                    if (space[at(x, y, z)] == 0)
+                        continue;
+                    int m = 254;
+                    for (int dz = -1; dz <= 1; ++dz)
+                        for (int dy = -1; dy <= 1; ++dy)
+                            for (int dx = -1; dx <= 1; ++dx) {
+                                const int xx = x + dx, yy = y + dy, zz = z + dz;
+                                if (xx >= 0 && yy >= 0 && zz >= 0 && xx < n.x && yy < n.y && zz < n.z)
+                                    m = std::min<int>(m, space[at(xx, yy, zz)]);
+                            }
+                    const auto v = static_cast<cl_uchar>(m + 1);
+                    if (v != space[at(x, y, z)]) {
+                        next[at(x, y, z)] = v;
+                        changed = true;
+                    }
+                }
+        space.swap(next);
+    }
+    return space;
 }
 
 std::vector<float> packTransferFunction(const TransferFunction& tf)

@@ -22,6 +22,7 @@ struct Slice3dOptions {
     Order order = Order::BackToFront;
     double earlyTermination = 1.0;  // front-to-back only: stop once A >= this; 1.0 = off
     Path path = Path::Fused;
+    bool emptySpaceSkipping = true;  // fused path: step over bricks where tau is 0 (bit-identical image)
 };
 
 // Reads the scene's "options" for slice3d. Throws InputError naming the key ("options.slices: ...")
@@ -47,6 +48,31 @@ SlicePlan planSlices(const Camera& camera, const glm::dvec3& lo, const glm::dvec
 // plane misses the box or only touches it in fewer than 3 distinct points.
 std::vector<glm::dvec3> slicePolygon(const glm::dvec3& lo, const glm::dvec3& hi, const glm::dvec3& normal,
                                      double offset);
+
+// Empty-space skipping (docs/slice3d.md): bricks of B^3 cells, B = kBrickCells (= 2^SLICE3D_BRICK_SHIFT
+// in kernels/slice3d.cl; 4 measured faster than 8 on the engine); brick b covers the grid points
+// [Bb, Bb + B] on each axis (one point of overlap), so it holds every trilinear footprint whose lower
+// corner lies in it. The min-max grid is built once per volume.
+constexpr int kBrickCells = 4;
+struct BrickGrid {
+    glm::ivec3 dims{0};             // bricks per axis: ceil((n - 1) / B)
+    std::vector<glm::vec2> minMax;  // (min, max) of the brick's grid points, x fastest
+};
+BrickGrid buildBrickGrid(const Volume& volume);
+
+// True when the device's evaluation of the packed transfer function (clvr_tf_eval, float control
+// points) gives tau exactly 0 for every x in [lo, hi]: all control points whose segments the interval
+// touches have tau 0 (then the slopes are 0 too), including the clamped ends.
+bool tauZeroOn(const TransferFunction& tf, float lo, float hi);
+
+// One byte per brick, 1 = empty: tauZeroOn over the brick's [min, max], widened by a few ulp so that
+// float rounding in the trilinear interpolation cannot leave the interval.
+std::vector<cl_uchar> emptyBricks(const BrickGrid& grid, const TransferFunction& tf);
+
+// What the fused kernel reads per brick (kernels/slice3d.cl): 0 for a brick that is not empty, else
+// r + 1 where every brick within Chebyshev distance r is empty (bricks outside the grid count as
+// empty), capped at 255; the kernel steps over that cube in one run.
+std::vector<cl_uchar> emptySpaceRadii(const glm::ivec3& brickDims, const std::vector<cl_uchar>& empty);
 
 // The transfer function as kernels/transfer_function.h lays it out.
 std::vector<float> packTransferFunction(const TransferFunction& tf);
