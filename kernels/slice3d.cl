@@ -45,6 +45,14 @@ float slice3d_stretch(const float2 ndc, const float4 params)
 
 #ifndef CLVR_SLICE3D_FRAGMENT
 
+/* The volume's type on the device for the fused kernel: float by default; the host builds with
+ * -DSLICE3D_VOXEL=uchar -DSLICE3D_TRILINEAR=clvr_trilinear_uchar (or ushort) when every value is an
+ * integer in that type's range (the same interpolated values, bit for bit). */
+#ifndef SLICE3D_VOXEL
+#define SLICE3D_VOXEL float
+#define SLICE3D_TRILINEAR clvr_trilinear
+#endif
+
 /* Empty-space skipping (docs/slice3d.md). The grid's cells are grouped in bricks of
  * B = 2^SLICE3D_BRICK_SHIFT = 4 cells per axis (host: kBrickCells); brick b covers the cells
  * [Bb, Bb + B), i.e. the grid points [Bb, Bb + B] (one point of overlap with its neighbour), so every
@@ -127,7 +135,7 @@ int slice3d_space(global const uchar* space, const int4 bdims, const int4 b)
  * stopping once 1 - T >= ert_alpha. alpha = 1 - exp(-tau Delta), computed as
  * 1 - exp2(tau * (-Delta log2 e)). The pixel is c + (1 - A) background, A. */
 kernel void slice3d_fused(global float4* out, global uint* samples, global uint* skipped, const int width,
-                          const int height, global const float* volume, const int4 dims, const float4 grid_origin,
+                          const int height, global const SLICE3D_VOXEL* volume, const int4 dims, const float4 grid_origin,
                           const float4 inv_spacing, global const float* tf, const int tf_count,
                           global const uchar* space, const int4 bdims, const int skip,
                           const float4 cam_position, const float4 cam_forward, const float4 cam_right,
@@ -191,7 +199,7 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
                 }
             }
             ++taken;
-            const float4 ct = clvr_tf_eval(tf, tf_count, clvr_trilinear(volume, dims, g));
+            const float4 ct = clvr_tf_eval(tf, tf_count, SLICE3D_TRILINEAR(volume, dims, g));
             const float alpha = 1.0f - exp2(ct.w * neg_delta_log2e);
             c += (transmittance * alpha) * ct.xyz;
             transmittance *= 1.0f - alpha;
@@ -216,7 +224,7 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
                 }
             }
             ++taken;
-            const float4 ct = clvr_tf_eval(tf, tf_count, clvr_trilinear(volume, dims, g));
+            const float4 ct = clvr_tf_eval(tf, tf_count, SLICE3D_TRILINEAR(volume, dims, g));
             const float alpha = 1.0f - exp2(ct.w * neg_delta_log2e);
             c = ct.xyz * alpha + (1.0f - alpha) * c;
             alpha_acc = alpha + (1.0f - alpha) * alpha_acc;

@@ -36,4 +36,32 @@ float clvr_trilinear(global const float* v, const int4 dims, const float3 g)
     return c0 + fz * (c1 - c0);
 }
 
+/* The same for volumes stored in their native integer type (1 or 2 bytes per grid point): the
+ * conversion of each grid value to float is exact, so the result equals clvr_trilinear on the same
+ * values stored as float, bit for bit. */
+#define CLVR_TRILINEAR_INT(name, T)                                                                 \
+    float name(global const T* v, const int4 dims, const float3 g)                                 \
+    {                                                                                               \
+        const int i = min((int)g.x, dims.x - 2);                                                    \
+        const int j = min((int)g.y, dims.y - 2);                                                    \
+        const int k = min((int)g.z, dims.z - 2);                                                    \
+        const float fx = g.x - (float)i, fy = g.y - (float)j, fz = g.z - (float)k;                  \
+        const uint nx = (uint)dims.x;                                                               \
+        const uint nxy = nx * (uint)dims.y;                                                         \
+        global const T* p = v + ((uint)k * nxy + (uint)j * nx + (uint)i);                          \
+        const float2 a00 = convert_float2(vload2(0, p)), a10 = convert_float2(vload2(0, p + nx));   \
+        const float2 a01 = convert_float2(vload2(0, p + nxy));                                      \
+        const float2 a11 = convert_float2(vload2(0, p + nxy + nx));                                 \
+        const float c00 = a00.x + fx * (a00.y - a00.x);                                             \
+        const float c10 = a10.x + fx * (a10.y - a10.x);                                             \
+        const float c01 = a01.x + fx * (a01.y - a01.x);                                             \
+        const float c11 = a11.x + fx * (a11.y - a11.x);                                             \
+        const float c0 = c00 + fy * (c10 - c00);                                                    \
+        const float c1 = c01 + fy * (c11 - c01);                                                    \
+        return c0 + fz * (c1 - c0);                                                                 \
+    }
+CLVR_TRILINEAR_INT(clvr_trilinear_uchar, uchar)
+CLVR_TRILINEAR_INT(clvr_trilinear_ushort, ushort)
+#undef CLVR_TRILINEAR_INT
+
 #endif

@@ -196,7 +196,7 @@ void expectInputError(const json& options, const std::string& fragment)
 TEST(Slice3dOptions, BadOptionsThrowInputErrorNamingTheKey)
 {
     expectInputError({{"foo", 1}},
-                     "options.foo: unknown option for slice3d (known: slices, slice_spacing, order, early_termination, path, empty_space_skipping)");
+                     "options.foo: unknown option for slice3d (known: slices, slice_spacing, order, early_termination, path, empty_space_skipping, voxel_type)");
     expectInputError({{"slices", 0}}, "options.slices");
     expectInputError({{"slices", 65537}}, "options.slices");
     expectInputError({{"slices", 2.5}}, "options.slices");
@@ -205,6 +205,8 @@ TEST(Slice3dOptions, BadOptionsThrowInputErrorNamingTheKey)
     expectInputError({{"slice_spacing", 0.1}, {"slices", 4}}, "options.slice_spacing");
     expectInputError({{"order", "sideways"}}, "options.order");
     expectInputError({{"path", "gpu"}}, "options.path");
+    expectInputError({{"voxel_type", "int8"}}, "options.voxel_type");
+    expectInputError({{"empty_space_skipping", 1}}, "options.empty_space_skipping");
     expectInputError({{"early_termination", 1.5}}, "options.early_termination");
     expectInputError({{"early_termination", 0.9}}, "options.early_termination");  // needs front-to-back
     expectInputError({{"early_termination", 0.9}, {"order", "front-to-back"}, {"path", "raster"}},
@@ -306,6 +308,38 @@ TEST(Slice3dEmptySpace, RadiiAreChebyshevDistancesToTheNearestNonEmptyBrick)
                 EXPECT_EQ(space[(z * n.y + y) * n.x + x], d) << x << " " << y << " " << z;  // r + 1 = d
             }
     EXPECT_EQ(emptySpaceRadii({2, 1, 1}, {1, 1}), (std::vector<cl_uchar>{255, 255}));  // all empty: capped
+}
+
+// Integer volumes go to the device as uint8 (values in [0, 255]) or uint16 (in [0, 65535]); the
+// kernel converts each grid value to float exactly, so the image equals the float32 one bit for bit.
+TEST(Slice3dRenderer, NativeIntegerVoxelsGiveTheFloat32ImageBitForBit)
+{
+    const Volume sphere = generateVolume("sphere", {33, 29, 37});
+    for (const float scale : {255.0f, 1000.0f}) {
+        Volume v = sphere;
+        for (float& x : v.values)
+            x = std::round(x * scale);
+        const TransferFunction tf({{0.0, {0, 0, 0}, 0.0}, {0.3 * scale, {0.2, 0.4, 1}, 0.0},
+                                   {0.6 * scale, {1, 0.5, 0}, 6.0}, {scale, {1, 1, 1}, 12.0}});
+        for (const char* order : {"back-to-front", "front-to-back"}) {
+            const json options = {{"slices", 80}, {"order", order}};
+            json asFloat = options;
+            asFloat["voxel_type"] = "float32";
+            FrameStats nativeStats, floatStats;
+            auto renderer = makeRenderer(test::device(), makeScene(perspectiveCamera(), tf, 53, options), v);
+            const Image4f native = renderer->render(nativeStats);
+            const Image4f f32 = renderScene(makeScene(perspectiveCamera(), tf, 53, asFloat), v, &floatStats);
+            const std::string type = scale == 255.0f ? "uint8" : "uint16";
+            EXPECT_EQ(nativeStats.extra["voxel_type"], type);
+            EXPECT_EQ(floatStats.extra["voxel_type"], "float32");
+            const std::uint64_t bytesPerPoint = scale == 255.0f ? 1 : 2;
+            const std::uint64_t bricks = 8 * 7 * 9;  // ceil((n - 1) / 4) per axis
+            EXPECT_EQ(renderer->residentBytes(), v.voxelCount() * bytesPerPoint + (4 + 16 + 16) * 4 + bricks);
+            EXPECT_EQ(std::memcmp(native.pixels().data(), f32.pixels().data(), native.pixelCount() * sizeof(glm::vec4)),
+                      0) << type << " " << order;
+            EXPECT_EQ(nativeStats.extra["samples_skipped"], floatStats.extra["samples_skipped"]);
+        }
+    }
 }
 
 // Skipped samples would have contributed alpha = 1 - exp2(0) = 0 exactly, so the image with

@@ -18,7 +18,7 @@ namespace clvr {
 namespace {
 
 constexpr int kMaxSlices = 65536;
-constexpr const char* kKnownOptions = "slices, slice_spacing, order, early_termination, path, empty_space_skipping";
+constexpr const char* kKnownOptions = "slices, slice_spacing, order, early_termination, path, empty_space_skipping, voxel_type";
 
 [[noreturn]] void badOption(const std::string& key, const std::string& what)
 {
@@ -56,6 +56,7 @@ private:
     cl::Buffer emptyBricks_;
     std::uint64_t emptyBrickCount_ = 0;
     double brickSetupMs_ = 0.0;
+    std::string voxelType_ = "float32";  // on the device
     // Fused path.
     cl::Kernel fused_;
     cl::Buffer out_, samples_, skipped_;
@@ -82,16 +83,39 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
         throw InputError("image: width and height must be >= 1");
     plan_ = planSlices(camera_, lo_, hi_, options_);
 
-    // float32 on the device, 4 bytes per grid point; Device::buffer throws DeviceError if too big.
-    volume_ = device_.upload("slice3d volume (float32)", volume.values);
+    // On the fused path with voxel_type auto, uint8 or uint16 when every value is an integer in that
+    // range (1 or 2 bytes per grid point, converted to float exactly in the kernel); else float32, 4
+    // bytes per grid point. Device::buffer throws DeviceError if too big.
+    std::string trilinearOptions;
+    const bool fused = options_.path == Slice3dOptions::Path::Fused;
+    auto integralUpTo = [&](float top) {
+        return std::all_of(volume.values.begin(), volume.values.end(),
+                           [top](float v) { return v >= 0.0f && v <= top && v == std::floor(v); });
+    };
+    if (fused && options_.nativeVoxels && integralUpTo(255.0f)) {
+        std::vector<cl_uchar> v(volume.values.begin(), volume.values.end());
+        volume_ = device_.upload("slice3d volume (uint8)", v);
+        voxelType_ = "uint8";
+        residentBytes_ = v.size();
+        trilinearOptions = "-DSLICE3D_VOXEL=uchar -DSLICE3D_TRILINEAR=clvr_trilinear_uchar";
+    } else if (fused && options_.nativeVoxels && integralUpTo(65535.0f)) {
+        std::vector<cl_ushort> v(volume.values.begin(), volume.values.end());
+        volume_ = device_.upload("slice3d volume (uint16)", v);
+        voxelType_ = "uint16";
+        residentBytes_ = v.size() * sizeof(cl_ushort);
+        trilinearOptions = "-DSLICE3D_VOXEL=ushort -DSLICE3D_TRILINEAR=clvr_trilinear_ushort";
+    } else {
+        volume_ = device_.upload("slice3d volume (float32)", volume.values);
+        residentBytes_ = volume.values.size() * sizeof(float);
+    }
     const std::vector<float> tf = packTransferFunction(scene.transferFunction);
     tfCount_ = static_cast<int>(scene.transferFunction.points().size());
     tf_ = device_.upload("slice3d transfer function", tf);
-    residentBytes_ = volume.values.size() * sizeof(float) + tf.size() * sizeof(float);
+    residentBytes_ += tf.size() * sizeof(float);
 
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
     if (options_.path == Slice3dOptions::Path::Fused) {
-        fused_ = device_.kernel("slice3d.cl", "slice3d_fused");
+        fused_ = device_.kernel("slice3d.cl", "slice3d_fused", {}, trilinearOptions);
         out_ = device_.buffer("slice3d image", pixels * sizeof(cl_float4), CL_MEM_WRITE_ONLY);
         samples_ = device_.buffer("slice3d sample counts", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
         skipped_ = device_.buffer("slice3d skipped sample counts", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
@@ -149,6 +173,7 @@ Image4f Slice3dRenderer::render(FrameStats& stats)
     stats.extra["early_termination"] = options_.earlyTermination;
     stats.extra["voxels"] = static_cast<std::uint64_t>(dims_.x) * dims_.y * dims_.z;
     stats.extra["resident_bytes"] = residentBytes_;
+    stats.extra["voxel_type"] = voxelType_;
     return image;
 }
 
@@ -299,6 +324,14 @@ Slice3dOptions parseSlice3dOptions(const nlohmann::json& options)
                 o.path = Slice3dOptions::Path::Raster;
             else
                 badOption(key, "must be \"fused\" or \"raster\", got " + value.dump());
+        } else if (key == "voxel_type") {
+            const std::string s = value.is_string() ? value.get<std::string>() : "";
+            if (s == "auto")
+                o.nativeVoxels = true;
+            else if (s == "float32")
+                o.nativeVoxels = false;
+            else
+                badOption(key, "must be \"auto\" or \"float32\", got " + value.dump());
         } else if (key == "empty_space_skipping") {
             if (!value.is_boolean())
                 badOption(key, "must be true or false, got " + value.dump());

@@ -23,6 +23,7 @@ struct Slice3dOptions {
     double earlyTermination = 1.0;  // front-to-back only: stop once A >= this; 1.0 = off
     Path path = Path::Fused;
     bool emptySpaceSkipping = true;  // fused path: step over bricks where tau is 0 (bit-identical image)
+    bool nativeVoxels = true;  // fused path: uint8/uint16 on the device when every value fits (same bits)
 };
 
 // Reads the scene's "options" for slice3d. Throws InputError naming the key ("options.slices: ...")
