@@ -415,3 +415,75 @@ TEST(Harc, EarlyTerminationStaysWithinItsThreshold)
 
 }  // namespace
 }  // namespace clvr
+
+// ---- the paper's meshes against the exact tetrahedral reference (host/tet_reference.h) -------------
+#include "host/mesh_io.h"
+#include "host/tet_reference.h"
+
+namespace clvr {
+namespace {
+
+struct MeshCase {
+    const char* name;
+    nlohmann::json spec;
+    TransferFunction tf;
+};
+
+void checkMeshAgainstReference(const MeshCase& c, bool parallel)
+{
+    TetMesh mesh = loadMesh(c.spec, "/");
+    const glm::dvec3 lo = mesh.boundsMin(), hi = mesh.boundsMax(), center = 0.5 * (lo + hi);
+    const double radius = 0.5 * glm::length(hi - lo);
+    Camera camera;
+    camera.focalPoint = center;
+    camera.position = center + radius * glm::dvec3(1.3, 0.9, 2.2);
+    camera.viewUp = {0.0, 1.0, 0.0};
+    camera.viewAngle = 34.0;
+    if (parallel) {
+        camera.parallel = true;
+        camera.parallelScale = 0.8 * radius;
+    }
+    Scene scene = makeScene(camera, c.tf, 64);
+    auto renderer = makeHarcRenderer(test::device(), scene, mesh, buildTopology(mesh));
+    FrameStats stats;
+    const Image4f image = renderer->render(stats);
+    const Image4d expected = tetReferenceIntegral(mesh, c.tf, camera, scene.image);
+    const std::string what = std::string(c.name) + (parallel ? ", parallel" : ", perspective");
+    printError(what.c_str(), image, expected);
+    EXPECT_TRUE(test::imagesNear(image, expected, {.maxAbs = 2e-3, .meanAbs = 2e-4})) << what;
+    EXPECT_EQ(stats.extra["rays_step_bound"].get<std::uint64_t>(), 0u);
+}
+
+TEST(HarcMeshes, BluntfinMatchesExactReference)
+{
+    const MeshCase c{"bluntfin",
+                     {{"file", test::sharedData("bluntfin/bluntfinxyz.bin")},
+                      {"q_file", test::sharedData("bluntfin/bluntfinq.bin")},
+                      {"scalar", "density"}},
+                     TransferFunction({{0.2, {0.0, 0.0, 0.3}, 0.0},
+                                       {0.8, {0.1, 0.3, 1.0}, 0.1},
+                                       {1.5, {0.2, 1.0, 0.3}, 0.4},
+                                       {2.5, {1.0, 0.8, 0.1}, 0.8},
+                                       {4.0, {1.0, 0.2, 0.1}, 1.5}})};
+    checkMeshAgainstReference(c, false);
+    checkMeshAgainstReference(c, true);
+}
+
+TEST(HarcMeshes, PostMatchesExactReference)
+{
+    TetMesh probe = loadMesh(nlohmann::json{{"file", test::sharedData("post/post.vtk")}}, "/");
+    const glm::dvec2 range = probe.scalarRange();
+    auto at = [&](double f) { return range.x + f * (range.y - range.x); };
+    const double size = glm::length(probe.boundsMax() - probe.boundsMin());
+    const MeshCase c{"post",
+                     {{"file", test::sharedData("post/post.vtk")}},
+                     TransferFunction({{at(0.0), {0.1, 0.1, 0.5}, 0.0},
+                                       {at(0.3), {0.2, 0.6, 1.0}, 1.0 / size},
+                                       {at(0.6), {0.9, 0.9, 0.2}, 3.0 / size},
+                                       {at(1.0), {1.0, 0.3, 0.1}, 8.0 / size}})};
+    checkMeshAgainstReference(c, false);
+    checkMeshAgainstReference(c, true);
+}
+
+}  // namespace
+}  // namespace clvr

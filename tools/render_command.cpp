@@ -6,6 +6,7 @@
 #include "host/device.h"
 #include "host/errors.h"
 #include "host/image_io.h"
+#include "host/mesh_io.h"
 #include "host/render/renderer.h"
 #include "host/scene.h"
 #include "host/volume.h"
@@ -164,9 +165,14 @@ int render(const RenderOptions& options)
     Volume volume;
     if (!scene.volume.is_null())
         volume = loadVolume(scene.volume, scene.baseDir);
+    TetMesh mesh;
+    if (!scene.mesh.is_null())
+        mesh = loadMesh(scene.mesh, scene.baseDir);
     const double loadMs = msSince(loadStart);
     if (!scene.camera && !scene.volume.is_null())
         scene.camera = fitCamera(volume.boundsMin(), volume.boundsMax());
+    if (!scene.camera && !scene.mesh.is_null())
+        scene.camera = fitCamera(mesh.boundsMin(), mesh.boundsMax());
 
     // 3. Device, set-up (upload, kernel builds) and a first frame; then one steady frame.
     Device device(options.deviceSpec);
@@ -179,7 +185,8 @@ int render(const RenderOptions& options)
         ProgressLine progress("rendering " + scene.technique + " " + size);
         const Clock::time_point t0 = Clock::now();
         try {
-            renderer = makeRenderer(device, scene, volume);
+            renderer = scene.mesh.is_null() ? makeRenderer(device, scene, volume)
+                                            : makeMeshRenderer(device, scene, mesh);
         } catch (const DeviceError&) {
             throw;
         } catch (const InputError& e) {  // technique or options: say which scene they came from

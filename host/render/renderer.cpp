@@ -2,11 +2,12 @@
 #include "host/render/renderer.h"
 
 #include "host/errors.h"
+#include "host/render/harc.h"
 #include "host/render/slice3d.h"
 
 namespace clvr {
 
-std::vector<std::string> techniqueNames() { return {"slice3d"}; }
+std::vector<std::string> techniqueNames() { return {"slice3d", "harc"}; }
 
 std::unique_ptr<Renderer> makeRenderer(Device& device, const Scene& scene, const Volume& volume)
 {
@@ -15,10 +16,21 @@ std::unique_ptr<Renderer> makeRenderer(Device& device, const Scene& scene, const
             throw InputError("technique slice3d needs a regular-grid \"volume\", and the scene has none");
         return makeSlice3dRenderer(device, scene, volume);
     }
+    if (scene.technique == "harc")
+        throw InputError("technique harc needs a tetrahedral \"mesh\", and the scene has none");
     std::string known;
     for (const std::string& name : techniqueNames())
         known += (known.empty() ? "" : ", ") + name;
     throw InputError("technique: unknown technique \"" + scene.technique + "\" (known: " + known + ")");
+}
+
+std::unique_ptr<Renderer> makeMeshRenderer(Device& device, const Scene& scene, const TetMesh& mesh)
+{
+    if (scene.technique == "harc")
+        return makeHarcRenderer(device, scene, mesh, buildTopology(mesh));
+    if (scene.technique != "slice3d")
+        throw InputError("technique: unknown technique \"" + scene.technique + "\" (mesh techniques: harc)");
+    throw InputError("technique \"" + scene.technique + "\" renders regular-grid volumes, and the scene has a \"mesh\" (mesh techniques: harc)");
 }
 
 }  // namespace clvr

@@ -4,6 +4,7 @@
 
 #include "host/device.h"
 #include "host/image.h"
+#include "host/mesh.h"
 #include "host/scene.h"
 #include "host/volume.h"
 
@@ -38,7 +39,11 @@ public:
 // unknown technique (listing the known ones) or an unknown or invalid option.
 std::unique_ptr<Renderer> makeRenderer(Device& device, const Scene& scene, const Volume& volume);
 
-// Technique names makeRenderer knows, in the order `clvr render --help` lists them.
+// The mesh technique the scene names ("harc"), set up on `device` for `mesh` (checked by checkMesh;
+// its adjacency is built here). Throws InputError as makeRenderer does.
+std::unique_ptr<Renderer> makeMeshRenderer(Device& device, const Scene& scene, const TetMesh& mesh);
+
+// Technique names makeRenderer and makeMeshRenderer know, in the order `clvr render --help` lists them.
 std::vector<std::string> techniqueNames();
 
 }  // namespace clvr
