@@ -30,42 +30,9 @@ using clvr::TetMesh;
 
 namespace {
 
-class TempDir {
-public:
-    TempDir()
-    {
-        static int counter = 0;
-        const auto* info = testing::UnitTest::GetInstance()->current_test_info();
-        path_ = fs::temp_directory_path() / ("clvr-mesh-io-" + std::to_string(::getpid()) + "-" +
-                                             std::to_string(counter++) + "-" + (info ? info->name() : "x"));
-        fs::create_directories(path_);
-    }
-    ~TempDir()
-    {
-        std::error_code ec;
-        fs::remove_all(path_, ec);
-    }
-    fs::path operator/(const std::string& name) const { return path_ / name; }
-    const fs::path& path() const { return path_; }
-
-private:
-    fs::path path_;
-};
-
-void writeFile(const fs::path& path, const std::string& bytes)
-{
-    std::ofstream out(path, std::ios::binary);
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    ASSERT_TRUE(out.good()) << path;
-}
-
-std::string readFile(const fs::path& path)
-{
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
+using clvr::test::readFile;
+using clvr::test::TempDir;
+using clvr::test::writeFile;
 
 std::string messageOf(const std::function<void()>& f)
 {

@@ -5,8 +5,10 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <sstream>
+#include <unistd.h>
 
 namespace clvr::test {
 
@@ -98,6 +100,37 @@ testing::AssertionResult imagesNear(const Image4f& actual, const Image4d& expect
     writeImage(dir + "/diff.exr", diff);
     msg << "wrote " << dir << "/{actual,expected,diff}.exr";
     return testing::AssertionFailure() << msg.str();
+}
+
+TempDir::TempDir()
+{
+    static int counter = 0;
+    const testing::TestInfo* info = testing::UnitTest::GetInstance()->current_test_info();
+    path_ = std::filesystem::temp_directory_path() /
+            ("clvr-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) + "-" +
+             (info ? std::string(info->name()) : std::string("x")));
+    std::filesystem::create_directories(path_);
+}
+
+TempDir::~TempDir()
+{
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+}
+
+void writeFile(const std::filesystem::path& path, const std::string& bytes)
+{
+    std::ofstream out(path, std::ios::binary);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    ASSERT_TRUE(out.good()) << path;
+}
+
+std::string readFile(const std::filesystem::path& path)
+{
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
 }
 
 std::uint64_t Rng::next()

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <filesystem>
 #include <string>
 
 namespace clvr::test {
@@ -34,6 +35,25 @@ ImageError imageError(const Image4f& actual, const Image4d& expected);
 // Per channel max and mean absolute error against `expected`; fails on NaN or size mismatch.
 // On failure writes test_output/<suite>.<test>/{actual,expected,diff}.exr and says so.
 testing::AssertionResult imagesNear(const Image4f& actual, const Image4d& expected, Tolerance tolerance);
+
+// A fresh directory under the system temporary directory (named after the running test), removed
+// with everything in it when it goes out of scope. Tests write malformed files here, never in the repo.
+class TempDir {
+public:
+    TempDir();
+    ~TempDir();
+    TempDir(const TempDir&) = delete;
+    TempDir& operator=(const TempDir&) = delete;
+    std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
+    const std::filesystem::path& path() const { return path_; }
+
+private:
+    std::filesystem::path path_;
+};
+
+// Whole-file binary write (asserting success) and read.
+void writeFile(const std::filesystem::path& path, const std::string& bytes);
+std::string readFile(const std::filesystem::path& path);
 
 // A small deterministic generator (splitmix64): the same numbers on every standard library.
 class Rng {

@@ -28,43 +28,9 @@ using clvr::ScalarType;
 
 namespace {
 
-// A fresh directory under the system temporary directory, removed with everything in it.
-class TempDir {
-public:
-    TempDir()
-    {
-        static int counter = 0;
-        const auto* info = testing::UnitTest::GetInstance()->current_test_info();
-        path_ = fs::temp_directory_path() / ("clvr-volume-io-" + std::to_string(::getpid()) + "-" +
-                                             std::to_string(counter++) + "-" + (info ? info->name() : "x"));
-        fs::create_directories(path_);
-    }
-    ~TempDir()
-    {
-        std::error_code ec;
-        fs::remove_all(path_, ec);
-    }
-    fs::path operator/(const std::string& name) const { return path_ / name; }
-    const fs::path& path() const { return path_; }
-
-private:
-    fs::path path_;
-};
-
-void writeFile(const fs::path& path, const std::string& bytes)
-{
-    std::ofstream out(path, std::ios::binary);
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    ASSERT_TRUE(out.good()) << path;
-}
-
-std::string readFile(const fs::path& path)
-{
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
+using clvr::test::readFile;
+using clvr::test::TempDir;
+using clvr::test::writeFile;
 
 // Values encoded as `T` in the given byte order, independently of the readers.
 template <typename T>
