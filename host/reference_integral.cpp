@@ -2,6 +2,8 @@
 // (Eq. 1 of seeds/001_cd12fd6b76f9cf96.txt) in double, per pixel, rows spread over std::threads.
 #include "host/reference_integral.h"
 
+#include "host/parallel.h"
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -151,14 +153,7 @@ Image4d referenceIntegral(const Volume& volume, const TransferFunction& tf, cons
         total.maxResidual = std::max(total.maxResidual, local.maxResidual);
     };
 
-    int threads = options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency());
-    threads = std::clamp(threads, 1, std::max(1, image.height));
-    std::vector<std::thread> pool;
-    for (int i = 1; i < threads; ++i)
-        pool.emplace_back(worker);
-    worker();
-    for (auto& t : pool)
-        t.join();
+    runOnThreads(options.threads, image.height, worker);
     if (options.stats)
         *options.stats = total;
     return out;

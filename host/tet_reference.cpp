@@ -4,6 +4,8 @@
 // seeds/001_cd12fd6b76f9cf96.txt; derivation and numerical care in docs/tet-reference.md).
 #include "host/tet_reference.h"
 
+#include "host/parallel.h"
+
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -437,14 +439,7 @@ Image4d tetReferenceIntegral(const TetAccel& accel, const TransferFunction& tf, 
         total.pieces += local.pieces;
         total.maxSegmentsPerRay = std::max(total.maxSegmentsPerRay, local.maxSegmentsPerRay);
     };
-    int threads = options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency());
-    threads = std::clamp(threads, 1, std::max(1, image.height));
-    std::vector<std::thread> pool;
-    for (int i = 1; i < threads; ++i)
-        pool.emplace_back(worker);
-    worker();
-    for (auto& t : pool)
-        t.join();
+    runOnThreads(options.threads, image.height, worker);
     if (options.stats)
         *options.stats = total;
     return out;
