@@ -1,5 +1,5 @@
 // host/reference_integral.cpp — converged midpoint quadrature of the emission-absorption integral
-// (Eq. 1 of seeds/001_cd12fd6b76f9cf96.txt) in double, per pixel, rows spread over std::threads.
+// (Eq. 1 of seeds/001_cd12fd6b76f9cf96.txt) in double, per pixel, rows spread over host threads.
 #include "host/reference_integral.h"
 
 #include "host/parallel.h"
@@ -9,7 +9,6 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
-#include <thread>
 #include <vector>
 
 namespace clvr {

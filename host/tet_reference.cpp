@@ -12,7 +12,6 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
-#include <thread>
 
 namespace clvr {
 namespace {
