@@ -4,6 +4,7 @@
 #include "host/mesh_io.h"
 
 #include "host/errors.h"
+#include "host/file_io.h"
 
 #include <nlohmann/json.hpp>
 
@@ -82,20 +83,6 @@ std::optional<double> parseDouble(std::string_view s)
     if (ec != std::errc())
         return std::nullopt;
     return v;
-}
-
-std::uint64_t fileSize(const fs::path& path)
-{
-    std::error_code ec;
-    const fs::file_status st = fs::status(path, ec);
-    if (ec || !fs::exists(st))
-        throw InputError(path.string() + ": no such file");
-    if (fs::is_directory(st))
-        throw InputError(path.string() + ": is a directory, not a file");
-    const std::uintmax_t size = fs::file_size(path, ec);
-    if (ec)
-        throw InputError(path.string() + ": cannot read (" + ec.message() + ")");
-    return size;
 }
 
 std::string readWhole(const fs::path& path)

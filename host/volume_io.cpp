@@ -4,6 +4,7 @@
 #include "host/volume_io.h"
 
 #include "host/errors.h"
+#include "host/file_io.h"
 #include "host/generators.h"
 
 #include <nlohmann/json.hpp>
@@ -142,20 +143,6 @@ std::uint64_t checkedVoxelCount(const std::string& source, const std::vector<lon
                          ", the limit is 2^34)");
     checkHostMemoryForVoxels(source, count);
     return count;
-}
-
-std::uint64_t fileSize(const fs::path& path)
-{
-    std::error_code ec;
-    const fs::file_status st = fs::status(path, ec);
-    if (ec || !fs::exists(st))
-        throw InputError(path.string() + ": no such file");
-    if (fs::is_directory(st))
-        throw InputError(path.string() + ": is a directory, not a file");
-    const std::uintmax_t size = fs::file_size(path, ec);
-    if (ec)
-        throw InputError(path.string() + ": cannot read (" + ec.message() + ")");
-    return size;
 }
 
 std::ifstream openBinary(const fs::path& path)
