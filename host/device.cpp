@@ -5,9 +5,11 @@
 #include "host/errors.h"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <chrono>
 #include <cstdlib>
+#include <cstring>
 
 namespace clvr {
 namespace {
@@ -279,11 +281,22 @@ cl::Buffer Device::buffer(std::string_view what, std::size_t bytes, cl_mem_flags
         throw DeviceError("out of device memory: " + std::string(what) + " needs " + mib(bytes) + ", " +
                           listing_.name + " allows " + mib(listing_.maxAllocBytes) + " per buffer and has " +
                           mib(listing_.globalMemBytes));
+    // Zero-sized buffers are invalid in OpenCL: allocate at least 4 bytes. CL_MEM_COPY_HOST_PTR then
+    // reads the whole allocation, so a shorter host block is copied into a zero-padded one first.
+    constexpr std::size_t kMinBytes = 4;
+    std::array<unsigned char, kMinBytes> padded{};
+    if ((flags & CL_MEM_COPY_HOST_PTR) != 0 && bytes < kMinBytes) {
+        if (bytes > 0)
+            std::memcpy(padded.data(), host, bytes);
+        host = padded.data();
+    }
     try {
-        return cl::Buffer(context_, flags, std::max<std::size_t>(bytes, 4), const_cast<void*>(host));
+        return cl::Buffer(context_, flags, std::max(bytes, kMinBytes), const_cast<void*>(host));
     } catch (const cl::Error& e) {
-        throw DeviceError("out of device memory: allocating " + mib(bytes) + " for " + std::string(what) + " on " +
-                          listing_.name + " failed: " + clErrorName(e.err()));
+        const bool noMemory = e.err() == CL_MEM_OBJECT_ALLOCATION_FAILURE || e.err() == CL_OUT_OF_RESOURCES ||
+                              e.err() == CL_OUT_OF_HOST_MEMORY || e.err() == CL_INVALID_BUFFER_SIZE;
+        throw DeviceError(std::string(noMemory ? "out of device memory: " : "") + "allocating " + mib(bytes) +
+                          " for " + std::string(what) + " on " + listing_.name + " failed: " + clErrorName(e.err()));
     }
 }
 

@@ -47,6 +47,21 @@ TEST(Device, FillKernelWritesEveryElementOfAnOddSizedBuffer)
     EXPECT_GE(times[0].ms, 0.0);
 }
 
+TEST(Device, UploadShorterThanTheMinimumAllocationKeepsItsBytes)
+{
+    // Buffers are at least 4 bytes; a 1-byte host block must be copied, not over-read (ASan
+    // caught the over-read when a volume had a single empty-space brick).
+    clvr::Device& device = clvr::test::device();
+    for (std::size_t n = 0; n <= 5; ++n) {
+        std::vector<cl_uchar> data(n);
+        for (std::size_t i = 0; i < n; ++i)
+            data[i] = static_cast<cl_uchar>(200 + i);
+        cl::Buffer buffer = device.upload("short block", data);
+        const std::vector<cl_uchar> out = device.download<cl_uchar>(buffer, n);
+        EXPECT_EQ(out, data) << n << " bytes";
+    }
+}
+
 TEST(Device, ProgramCacheReturnsTheSameProgram)
 {
     clvr::Device& device = clvr::test::device();
