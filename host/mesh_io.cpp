@@ -5,6 +5,7 @@
 
 #include "host/errors.h"
 #include "host/file_io.h"
+#include "host/tetgen_mesher.h"
 
 #include <nlohmann/json.hpp>
 
@@ -1010,13 +1011,55 @@ void writeVtkUnstructured(const TetMesh& mesh, const fs::path& path, bool binary
 
 // ---------------------------------------------------------------------------------------------------
 
+namespace {
+
+// {"surface": ..., "quality": Q, "max_volume": V, "scalar": generator or volume file}: TetGen at load time.
+TetMesh meshSurfaceSpec(const nlohmann::json& spec, const fs::path& baseDir)
+{
+    const auto resolve = [&](const std::string& f) {
+        const fs::path p(f);
+        return p.is_absolute() ? p : baseDir / p;
+    };
+    if (!spec["surface"].is_string())
+        throw InputError("scene: mesh.surface must be a file name (string)");
+    MesherOptions options;
+    const auto positive = [&](const char* key, double& out) {
+        if (!spec.contains(key))
+            return;
+        const auto& v = spec[key];
+        if (!v.is_number() || !(v.get<double>() > 0.0) || !std::isfinite(v.get<double>()))
+            throw InputError(std::string("scene: mesh.") + key + " must be a positive number, got " + v.dump());
+        out = v.get<double>();
+    };
+    positive("quality", options.quality);
+    positive("max_volume", options.maxVolume);
+    if (spec.contains("scalar")) {
+        if (!spec["scalar"].is_string())
+            throw InputError("scene: mesh.scalar must be a generator name or a volume file (string) for a surface");
+        options.scalar = spec["scalar"].get<std::string>();
+        const std::string ext = lower(fs::path(options.scalar).extension().string());
+        if (ext == ".nrrd" || ext == ".nhdr")
+            options.scalar = resolve(options.scalar).string();
+    }
+    return meshSurface(resolve(spec["surface"].get<std::string>()), options);
+}
+
+}  // namespace
+
 TetMesh loadMesh(const nlohmann::json& spec, const fs::path& baseDir)
 {
     if (!spec.is_object())
         throw InputError("scene: \"mesh\" must be an object such as {\"file\": \"x.vtk\"}");
+    if (spec.contains("surface")) {
+        for (auto it = spec.begin(); it != spec.end(); ++it)
+            if (it.key() != "surface" && it.key() != "quality" && it.key() != "max_volume" && it.key() != "scalar")
+                throw InputError("scene: mesh." + it.key() +
+                                 " is not a key of a surface mesh (surface, quality, max_volume, scalar)");
+        return meshSurfaceSpec(spec, baseDir);  // checked by meshSurface
+    }
     for (auto it = spec.begin(); it != spec.end(); ++it)
         if (it.key() != "file" && it.key() != "q_file" && it.key() != "scalar")
-            throw InputError("scene: mesh." + it.key() + " is not a mesh key (file, q_file, scalar)");
+            throw InputError("scene: mesh." + it.key() + " is not a mesh key (file, q_file, scalar, or surface)");
     if (!spec.contains("file") || !spec["file"].is_string())
         throw InputError("scene: mesh.file must be a file name (string)");
     std::string scalar;

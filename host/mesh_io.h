@@ -17,6 +17,8 @@ namespace clvr {
 // Loads the scene's "mesh" object and returns a checked mesh (checkMesh applied):
 //   {"file": "x.node"|"x.ele"|"x.vtk"|"x.off", "scalar": name or index (optional)}
 //   {"file": "xyz.bin", "q_file": "q.bin", "scalar": "density"|"momentum"|"energy"|"pressure"} (PLOT3D)
+//   {"surface": "x.off"|.stl|.poly|.smesh, "quality": Q, "max_volume": V, "scalar": generator or .nrrd}
+//     (meshed with TetGen at load time, host/tetgen_mesher.h; scalar default "sphere")
 // Relative paths are relative to baseDir. Unknown keys and wrongly typed values: InputError naming the key.
 TetMesh loadMesh(const nlohmann::json& spec, const std::filesystem::path& baseDir);
 

@@ -3,6 +3,7 @@
 // written here, hexahedron and wedge splits, the scene's "mesh" object, and malformed files giving a
 // one-line InputError that names the file. Files are written to a temporary directory.
 #include "host/errors.h"
+#include "host/generators.h"
 #include "host/mesh.h"
 #include "host/mesh_io.h"
 #include "host/tetgen_mesher.h"
@@ -494,4 +495,27 @@ TEST(MeshIo, TetgenMesherLBlockPoly)
     expectError([&] { clvr::meshSurface(dir / "bad.off", options); }, "the surface is flat", "bad.off");
     options.scalar = "nosuch";
     expectError([&] { clvr::meshSurface(dir / "l.poly", options); }, "neither a generator");
+}
+
+TEST(MeshIo, SceneSurfaceIsMeshedAtLoad)
+{
+    // data/surfaces/l-block.poly through the scene's {"surface": ...} form: TetGen at load time, the
+    // volume bound honored, the scalar from a generator; a volume file as the scalar is resolved
+    // against the scene's folder like every other path.
+    const std::string dir = clvr::test::repoData("surfaces");
+    const TetMesh coarse = clvr::loadMesh({{"surface", "l-block.poly"}, {"scalar", "sphere"}}, dir);
+    const TetMesh fine = clvr::loadMesh({{"surface", "l-block.poly"}, {"max_volume", 0.01}, {"quality", 1.5}}, dir);
+    expectGoodMesh(coarse, 3.0, 1e-12);
+    expectGoodMesh(fine, 3.0, 1e-12);
+    EXPECT_GT(fine.tets.size(), 300u);
+    EXPECT_GT(fine.tets.size(), 10 * coarse.tets.size());
+    for (std::size_t i = 0; i < coarse.points.size(); ++i)
+        ASSERT_DOUBLE_EQ(coarse.scalars[i], clvr::sphereField(coarse.points[i]));
+
+    expectError([&] { clvr::loadMesh({{"surface", "l-block.poly"}, {"file", "x.ele"}}, dir); }, "mesh.file");
+    expectError([&] { clvr::loadMesh({{"surface", "l-block.poly"}, {"max_volume", -1}}, dir); }, "mesh.max_volume");
+    expectError([&] { clvr::loadMesh({{"surface", "l-block.poly"}, {"quality", "high"}}, dir); }, "mesh.quality");
+    expectError([&] { clvr::loadMesh({{"surface", 3}}, dir); }, "mesh.surface");
+    expectError([&] { clvr::loadMesh({{"surface", "l-block.poly"}, {"scalar", "head.nrrd"}}, dir); }, "head.nrrd");
+    expectError([&] { clvr::loadMesh({{"surface", "nosuch.off"}}, dir); }, "nosuch.off");
 }
