@@ -1,0 +1,62 @@
+// kernels/harc_entry.cl — the fragment program of HARC's entry pass (host/render/harc_entry.h):
+// raster::draw appends it, with CLVR_HARC_ENTRY_FRAGMENT defined, after kernels/raster.cl. One draw
+// of the mesh's boundary faces per depth-peeling layer, back faces culled, depth test LESS: at each
+// pixel the nearest front face whose ray parameter λ lies beyond the previous layer's survives.
+#ifdef CLVR_HARC_ENTRY_FRAGMENT
+
+/* attr[0] = (position relative to the mesh origin, 0), perspective-correct; attr[1] = (code & 0xffff,
+ * code >> 16, 0, 0), the same at the three corners (code = tet * 4 + face).
+ * uniforms (camera relative to the mesh origin, as kernels/harc.cl's harc_render takes it):
+ *   0 position, 1 forward, 2 right, 3 up, 4 params (tan(view_angle/2) or parallel_scale, aspect,
+ *   1 if parallel else 0), 5 (width, height).
+ * buffer[0] = the previous layer's λ per pixel (-1e30 before the first); buffer[1] = the tetrahedra in
+ * kernels/harc.cl's 80-byte layout.
+ * λ is the parameter of harc_render's ray e + λ d through this pixel's center where it crosses the
+ * face's plane, computed from the plane (b_face(e + λ d) = 0), so that it does not carry the raster
+ * stage's subpixel snapping; the interpolated position is the fallback for a face seen edge-on.
+ * Output: (λ, code & 0xffff, code >> 16, 1), exact integers in float. */
+int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* color)
+{
+    constant float4* u = r->uniforms;
+    const int width = (int)u[5].x, height = (int)u[5].y;
+    const float ndc_x = f->window.x / (float)width * 2.0f - 1.0f;
+    const float ndc_y = 1.0f - f->window.y / (float)height * 2.0f;
+    const float sx = ndc_x * u[4].x * u[4].y, sy = ndc_y * u[4].x;
+    float3 e, d;
+    if (u[4].z != 0.0f) {
+        e = u[0].xyz + sx * u[2].xyz + sy * u[3].xyz;
+        d = u[1].xyz;
+    } else {
+        e = u[0].xyz;
+        d = normalize(u[1].xyz + sx * u[2].xyz + sy * u[3].xyz);
+    }
+    const int code = (int)rint(f->attr[1].x) | ((int)rint(f->attr[1].y) << 16);
+    global const float4* tet = (global const float4*)r->buffer[1] + (size_t)(code >> 2) * 5;
+    const int face = code & 3;
+    float4 plane;
+    if (face < 3)
+        plane = tet[face];
+    else
+        plane = (float4)(-(tet[0].xyz + tet[1].xyz + tet[2].xyz), 1.0f - (tet[0].w + tet[1].w + tet[2].w));
+    const float hd = dot(plane.xyz, d);
+    float lambda;
+    if (hd > 0.0f)  /* entering: b_face grows from 0 along d */
+        lambda = -(dot(plane.xyz, e) + plane.w) / hd;
+    else
+        lambda = dot(f->attr[0].xyz - e, d);
+    const int p = (int)f->window.y * width + (int)f->window.x;
+    const float previous = r->buffer[0][p];
+    /* Peel: strictly beyond the last layer, by a relative margin far above float rounding of λ. */
+    if (!(lambda > previous + 1e-5f * (1.0f + fabs(previous))))
+        return 0;
+    *color = (float4)(lambda, (float)(code & 0xffff), (float)(code >> 16), 1.0f);
+    return 1;
+}
+
+#else
+
+/* Compiled on its own (the offline syntax check) this file holds only the marker below: the program
+ * exists only inside raster::draw's kernel. */
+typedef int clvr_harc_entry_is_a_fragment_program;
+
+#endif
