@@ -6,10 +6,12 @@
 #include "host/errors.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numeric>
 #include <sstream>
+#include <tuple>
 
 namespace clvr {
 
@@ -104,6 +106,9 @@ void checkMesh(TetMesh& mesh)
     const glm::dvec3 extent = mesh.boundsMax() - mesh.boundsMin();
     const double scale = std::max({extent.x, extent.y, extent.z});
     const double threshold = 1e-12 * scale * scale * scale;
+    if (!mesh.neighbors.empty() && mesh.neighbors.size() != mesh.tets.size())
+        throw InputError(source + ": adjacency for " + std::to_string(mesh.neighbors.size()) + " tetrahedra, the mesh has " +
+                         std::to_string(mesh.tets.size()));
     std::size_t kept = 0;
     for (std::size_t t = 0; t < mesh.tets.size(); ++t) {
         glm::uvec4 c = mesh.tets[t];
@@ -114,13 +119,70 @@ void checkMesh(TetMesh& mesh)
             continue;
         }
         if (v6 < 0.0) {
-            std::swap(c[2], c[3]);
+            std::swap(c[2], c[3]);  // faces 2 and 3 swap with their opposite vertices
+            if (!mesh.neighbors.empty())
+                std::swap(mesh.neighbors[t][2], mesh.neighbors[t][3]);
             ++mesh.tetsReoriented;
         }
+        if (!mesh.neighbors.empty())
+            mesh.neighbors[kept] = mesh.neighbors[t];
         mesh.tets[kept++] = c;
     }
     mesh.tets.resize(kept);
+    // Dropped cells renumber the others and leave holes that face matching (with welding) handles.
+    if (kept != mesh.neighbors.size())
+        mesh.neighbors.clear();
 }
+
+namespace {
+
+// The positions of the three points of face f of tetrahedron c (the face opposite vertex f), sorted:
+// faces are the same when their points coincide, as buildTopology's welding has it.
+std::array<std::tuple<double, double, double>, 3> faceKey(const TetMesh& mesh, const glm::uvec4& c, int f)
+{
+    std::array<std::tuple<double, double, double>, 3> key{};
+    int k = 0;
+    for (int i = 0; i < 4; ++i)
+        if (i != f) {
+            const glm::dvec3& p = mesh.points[c[i]];
+            key[k++] = {p.x, p.y, p.z};
+        }
+    std::sort(key.begin(), key.end());
+    return key;
+}
+
+// buildTopology from a given adjacency (a TetGen .neigh), checked pair by pair.
+TetTopology topologyFromNeighbors(const TetMesh& mesh, const std::string& source)
+{
+    TetTopology topo;
+    topo.neighbor = mesh.neighbors;
+    const std::size_t nt = mesh.tets.size();
+    for (std::size_t t = 0; t < nt; ++t)
+        for (int f = 0; f < 4; ++f) {
+            const std::int32_t n = topo.neighbor[t][f];
+            if (n == -1) {
+                topo.boundary.push_back({static_cast<std::uint32_t>(t), static_cast<std::uint32_t>(f)});
+                continue;
+            }
+            const std::string cell = source + ": tetrahedron " + std::to_string(t) + ", face " + std::to_string(f);
+            if (n < 0 || static_cast<std::size_t>(n) >= nt || static_cast<std::size_t>(n) == t)
+                throw InputError(cell + ": neighbor " + std::to_string(n) + " is not another tetrahedron of the mesh");
+            const auto key = faceKey(mesh, mesh.tets[t], f);
+            int back = -1;
+            for (int g = 0; g < 4 && back < 0; ++g)
+                if (faceKey(mesh, mesh.tets[n], g) == key)
+                    back = g;
+            if (back < 0)
+                throw InputError(cell + ": the adjacency names tetrahedron " + std::to_string(n) +
+                                 " as its neighbor, but they do not share that face");
+            if (topo.neighbor[n][back] != static_cast<std::int32_t>(t))
+                throw InputError(cell + ": the adjacency is not symmetric (tetrahedron " + std::to_string(n) +
+                                 " does not name it back)");
+        }
+    return topo;
+}
+
+}  // namespace
 
 TetTopology buildTopology(const TetMesh& mesh)
 {
@@ -129,6 +191,8 @@ TetTopology buildTopology(const TetMesh& mesh)
     const std::string source = mesh.source.empty() ? std::string("mesh") : mesh.source;
     if (nt > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
         throw InputError(source + ": " + std::to_string(nt) + " tetrahedra, the limit is 2^31 - 1");
+    if (!mesh.neighbors.empty() && mesh.neighbors.size() == nt)
+        return topologyFromNeighbors(mesh, source);
 
     // Weld: points with exactly the same position get the same id (-0.0 equals 0.0 under <).
     std::vector<std::uint32_t> order(n);

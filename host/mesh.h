@@ -22,6 +22,10 @@ struct TetMesh {
     std::uint64_t tetsRead = 0;         // as read or split, before degenerate ones are dropped
     std::uint64_t tetsDegenerate = 0;   // zero volume: dropped
     std::uint64_t tetsReoriented = 0;   // inverted: vertex order fixed
+    // Adjacency as a file gave it (TetGen .neigh): neighbors[t][i] is the tetrahedron across face i of t,
+    // -1 on the boundary; empty when there was none. checkMesh keeps it in step with reoriented cells
+    // and forgets it when cells are dropped; buildTopology checks it and then uses it.
+    std::vector<std::array<std::int32_t, 4>> neighbors;
 
     glm::dvec3 boundsMin() const;
     glm::dvec3 boundsMax() const;
@@ -41,6 +45,9 @@ double signedVolume6(const glm::dvec3& p0, const glm::dvec3& p1, const glm::dvec
 // Faces are matched by their points' positions (coincident points are welded), so curvilinear grids
 // that close on themselves with duplicated points (O-grids) are connected across the seam.
 // InputError for a face shared by three or more tetrahedra (naming the first such cell).
+// When mesh.neighbors is given (a TetGen .neigh) it is used instead of matching faces, after checking
+// that every pair it names shares that face's three points and names each other: InputError naming the
+// first cell where it does not.
 struct TetTopology {
     std::vector<std::array<std::int32_t, 4>> neighbor;
     struct BoundaryFace {

@@ -775,6 +775,40 @@ TetMesh readTetgen(const fs::path& path, const std::string& scalar)
         mesh.tets[t] = c;
     }
     mesh.tetsRead = nt;
+
+    // x.neigh (TetGen -n): `ntets 4`, then `number n0 n1 n2 n3`, neighbor i across the face opposite
+    // point i, -1 on the boundary, numbered like the points. Used instead of matching faces when present.
+    const fs::path neighPath = base.string() + ".neigh";
+    std::error_code ec;
+    if (!fs::exists(neighPath, ec))
+        return mesh;
+    TextLines neigh(neighPath);
+    if (!neigh.next(tok))
+        throw InputError(neigh.file() + ": empty file");
+    const long long count = neigh.integer(tok[0], "tetrahedron count");
+    if (count != static_cast<long long>(nt))
+        throw InputError(neigh.where() + ": " + std::to_string(count) + " tetrahedra, " + ele.file() + " has " +
+                         std::to_string(nt));
+    mesh.neighbors.resize(nt);
+    for (std::uint64_t t = 0; t < nt; ++t) {
+        if (!neigh.next(tok))
+            throw InputError(neigh.file() + ": ends after " + std::to_string(t) + " of " + std::to_string(nt) +
+                             " tetrahedra (truncated or a wrong count)");
+        if (tok.size() < 5)
+            throw InputError(neigh.where() + ": a neighbor line needs a number and 4 neighbors");
+        for (int k = 0; k < 4; ++k) {
+            const long long id = neigh.integer(tok[1 + k], "neighbor");
+            if (id == -1) {
+                mesh.neighbors[t][k] = -1;
+                continue;
+            }
+            if (id - firstNumber < 0 || static_cast<std::uint64_t>(id - firstNumber) >= nt)
+                throw InputError(neigh.where() + ": neighbor " + std::to_string(id) + " out of range (tetrahedra are numbered " +
+                                 std::to_string(firstNumber) + " to " + std::to_string(firstNumber + static_cast<long long>(nt) - 1) +
+                                 ", -1 for none)");
+            mesh.neighbors[t][k] = static_cast<std::int32_t>(id - firstNumber);
+        }
+    }
     return mesh;
 }
 
@@ -954,6 +988,20 @@ void writeTetgen(const TetMesh& mesh, const fs::path& base)
     out << "# written by clvr\n";
     if (!out)
         throw InputError(elePath.string() + ": write error");
+    // The adjacency, so that readers (clvr render) need not match faces again.
+    const TetTopology topology = buildTopology(mesh);
+    const fs::path neighPath = base.string() + ".neigh";
+    std::ofstream neigh(neighPath);
+    if (!neigh)
+        throw InputError(neighPath.string() + ": cannot open for writing");
+    neigh << mesh.tets.size() << " 4\n";
+    for (std::size_t t = 0; t < mesh.tets.size(); ++t) {
+        const auto& a = topology.neighbor[t];
+        neigh << t << ' ' << a[0] << ' ' << a[1] << ' ' << a[2] << ' ' << a[3] << '\n';
+    }
+    neigh << "# written by clvr\n";
+    if (!neigh)
+        throw InputError(neighPath.string() + ": write error");
 }
 
 void writeVtkUnstructured(const TetMesh& mesh, const fs::path& path, bool binary, const std::string& scalarName)

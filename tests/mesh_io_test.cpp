@@ -519,3 +519,47 @@ TEST(MeshIo, SceneSurfaceIsMeshedAtLoad)
     expectError([&] { clvr::loadMesh({{"surface", "l-block.poly"}, {"scalar", "head.nrrd"}}, dir); }, "head.nrrd");
     expectError([&] { clvr::loadMesh({{"surface", "nosuch.off"}}, dir); }, "nosuch.off");
 }
+
+TEST(MeshIo, TetgenNeighIsUsedWhenPresentAndChecked)
+{
+    TempDir dir;
+    // Written by writeTetgen (as `clvr mesh` does) and read back: the same adjacency as face matching.
+    {
+        clvr::MesherOptions options;
+        options.maxVolume = 0.05;
+        const TetMesh meshed = clvr::meshSurface(clvr::test::repoData("surfaces/l-block.poly"), options);
+        clvr::writeTetgen(meshed, dir / "l");
+        const TetMesh back = clvr::loadMesh({{"file", "l.ele"}}, dir.path());
+        ASSERT_EQ(back.neighbors.size(), back.tets.size());
+        TetMesh matched = back;
+        matched.neighbors.clear();
+        const clvr::TetTopology a = clvr::buildTopology(back), b = clvr::buildTopology(matched);
+        EXPECT_EQ(a.neighbor, b.neighbor);
+        ASSERT_EQ(a.boundary.size(), b.boundary.size());
+        for (std::size_t i = 0; i < a.boundary.size(); ++i)
+            EXPECT_TRUE(a.boundary[i].tet == b.boundary[i].tet && a.boundary[i].face == b.boundary[i].face) << i;
+    }
+    // 1-based, the second tetrahedron inverted (points 4 and 5 swapped): checkMesh reorients it and
+    // swaps its neighbors 2 and 3 with it.
+    writeFile(dir / "a.node", "5 3 1 0\n1 0 0 0 0\n2 1 0 0 1\n3 0 1 0 2\n4 0 0 1 3\n5 1 1 1 4\n");
+    writeFile(dir / "a.ele", "2 4 0\n1 1 2 3 4\n2 2 3 5 4\n");
+    writeFile(dir / "a.neigh", "2 4\n1 2 -1 -1 -1\n2 -1 -1 1 -1\n");
+    TetMesh m = clvr::loadMesh({{"file", "a.ele"}}, dir.path());
+    EXPECT_EQ(m.tetsReoriented, 1u);
+    ASSERT_EQ(m.neighbors.size(), 2u);
+    EXPECT_EQ(m.neighbors[1], (std::array<std::int32_t, 4>{-1, -1, -1, 0}));
+    const clvr::TetTopology topo = clvr::buildTopology(m);
+    EXPECT_EQ(topo.neighbor[0], (std::array<std::int32_t, 4>{1, -1, -1, -1}));
+    EXPECT_EQ(topo.boundary.size(), 6u);
+
+    // What a wrong .neigh gets: one line naming the file (reading) or the cell (checking).
+    auto topologyOf = [&](const std::string& neigh) {
+        writeFile(dir / "a.neigh", neigh);
+        clvr::buildTopology(clvr::loadMesh({{"file", "a.ele"}}, dir.path()));
+    };
+    expectError([&] { topologyOf("3 4\n1 2 -1 -1 -1\n2 -1 -1 1 -1\n"); }, "3 tetrahedra", "a.neigh");
+    expectError([&] { topologyOf("2 4\n1 2 -1 -1 -1\n"); }, "ends after 1 of 2", "a.neigh");
+    expectError([&] { topologyOf("2 4\n1 3 -1 -1 -1\n2 -1 -1 1 -1\n"); }, "neighbor 3 out of range", "a.neigh");
+    expectError([&] { topologyOf("2 4\n1 2 -1 -1 -1\n2 -1 -1 -1 -1\n"); }, "not symmetric", "tetrahedron 0, face 0");
+    expectError([&] { topologyOf("2 4\n1 -1 2 -1 -1\n2 -1 -1 1 -1\n"); }, "do not share that face", "tetrahedron 0, face 1");
+}
