@@ -362,6 +362,23 @@ TEST(Harc, IdenticalBitsTwice)
     EXPECT_EQ(std::memcmp(a.pixels().data(), b.pixels().data(), a.pixelCount() * sizeof(glm::vec4)), 0);
 }
 
+TEST(Harc, TransferFunctionChangeBetweenFramesEqualsAFreshRenderer)
+{
+    const TetMesh mesh = boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, 3}}, {0.5, 0.3, 0.2}, 0.1);
+    const TransferFunction other({{0.0, {1.0, 0.2, 0.2}, 4.0}, {0.5, {0.2, 1.0, 0.2}, 0.0}, {1.0, {0.2, 0.2, 1.0}, 8.0}});
+    const Scene scene = makeScene(perspective({1.7, 1.3, 2.4}), rampTf(), 40);
+    auto renderer = makeHarcRenderer(test::device(), scene, mesh, handTopology(mesh));
+    FrameStats stats;
+    renderer->render(stats);
+    const std::uint64_t resident = renderer->residentBytes();
+    renderer->setTransferFunction(other);
+    const Image4f edited = renderer->render(stats);
+    const Image4f fresh = renderHarc(makeScene(perspective({1.7, 1.3, 2.4}), other, 40), mesh);
+    EXPECT_EQ(std::memcmp(edited.pixels().data(), fresh.pixels().data(), edited.pixelCount() * sizeof(glm::vec4)), 0);
+    // 5 control points -> 3: the packed table shrinks by (8 - 4) + 8 * 2 floats; the mesh stays.
+    EXPECT_EQ(resident - renderer->residentBytes(), (4 + 16) * sizeof(float));
+}
+
 TEST(Harc, IndependentOfSplittingTheTransferFunction)
 {
     const TetMesh mesh = boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, 3}}, {0.5, 0.3, 0.2}, 0.1);

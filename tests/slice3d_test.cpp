@@ -621,6 +621,33 @@ TEST(Slice3dRenderer, RendersAreBitIdentical)
     }
 }
 
+// An edit of the transfer function between frames gives the image a new renderer gives, on both paths.
+// On the sphere field (1 - |p|): from a threshold at 0.5 to one at 0.2 (the shell between radius 0.5
+// and 0.8 was empty and is not now: stale empty-space flags would skip it), to one with no empty
+// brick and a different number of control points, and back.
+TEST(Slice3dRenderer, TransferFunctionChangeBetweenFramesEqualsAFreshRenderer)
+{
+    static const Volume sphere = generateVolume("sphere", {33, 33, 33});
+    const TransferFunction threshold({{0.0, {0, 0, 0}, 0.0}, {0.5, {0.3, 0.3, 1}, 0.0}, {1.0, {1, 1, 0.5}, 9.0}});
+    const TransferFunction lower({{0.0, {0, 0, 0}, 0.0}, {0.2, {0.3, 0.3, 1}, 0.0}, {1.0, {1, 1, 0.5}, 9.0}});
+    const TransferFunction dense = mlTransferFunction();
+    for (const char* path : {"fused", "raster"}) {
+        const json options = {{"slices", 48}, {"path", path}};
+        auto renderer = makeRenderer(test::device(), makeScene(perspectiveCamera(), threshold, 40, options), sphere);
+        FrameStats stats;
+        const Image4f first = renderer->render(stats);
+        for (const TransferFunction* tf : {&lower, &dense, &threshold}) {
+            renderer->setTransferFunction(*tf);
+            const Image4f edited = renderer->render(stats);
+            const Image4f fresh = renderScene(makeScene(perspectiveCamera(), *tf, 40, options), sphere);
+            EXPECT_EQ(std::memcmp(edited.pixels().data(), fresh.pixels().data(), edited.pixelCount() * sizeof(glm::vec4)), 0)
+                << path << ", " << tf->points().size() << " control points";
+            if (tf == &lower)  // the edit shows: the shell adds to the image
+                EXPECT_NE(std::memcmp(edited.pixels().data(), first.pixels().data(), edited.pixelCount() * sizeof(glm::vec4)), 0);
+        }
+    }
+}
+
 // A blob at world (-0.5, +0.5, 0) seen from +z with y up must land in the image's upper left
 // (row 0 is the top row), on both paths and both cameras.
 TEST(Slice3dRenderer, AsymmetricBlobLandsUpperLeft)

@@ -44,6 +44,7 @@ public:
     HarcRenderer(Device& device, const Scene& scene, const TetMesh& mesh, const TetTopology& topology);
     Image4f render(FrameStats& stats) override;
     std::uint64_t residentBytes() const override { return residentBytes_; }
+    void setTransferFunction(const TransferFunction& tf) override;
 
 private:
     Device& device_;
@@ -100,6 +101,17 @@ HarcRenderer::HarcRenderer(Device& device, const Scene& scene, const TetMesh& me
     out_ = device_.buffer("harc image", pixels * sizeof(cl_float4), CL_MEM_WRITE_ONLY);
     stats_ = device_.buffer("harc ray counts", pixels * 3 * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
     kernel_ = device_.kernel("harc.cl", "harc_render");
+}
+
+void HarcRenderer::setTransferFunction(const TransferFunction& tf)
+{
+    // Partial pre-integration needs no table that depends on the transfer function: only the packed
+    // control points change (the ψ table is the same for every transfer function).
+    const std::vector<float> packed = packTransferFunction(tf);
+    residentBytes_ -= static_cast<std::uint64_t>(((tfCount_ + 3) / 4 * 4 + 8 * tfCount_) * sizeof(float));
+    tfCount_ = static_cast<int>(tf.points().size());
+    tf_ = device_.upload("harc transfer function", packed);
+    residentBytes_ += packed.size() * sizeof(float);
 }
 
 Image4f HarcRenderer::render(FrameStats& stats)

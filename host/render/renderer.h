@@ -33,6 +33,10 @@ public:
     virtual Image4f render(FrameStats& stats) = 0;
     // Bytes resident on the device for the data (volume, tables), not counting the frame buffer.
     virtual std::uint64_t residentBytes() const = 0;
+    // Replaces the transfer function for the following frames (an interactive editor's edit). Only what
+    // depends on it is rebuilt — the packed control points, and tables derived from them — never the
+    // volume or the mesh on the device. The result is the same image a new renderer would give.
+    virtual void setTransferFunction(const TransferFunction& tf) = 0;
 };
 
 // The technique the scene names, set up on `device` for `volume`. Throws InputError for an

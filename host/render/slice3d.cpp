@@ -35,6 +35,7 @@ public:
     Slice3dRenderer(Device& device, const Scene& scene, const Volume& volume);
     Image4f render(FrameStats& stats) override;
     std::uint64_t residentBytes() const override { return residentBytes_; }
+    void setTransferFunction(const TransferFunction& tf) override;
 
 private:
     Image4f renderFused(FrameStats& stats);
@@ -53,6 +54,7 @@ private:
     std::uint64_t residentBytes_ = 0;
     // Empty-space skipping (fused path).
     glm::ivec3 brickDims_{0};
+    BrickGrid brickGrid_;  // min-max per brick, kept to classify the bricks again for a new transfer function
     cl::Buffer emptyBricks_;
     std::uint64_t emptyBrickCount_ = 0;
     double brickSetupMs_ = 0.0;
@@ -121,7 +123,8 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
         skipped_ = device_.buffer("slice3d skipped sample counts", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
         // The min-max grid (host) and one flag byte per brick for this transfer function (device).
         const auto t0 = std::chrono::steady_clock::now();
-        const BrickGrid grid = buildBrickGrid(volume);
+        brickGrid_ = buildBrickGrid(volume);
+        const BrickGrid& grid = brickGrid_;
         std::vector<cl_uchar> flags = emptyBricks(grid, scene.transferFunction);
         brickSetupMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         brickDims_ = grid.dims;
@@ -175,6 +178,27 @@ Image4f Slice3dRenderer::render(FrameStats& stats)
     stats.extra["resident_bytes"] = residentBytes_;
     stats.extra["voxel_type"] = voxelType_;
     return image;
+}
+
+void Slice3dRenderer::setTransferFunction(const TransferFunction& tf)
+{
+    const std::vector<float> packed = packTransferFunction(tf);
+    residentBytes_ -= static_cast<std::uint64_t>(((tfCount_ + 3) / 4 * 4 + 8 * tfCount_) * sizeof(float));
+    tfCount_ = static_cast<int>(tf.points().size());
+    tf_ = device_.upload("slice3d transfer function", packed);
+    residentBytes_ += packed.size() * sizeof(float);
+    if (options_.path == Slice3dOptions::Path::Fused) {
+        // Which bricks are empty depends on the transfer function: classify the kept min-max grid again.
+        const auto t0 = std::chrono::steady_clock::now();
+        const std::vector<cl_uchar> flags = emptyBricks(brickGrid_, tf);
+        const std::vector<cl_uchar> radii = emptySpaceRadii(brickGrid_.dims, flags);
+        brickSetupMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        emptyBrickCount_ = static_cast<std::uint64_t>(std::count(flags.begin(), flags.end(), cl_uchar(1)));
+        device_.queue().enqueueWriteBuffer(emptyBricks_, CL_TRUE, 0, radii.size(), radii.data());
+    } else {
+        fragmentProgram_.buffers[1] = tf_;
+        fragmentProgram_.uniforms[5].w = static_cast<float>(tfCount_);
+    }
 }
 
 Image4f Slice3dRenderer::renderFused(FrameStats& stats)
