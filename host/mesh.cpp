@@ -272,4 +272,17 @@ TetTopology buildTopology(const TetMesh& mesh)
     return topo;
 }
 
+std::array<glm::dvec3, 3> outwardFace(const TetMesh& mesh, std::uint32_t tet, std::uint32_t face)
+{
+    const glm::uvec4 c = mesh.tets[tet];
+    std::array<glm::dvec3, 3> p;
+    int n = 0;
+    for (std::uint32_t i = 0; i < 4; ++i)
+        if (i != face)
+            p[n++] = mesh.points[c[i]];
+    if (glm::dot(glm::cross(p[1] - p[0], p[2] - p[0]), mesh.points[c[face]] - p[0]) > 0.0)
+        std::swap(p[1], p[2]);  // the normal pointed at the opposite vertex: inward
+    return p;
+}
+
 }  // namespace clvr

@@ -58,4 +58,8 @@ struct TetTopology {
 };
 TetTopology buildTopology(const TetMesh& mesh);
 
+// The three points of face `face` of tetrahedron `tet` (the face opposite its vertex `face`), wound so
+// that (p1 - p0) x (p2 - p0) points out of the tetrahedron: counter-clockwise seen from outside.
+std::array<glm::dvec3, 3> outwardFace(const TetMesh& mesh, std::uint32_t tet, std::uint32_t face);
+
 }  // namespace clvr

@@ -7,6 +7,7 @@
 #include "host/render/slice3d.h"  // packTransferFunction: kernels/transfer_function.h's layout
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -269,15 +270,8 @@ HarcEntryLists buildHarcEntryLists(const TetMesh& mesh, const TetTopology& topol
     const double scale = camera.parallel ? camera.parallelScale : std::tan(glm::radians(camera.viewAngle) * 0.5);
     std::vector<Hit> hits;
     for (const TetTopology::BoundaryFace& bf : topology.boundary) {
-        const glm::uvec4 tv = mesh.tets[bf.tet];
-        glm::dvec3 p[3];
-        int n = 0;
-        for (int i = 0; i < 4; ++i)
-            if (i != static_cast<int>(bf.face))
-                p[n++] = mesh.points[tv[i]];
-        glm::dvec3 normal = glm::cross(p[1] - p[0], p[2] - p[0]);
-        if (glm::dot(normal, mesh.points[tv[bf.face]] - p[0]) > 0.0)
-            normal = -normal;  // outward: away from the opposite vertex
+        const std::array<glm::dvec3, 3> p = outwardFace(mesh, bf.tet, bf.face);
+        const glm::dvec3 normal = glm::cross(p[1] - p[0], p[2] - p[0]);
         // Pixel bounding box of the face (whole image if a corner is at or behind the eye plane).
         double x0 = 0.0, x1 = width - 1.0, y0 = 0.0, y1 = height - 1.0;
         bool clipped = false;

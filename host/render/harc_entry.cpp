@@ -38,22 +38,14 @@ HarcRasterEntries::HarcRasterEntries(Device& device, const TetMesh& mesh, const 
 {
     if (maxLayers_ < 1 || maxLayers_ > 255)
         throw InputError("options.max_layers: must be an integer in [1, 255], got " + std::to_string(maxLayers_));
-    // Outward-wound corners: the face's normal (b - a) x (c - a) points away from the opposite vertex,
-    // so a face seen from outside is counter-clockwise on screen and back-face culling keeps exactly the
-    // faces whose outward normal points towards the eye.
+    // Outward-wound corners (outwardFace): a face seen from outside is counter-clockwise on screen, so
+    // back-face culling keeps exactly the faces whose outward normal points towards the eye.
     corners_.reserve(3 * topology.boundary.size());
     codes_.reserve(topology.boundary.size());
     glm::dvec3 lo(INFINITY), hi(-INFINITY);
     for (const TetTopology::BoundaryFace& bf : topology.boundary) {
-        const glm::uvec4 tv = mesh.tets[bf.tet];
-        glm::dvec3 p[3];
-        int n = 0;
-        for (int i = 0; i < 4; ++i)
-            if (i != static_cast<int>(bf.face))
-                p[n++] = mesh.points[tv[i]] - shift;
-        if (glm::dot(glm::cross(p[1] - p[0], p[2] - p[0]), mesh.points[tv[bf.face]] - shift - p[0]) > 0.0)
-            std::swap(p[1], p[2]);
-        for (const glm::dvec3& q : p) {
+        for (const glm::dvec3& world : outwardFace(mesh, bf.tet, bf.face)) {
+            const glm::dvec3 q = world - shift;
             corners_.push_back(glm::vec3(q));
             lo = glm::min(lo, q);
             hi = glm::max(hi, q);
