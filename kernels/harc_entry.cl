@@ -1,7 +1,8 @@
 // kernels/harc_entry.cl — the fragment program of HARC's entry pass (host/render/harc_entry.h):
 // raster::draw appends it, with CLVR_HARC_ENTRY_FRAGMENT defined, after kernels/raster.cl. One draw
-// of the mesh's boundary faces per depth-peeling layer, back faces culled, depth test LESS: at each
-// pixel the nearest front face whose ray parameter λ lies beyond the previous layer's survives.
+// of the mesh's boundary faces per depth-peeling layer, no culling, depth test LESS: at each pixel the
+// nearest face that the ray enters through (decided here from the face's plane) whose ray parameter λ
+// lies beyond the previous layer's survives.
 #ifdef CLVR_HARC_ENTRY_FRAGMENT
 
 /* attr[0] = (position relative to the mesh origin, 0), perspective-correct; attr[1] = (code & 0xffff,
@@ -13,7 +14,7 @@
  * kernels/harc.cl's 80-byte layout.
  * λ is the parameter of harc_render's ray e + λ d through this pixel's center where it crosses the
  * face's plane, computed from the plane (b_face(e + λ d) = 0), so that it does not carry the raster
- * stage's subpixel snapping; the interpolated position is the fallback for a face seen edge-on.
+ * stage's subpixel snapping.
  * Output: (λ, code & 0xffff, code >> 16, 1), exact integers in float. */
 int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* color)
 {
@@ -39,11 +40,12 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
     else
         plane = (float4)(-(tet[0].xyz + tet[1].xyz + tet[2].xyz), 1.0f - (tet[0].w + tet[1].w + tet[2].w));
     const float hd = dot(plane.xyz, d);
-    float lambda;
-    if (hd > 0.0f)  /* entering: b_face grows from 0 along d */
-        lambda = -(dot(plane.xyz, e) + plane.w) / hd;
-    else
-        lambda = dot(f->attr[0].xyz - e, d);
+    /* Facing from the plane, not from the snapped screen-space winding: a boundary face seen nearly
+     * edge-on can change winding when its corners snap to the subpixel grid, and culling it would
+     * lose the ray's entry there (a grazing entry into the far tube of a torus, say). */
+    if (!(hd > 0.0f))  /* b_face does not grow along d: the ray leaves (or grazes) this cell here */
+        return 0;
+    const float lambda = -(dot(plane.xyz, e) + plane.w) / hd;
     const int p = (int)f->window.y * width + (int)f->window.x;
     const float previous = r->buffer[0][p];
     /* Peel: strictly beyond the last layer, by a relative margin far above float rounding of λ. */

@@ -3,21 +3,25 @@
 #include "host/render/harc.h"
 
 #include "host/errors.h"
+#include "host/parallel.h"
 #include "host/psi_table.h"
+#include "host/render/harc_entry.h"
 #include "host/render/slice3d.h"  // packTransferFunction: kernels/transfer_function.h's layout
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <mutex>
 #include <string>
 
 namespace clvr {
 namespace {
 
-constexpr const char* kKnownOptions = "integration, max_steps, early_termination";
+constexpr const char* kKnownOptions = "integration, max_steps, early_termination, entry, max_layers";
 
 [[noreturn]] void badOption(const std::string& key, const std::string& what)
 {
@@ -59,6 +63,7 @@ private:
     std::uint64_t maxSteps_ = 0;
     cl::Buffer tets_, tf_, psi_, out_, stats_;
     cl::Kernel kernel_;
+    std::unique_ptr<HarcRasterEntries> rasterEntries_;  // options_.entry == Raster
     std::uint64_t residentBytes_ = 0;
     std::uint64_t pointCount_ = 0, tetCount_ = 0, tetsRead_ = 0, tetsDegenerate_ = 0;
 };
@@ -102,6 +107,9 @@ HarcRenderer::HarcRenderer(Device& device, const Scene& scene, const TetMesh& me
     out_ = device_.buffer("harc image", pixels * sizeof(cl_float4), CL_MEM_WRITE_ONLY);
     stats_ = device_.buffer("harc ray counts", pixels * 3 * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
     kernel_ = device_.kernel("harc.cl", "harc_render");
+    if (options_.entry == HarcOptions::Entry::Raster)
+        rasterEntries_ = std::make_unique<HarcRasterEntries>(device_, mesh, topology, shift_, tets_, image_.width,
+                                                             image_.height, options_.maxLayers);
 }
 
 void HarcRenderer::setTransferFunction(const TransferFunction& tf)
@@ -118,8 +126,11 @@ void HarcRenderer::setTransferFunction(const TransferFunction& tf)
 Image4f HarcRenderer::render(FrameStats& stats)
 {
     const auto start = std::chrono::steady_clock::now();
-    // Entry points: the boundary front faces' crossings per pixel, sorted (host, every frame).
-    const HarcEntryLists lists = buildHarcEntryLists(mesh_, topology_, camera_, image_.width, image_.height);
+    // Entry points: the boundary front faces' crossings per pixel, sorted by depth, every frame.
+    HarcRasterEntryStats peel;
+    const HarcEntryLists lists = rasterEntries_
+                                     ? rasterEntries_->build(camera_, peel)
+                                     : buildHarcEntryLists(mesh_, topology_, camera_, image_.width, image_.height);
     const double entryMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     const cl::Buffer offsets = device_.upload("harc entry offsets", lists.offsets);
     std::vector<cl_int2> entries = lists.entries;
@@ -165,8 +176,16 @@ Image4f HarcRenderer::render(FrameStats& stats)
         bounded += counts[3 * p + 1];
         pieces += counts[3 * p + 2];
     }
-    stats.passes.push_back({"harc: entry lists (host)", entryMs});
-    for (PassTime& t : device_.takePassTimes())
+    std::vector<PassTime> deviceTimes = device_.takePassTimes();
+    if (rasterEntries_) {
+        // The peeling draws' own device passes are in deviceTimes; this is the whole entry stage,
+        // draws, read-backs and the host's compaction included.
+        stats.passes.push_back({"harc: entry lists (raster, all layers)", entryMs});
+        stats.passes.push_back({"harc: entry lists (raster) host compaction", peel.compactMs});
+    } else {
+        stats.passes.push_back({"harc: entry lists (host)", entryMs});
+    }
+    for (PassTime& t : deviceTimes)
         stats.passes.push_back(std::move(t));
     stats.frameMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     stats.extra["points"] = pointCount_;
@@ -185,6 +204,15 @@ Image4f HarcRenderer::render(FrameStats& stats)
     stats.extra["entry_crossings"] = lists.entries.size();
     stats.extra["integration"] = options_.integration == HarcOptions::Integration::Average ? "average" : "partial";
     stats.extra["early_termination"] = options_.earlyTermination;
+    stats.extra["entry"] = rasterEntries_ ? "raster" : "host";
+    stats.extra["entry_ms"] = entryMs;
+    if (rasterEntries_) {
+        stats.extra["entry_layers"] = peel.layers;
+        stats.extra["max_layers"] = options_.maxLayers;
+        stats.extra["rays_layer_bound"] = peel.pixelsAtBound;  // lists cut at max_layers
+        stats.extra["entry_triangles"] = peel.triangles;
+        stats.extra["entry_fragments"] = peel.fragments;
+    }
     return image;
 }
 
@@ -206,6 +234,18 @@ HarcOptions parseHarcOptions(const nlohmann::json& options)
                 o.integration = HarcOptions::Integration::Average;
             else
                 badOption(key, "must be \"partial\" or \"average\", got " + value.dump());
+        } else if (key == "entry") {
+            const std::string s = value.is_string() ? value.get<std::string>() : "";
+            if (s == "raster")
+                o.entry = HarcOptions::Entry::Raster;
+            else if (s == "host")
+                o.entry = HarcOptions::Entry::Host;
+            else
+                badOption(key, "must be \"raster\" or \"host\", got " + value.dump());
+        } else if (key == "max_layers") {
+            if (!value.is_number_integer() || value.get<long long>() < 1 || value.get<long long>() > 255)
+                badOption(key, "must be an integer in [1, 255], got " + value.dump());
+            o.maxLayers = value.get<int>();
         } else if (key == "max_steps") {
             if (!value.is_number_integer() || value.get<long long>() < 1 || value.get<long long>() > 0xffffffffll)
                 badOption(key, "must be an integer in [1, 4294967295], got " + value.dump());
@@ -268,66 +308,81 @@ HarcEntryLists buildHarcEntryLists(const TetMesh& mesh, const TetTopology& topol
     const glm::dvec3 f = camera.forward(), r = camera.right(), u = camera.up();
     const double aspect = static_cast<double>(width) / height;
     const double scale = camera.parallel ? camera.parallelScale : std::tan(glm::radians(camera.viewAngle) * 0.5);
+    // Boundary faces in chunks over the host's threads, each thread with its own hits; the per-pixel
+    // sort below (by λ, then face) makes the result independent of which thread found what.
+    constexpr std::size_t kChunk = 256;
+    const std::size_t faceCount = topology.boundary.size();
+    std::atomic<std::size_t> nextChunk{0};
+    std::mutex merge;
     std::vector<Hit> hits;
-    for (const TetTopology::BoundaryFace& bf : topology.boundary) {
-        const std::array<glm::dvec3, 3> p = outwardFace(mesh, bf.tet, bf.face);
-        const glm::dvec3 normal = glm::cross(p[1] - p[0], p[2] - p[0]);
-        // Pixel bounding box of the face (whole image if a corner is at or behind the eye plane).
-        double x0 = 0.0, x1 = width - 1.0, y0 = 0.0, y1 = height - 1.0;
-        bool clipped = false;
-        double minX = 1e300, maxX = -1e300, minY = 1e300, maxY = -1e300;
-        for (const glm::dvec3& q : p) {
-            const glm::dvec3 rel = q - camera.position;
-            double sx = glm::dot(rel, r), sy = glm::dot(rel, u);
-            if (!camera.parallel) {
-                const double z = glm::dot(rel, f);
-                if (!(z > 1e-12)) {
-                    clipped = true;
-                    break;
+    runOnThreads(0, static_cast<int>((faceCount + kChunk - 1) / kChunk), [&] {
+        std::vector<Hit> local;
+        for (std::size_t begin; (begin = nextChunk.fetch_add(kChunk)) < faceCount;) {
+            const std::size_t end = std::min(begin + kChunk, faceCount);
+            for (std::size_t i = begin; i < end; ++i) {
+                const TetTopology::BoundaryFace& bf = topology.boundary[i];
+                const std::array<glm::dvec3, 3> p = outwardFace(mesh, bf.tet, bf.face);
+                const glm::dvec3 normal = glm::cross(p[1] - p[0], p[2] - p[0]);
+                // Pixel bounding box of the face (whole image if a corner is at or behind the eye plane).
+                double x0 = 0.0, x1 = width - 1.0, y0 = 0.0, y1 = height - 1.0;
+                bool clipped = false;
+                double minX = 1e300, maxX = -1e300, minY = 1e300, maxY = -1e300;
+                for (const glm::dvec3& q : p) {
+                    const glm::dvec3 rel = q - camera.position;
+                    double sx = glm::dot(rel, r), sy = glm::dot(rel, u);
+                    if (!camera.parallel) {
+                        const double z = glm::dot(rel, f);
+                        if (!(z > 1e-12)) {
+                            clipped = true;
+                            break;
+                        }
+                        sx /= z;
+                        sy /= z;
+                    }
+                    const double px = (sx / (scale * aspect) + 1.0) * 0.5 * width - 0.5;
+                    const double py = (1.0 - sy / scale) * 0.5 * height - 0.5;
+                    minX = std::min(minX, px);
+                    maxX = std::max(maxX, px);
+                    minY = std::min(minY, py);
+                    maxY = std::max(maxY, py);
                 }
-                sx /= z;
-                sy /= z;
+                if (!clipped) {
+                    x0 = std::max(x0, std::floor(minX) - 1.0);
+                    x1 = std::min(x1, std::ceil(maxX) + 1.0);
+                    y0 = std::max(y0, std::floor(minY) - 1.0);
+                    y1 = std::min(y1, std::ceil(maxY) + 1.0);
+                }
+                const glm::dvec3 e1 = p[1] - p[0], e2 = p[2] - p[0];
+                for (int y = static_cast<int>(y0); y <= static_cast<int>(y1); ++y)
+                    for (int x = static_cast<int>(x0); x <= static_cast<int>(x1); ++x) {
+                        const Ray ray = camera.ray(x, y, width, height);
+                        if (!(glm::dot(normal, ray.direction) < 0.0))
+                            continue;  // back face (or edge-on) for this ray
+                        // Möller–Trumbore, edges included with a small margin so that no ray slips between
+                        // two faces that share an edge (a duplicate is skipped by the walk).
+                        const glm::dvec3 pv = glm::cross(ray.direction, e2);
+                        const double det = glm::dot(e1, pv);
+                        if (det == 0.0)
+                            continue;
+                        const double inv = 1.0 / det;
+                        const glm::dvec3 tv0 = ray.origin - p[0];
+                        const double bu = glm::dot(tv0, pv) * inv;
+                        const glm::dvec3 qv = glm::cross(tv0, e1);
+                        const double bv = glm::dot(ray.direction, qv) * inv;
+                        constexpr double kMargin = 1e-7;
+                        if (bu < -kMargin || bv < -kMargin || bu + bv > 1.0 + kMargin)
+                            continue;
+                        const double lambda = glm::dot(e2, qv) * inv;
+                        if (!(lambda >= 0.0))
+                            continue;
+                        local.push_back({static_cast<std::uint32_t>(y * width + x), static_cast<float>(lambda),
+                                         static_cast<std::int32_t>(bf.tet * 4 + bf.face)});
+                    }
             }
-            const double px = (sx / (scale * aspect) + 1.0) * 0.5 * width - 0.5;
-            const double py = (1.0 - sy / scale) * 0.5 * height - 0.5;
-            minX = std::min(minX, px);
-            maxX = std::max(maxX, px);
-            minY = std::min(minY, py);
-            maxY = std::max(maxY, py);
         }
-        if (!clipped) {
-            x0 = std::max(x0, std::floor(minX) - 1.0);
-            x1 = std::min(x1, std::ceil(maxX) + 1.0);
-            y0 = std::max(y0, std::floor(minY) - 1.0);
-            y1 = std::min(y1, std::ceil(maxY) + 1.0);
-        }
-        const glm::dvec3 e1 = p[1] - p[0], e2 = p[2] - p[0];
-        for (int y = static_cast<int>(y0); y <= static_cast<int>(y1); ++y)
-            for (int x = static_cast<int>(x0); x <= static_cast<int>(x1); ++x) {
-                const Ray ray = camera.ray(x, y, width, height);
-                if (!(glm::dot(normal, ray.direction) < 0.0))
-                    continue;  // back face (or edge-on) for this ray
-                // Möller–Trumbore, edges included with a small margin so that no ray slips between
-                // two faces that share an edge (a duplicate is skipped by the walk).
-                const glm::dvec3 pv = glm::cross(ray.direction, e2);
-                const double det = glm::dot(e1, pv);
-                if (det == 0.0)
-                    continue;
-                const double inv = 1.0 / det;
-                const glm::dvec3 tv0 = ray.origin - p[0];
-                const double bu = glm::dot(tv0, pv) * inv;
-                const glm::dvec3 qv = glm::cross(tv0, e1);
-                const double bv = glm::dot(ray.direction, qv) * inv;
-                constexpr double kMargin = 1e-7;
-                if (bu < -kMargin || bv < -kMargin || bu + bv > 1.0 + kMargin)
-                    continue;
-                const double lambda = glm::dot(e2, qv) * inv;
-                if (!(lambda >= 0.0))
-                    continue;
-                hits.push_back({static_cast<std::uint32_t>(y * width + x), static_cast<float>(lambda),
-                                 static_cast<std::int32_t>(bf.tet * 4 + bf.face)});
-            }
-    }
+        const std::lock_guard<std::mutex> lock(merge);
+        hits.insert(hits.end(), local.begin(), local.end());
+    });
     HarcEntryLists lists;
     const std::size_t pixels = static_cast<std::size_t>(width) * height;
     lists.offsets.assign(pixels + 1, 0);

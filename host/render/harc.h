@@ -24,10 +24,16 @@ struct HarcOptions {
     Integration integration = Integration::Partial;
     std::uint64_t maxSteps = 0;     // per ray; 0 = the default, 4 * cbrt(tets) + 10000
     double earlyTermination = 1.0;  // stop once A >= this; 1.0 = off (the paper's benchmarks)
+    // Where the per-pixel entry lists come from: the raster stage (depth peeling of the boundary front
+    // faces, host/render/harc_entry.h, as seeds/001 §3-4) or exact ray/face intersection on the host.
+    enum class Entry { Raster, Host };
+    Entry entry = Entry::Host;
+    int maxLayers = 64;  // raster entry: peeling layers per frame (1..255); rays past them are counted
 };
 
 // Reads the scene's "options" for harc: "integration" ("partial" | "average"), "max_steps" (integer
-// >= 1), "early_termination" (opacity in (0, 1]). InputError naming the key for unknown keys, wrong
+// >= 1), "early_termination" (opacity in (0, 1]), "entry" ("raster" | "host"), "max_layers" (integer
+// in [1, 255]). InputError naming the key for unknown keys, wrong
 // types and values out of range.
 HarcOptions parseHarcOptions(const nlohmann::json& options);
 

@@ -38,8 +38,8 @@ HarcRasterEntries::HarcRasterEntries(Device& device, const TetMesh& mesh, const 
 {
     if (maxLayers_ < 1 || maxLayers_ > 255)
         throw InputError("options.max_layers: must be an integer in [1, 255], got " + std::to_string(maxLayers_));
-    // Outward-wound corners (outwardFace): a face seen from outside is counter-clockwise on screen, so
-    // back-face culling keeps exactly the faces whose outward normal points towards the eye.
+    // Outward-wound corners (outwardFace). Facing is decided per fragment from the face's plane, not by
+    // culling: snapping can flip the screen winding of a face seen nearly edge-on.
     corners_.reserve(3 * topology.boundary.size());
     codes_.reserve(topology.boundary.size());
     glm::dvec3 lo(INFINITY), hi(-INFINITY);
@@ -104,7 +104,7 @@ HarcEntryLists HarcRasterEntries::build(const Camera& worldCamera, HarcRasterEnt
     raster::DrawState state;
     state.fragment.depth.test = true;
     state.fragment.depth.func = raster::CompareFunc::Less;
-    state.fragment.cull = raster::CullFace::Back;
+    state.fragment.cull = raster::CullFace::None;  // the fragment program decides facing (kernels/harc_entry.cl)
 
     std::vector<float> previous(pixels, kNoLayerYet);
     std::vector<std::uint8_t> count(pixels, 0);
@@ -145,6 +145,7 @@ HarcEntryLists HarcRasterEntries::build(const Camera& worldCamera, HarcRasterEnt
         stats.layers = layer + 1;
         if (layer + 1 >= maxLayers_) {
             stats.layerBound = true;
+            stats.pixelsAtBound = added;
             break;
         }
         device_.queue().enqueueWriteBuffer(previous_, CL_TRUE, 0, pixels * sizeof(float), previous.data());

@@ -1,7 +1,7 @@
 // host/render/harc_entry.h — HARC's entry points through the raster stage, as seeds/001 starts its
 // rays: "the propagation of the ray is started by rasterizing the front faces on the mesh's boundary"
 // (§3), and for non-convex meshes the further entries by depth peeling (§4, Everitt 2001). Each
-// layer is one raster::draw of the boundary faces, back faces culled, depth test LESS, with a
+// layer is one raster::draw of the boundary faces, no culling (the fragment program keeps the faces the ray enters through, by their plane), depth test LESS, with a
 // fragment program (kernels/harc_entry.cl) that writes the face and its ray parameter λ and discards
 // fragments at or before the previous layer's λ at that pixel. The layers, in order, are the per-pixel
 // sorted lists that kernels/harc.cl walks (HarcEntryLists, compacted on the host).
@@ -25,6 +25,7 @@ namespace clvr {
 struct HarcRasterEntryStats {
     int layers = 0;                  // draws that added at least one entry
     bool layerBound = false;         // stopped at maxLayers with entries still coming
+    std::uint64_t pixelsAtBound = 0; // pixels whose list was cut at maxLayers (their rays may miss cells)
     std::uint64_t triangles = 0;     // rasterized (after culling), all layers
     std::uint64_t fragments = 0;     // covered pixels before the tests, all layers
     double rasterMs = 0.0;           // raster::draw calls, wall clock
