@@ -12,7 +12,8 @@
  *          0 on face i (the face opposite vertex i). The fourth is recomputed, Σ b_i = 1:
  *          h_3 = -(h_0 + h_1 + h_2), k_3 = 1 - (k_0 + k_1 + k_2).
  *   [3]    gradient g and scalar term g0 of Eq. 6: s(x) = dot(g, x) + g0.
- *   [4]    adjacency a_0..a_3 (as_int4), -1 on the boundary.
+ *   [4]    adjacency a_0..a_3 (as_int4): across face i, neighbor * 4 + the neighbor's face that is
+ *          face i (the next cell's entry face, with no second load), or -1 on the boundary.
  * Face i is left along d where dot(h_i, d) < 0, at λ_i = λ + b_i(p) / -dot(h_i, d). */
 #define HARC_TET_FLOAT4S 5
 
@@ -222,10 +223,8 @@ kernel void harc_render(global float4* out, global uint* stats, const int width,
                 lambda_done = lambda_exit;
                 break;
             }
-            /* The entry face of the next cell is the one whose neighbor is this cell. */
-            const int4 next_adj = as_int4(tets[(size_t)next * HARC_TET_FLOAT4S + 4]);
-            entry_face = next_adj.x == t ? 0 : (next_adj.y == t ? 1 : (next_adj.z == t ? 2 : (next_adj.w == t ? 3 : -1)));
-            t = next;
+            t = next >> 2;
+            entry_face = next & 3;
         }
         if (k >= end)
             break;

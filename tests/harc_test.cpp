@@ -249,6 +249,39 @@ TEST(HarcLayout, PlanesAndGradientReproduceTheTet)
         EXPECT_EQ(adj[i], -1);
 }
 
+// The adjacency word across face i is neighbor * 4 + the neighbor's face that is the same triangle.
+TEST(HarcLayout, AdjacencyNamesTheNeighborsEntryFace)
+{
+    const TetMesh mesh = boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, 2}}, {0.5, 0.3, 0.2}, 0.1);
+    const TetTopology topology = handTopology(mesh);
+    const std::vector<cl_float4> packed = packHarcTets(mesh, topology, glm::dvec3(0.5));
+    std::size_t inner = 0;
+    for (std::size_t t = 0; t < mesh.tets.size(); ++t) {
+        cl_int adj[4];
+        std::memcpy(adj, &packed[5 * t + 4], sizeof adj);
+        for (int i = 0; i < 4; ++i) {
+            if (topology.neighbor[t][i] < 0) {
+                EXPECT_EQ(adj[i], -1);
+                continue;
+            }
+            ++inner;
+            const int n = adj[i] >> 2, j = adj[i] & 3;
+            ASSERT_EQ(n, topology.neighbor[t][i]);
+            std::array<std::uint32_t, 3> mine{}, theirs{};
+            for (int k = 0, a = 0, b = 0; k < 4; ++k) {
+                if (k != i)
+                    mine[a++] = mesh.tets[t][k];
+                if (k != j)
+                    theirs[b++] = mesh.tets[n][k];
+            }
+            std::sort(mine.begin(), mine.end());
+            std::sort(theirs.begin(), theirs.end());
+            EXPECT_EQ(mine, theirs) << "tet " << t << " face " << i;
+        }
+    }
+    EXPECT_GT(inner, mesh.tets.size());  // the grid has inner faces
+}
+
 TEST(Harc, SingleTetConstantMatchesClosedForm)
 {
     TetMesh mesh;

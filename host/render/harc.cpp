@@ -289,9 +289,17 @@ std::vector<cl_float4> packHarcTets(const TetMesh& mesh, const TetTopology& topo
         for (int i = 0; i < 3; ++i)
             o[i] = toCl4(h[i], k[i]);
         o[3] = toCl4(g, g0);
+        // Across face i: the neighbor n and the face of n that is this face, as n * 4 + face (the walk
+        // needs both and this saves it a second, dependent load per step), or -1 on the boundary.
         cl_int adj[4];
-        for (int i = 0; i < 4; ++i)
-            adj[i] = topology.neighbor[t][i];
+        for (int i = 0; i < 4; ++i) {
+            const std::int32_t n = topology.neighbor[t][i];
+            adj[i] = -1;
+            if (n >= 0)
+                for (int j = 0; j < 4; ++j)
+                    if (topology.neighbor[n][j] == static_cast<std::int32_t>(t))
+                        adj[i] = n * 4 + j;
+        }
         std::memcpy(&o[4], adj, sizeof adj);
     }
     return out;
