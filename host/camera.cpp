@@ -38,17 +38,27 @@ glm::dvec3 Camera::up() const { return glm::cross(right(), forward()); }
 
 Ray Camera::ray(double px, double py, int width, int height) const
 {
-    const double aspect = static_cast<double>(width) / height;
+    return PixelRays(*this, width, height).at(px, py);
+}
+
+PixelRays::PixelRays(const Camera& camera, int width, int height)
+    : position_(camera.position), forward_(camera.forward()), right_(camera.right()), up_(camera.up()),
+      width_(width), height_(height), aspect_(static_cast<double>(width) / height),
+      scale_(camera.parallel ? camera.parallelScale : std::tan(glm::radians(camera.viewAngle) * 0.5)),
+      parallel_(camera.parallel)
+{
+}
+
+Ray PixelRays::at(double px, double py) const
+{
     // Normalized device coordinates of the pixel center, y up.
-    const double ndcX = (px + 0.5) / width * 2.0 - 1.0;
-    const double ndcY = 1.0 - (py + 0.5) / height * 2.0;
-    const glm::dvec3 f = forward(), r = right(), u = up();
-    if (parallel) {
-        const glm::dvec3 origin = position + (ndcX * parallelScale * aspect) * r + (ndcY * parallelScale) * u;
-        return {origin, f};
+    const double ndcX = (px + 0.5) / width_ * 2.0 - 1.0;
+    const double ndcY = 1.0 - (py + 0.5) / height_ * 2.0;
+    if (parallel_) {
+        const glm::dvec3 origin = position_ + (ndcX * scale_ * aspect_) * right_ + (ndcY * scale_) * up_;
+        return {origin, forward_};
     }
-    const double t = std::tan(glm::radians(viewAngle) * 0.5);
-    return {position, glm::normalize(f + (ndcX * t * aspect) * r + (ndcY * t) * u)};
+    return {position_, glm::normalize(forward_ + (ndcX * scale_ * aspect_) * right_ + (ndcY * scale_) * up_)};
 }
 
 glm::dmat4 Camera::viewMatrix() const

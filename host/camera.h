@@ -30,11 +30,25 @@ struct Camera {
     glm::dvec3 up() const;
 
     // The ray through the center of pixel (px, py) of a width x height image (row 0 at the top).
+    // PixelRays gives the same rays without recomputing the basis per pixel.
     Ray ray(double px, double py, int width, int height) const;
 
     // OpenGL-style matrices for the raster stage: world -> eye, eye -> clip (near/far > 0 in eye units).
     glm::dmat4 viewMatrix() const;
     glm::dmat4 projectionMatrix(int width, int height, double near, double far) const;
+};
+
+// The rays of one camera and image size, with the basis (forward, right, up, tan of the half angle)
+// computed once: at(px, py) is bit-for-bit Camera::ray(px, py, width, height), which is defined by it.
+class PixelRays {
+public:
+    PixelRays(const Camera& camera, int width, int height);
+    Ray at(double px, double py) const;
+
+private:
+    glm::dvec3 position_, forward_, right_, up_;
+    double width_, height_, aspect_, scale_;  // scale: tan(view_angle / 2), or parallel_scale
+    bool parallel_;
 };
 
 }  // namespace clvr

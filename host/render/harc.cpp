@@ -314,6 +314,7 @@ HarcEntryLists buildHarcEntryLists(const TetMesh& mesh, const TetTopology& topol
         std::int32_t code;
     };
     const glm::dvec3 f = camera.forward(), r = camera.right(), u = camera.up();
+    const PixelRays rays(camera, width, height);
     const double aspect = static_cast<double>(width) / height;
     const double scale = camera.parallel ? camera.parallelScale : std::tan(glm::radians(camera.viewAngle) * 0.5);
     // Boundary faces in chunks over the host's threads, each thread with its own hits; the per-pixel
@@ -363,7 +364,7 @@ HarcEntryLists buildHarcEntryLists(const TetMesh& mesh, const TetTopology& topol
                 const glm::dvec3 e1 = p[1] - p[0], e2 = p[2] - p[0];
                 for (int y = static_cast<int>(y0); y <= static_cast<int>(y1); ++y)
                     for (int x = static_cast<int>(x0); x <= static_cast<int>(x1); ++x) {
-                        const Ray ray = camera.ray(x, y, width, height);
+                        const Ray ray = rays.at(x, y);
                         if (!(glm::dot(normal, ray.direction) < 0.0))
                             continue;  // back face (or edge-on) for this ray
                         // Möller–Trumbore, edges included with a small margin so that no ray slips between
