@@ -575,14 +575,14 @@ void checkMeshAgainstReference(const MeshCase& c, bool parallel)
 MeshCase bluntfinCase()
 {
     return {"bluntfin",
-                     {{"file", test::sharedData("bluntfin/bluntfinxyz.bin")},
-                      {"q_file", test::sharedData("bluntfin/bluntfinq.bin")},
-                      {"scalar", "density"}},
-                     TransferFunction({{0.2, {0.0, 0.0, 0.3}, 0.0},
-                                       {0.8, {0.1, 0.3, 1.0}, 0.1},
-                                       {1.5, {0.2, 1.0, 0.3}, 0.4},
-                                       {2.5, {1.0, 0.8, 0.1}, 0.8},
-                                       {4.0, {1.0, 0.2, 0.1}, 1.5}})};
+            {{"file", test::sharedData("bluntfin/bluntfinxyz.bin")},
+             {"q_file", test::sharedData("bluntfin/bluntfinq.bin")},
+             {"scalar", "density"}},
+            TransferFunction({{0.2, {0.0, 0.0, 0.3}, 0.0},
+                              {0.8, {0.1, 0.3, 1.0}, 0.1},
+                              {1.5, {0.2, 1.0, 0.3}, 0.4},
+                              {2.5, {1.0, 0.8, 0.1}, 0.8},
+                              {4.0, {1.0, 0.2, 0.1}, 1.5}})};
 }
 
 TEST(HarcMeshes, BluntfinMatchesExactReference)
@@ -598,12 +598,12 @@ MeshCase postCase()
     const glm::dvec2 range = probe.scalarRange();
     auto at = [&](double f) { return range.x + f * (range.y - range.x); };
     const double size = glm::length(probe.boundsMax() - probe.boundsMin());
-    const MeshCase c{"post",
-                     {{"file", test::sharedData("post/post.vtk")}},
-                     TransferFunction({{at(0.0), {0.1, 0.1, 0.5}, 0.0},
-                                       {at(0.3), {0.2, 0.6, 1.0}, 1.0 / size},
-                                       {at(0.6), {0.9, 0.9, 0.2}, 3.0 / size},
-                                       {at(1.0), {1.0, 0.3, 0.1}, 8.0 / size}})};
+    return {"post",
+            {{"file", test::sharedData("post/post.vtk")}},
+            TransferFunction({{at(0.0), {0.1, 0.1, 0.5}, 0.0},
+                              {at(0.3), {0.2, 0.6, 1.0}, 1.0 / size},
+                              {at(0.6), {0.9, 0.9, 0.2}, 3.0 / size},
+                              {at(1.0), {1.0, 0.3, 0.1}, 8.0 / size}})};
 }
 
 TEST(HarcMeshes, PostMatchesExactReference)
@@ -658,10 +658,13 @@ TEST(HarcMeshes, FullBluntfinErrorsAsFigure8)
     for (const bool parallel : {false, true}) {
         auto e = integrationErrors(bluntfinCase(), parallel);
         const char* what = parallel ? "parallel" : "perspective";
-        // Measured (perspective / parallel): full 64x64x64 max ... / ..., mean ... / ...
-        EXPECT_LT(e["full 64x64x64"].maxAbs, 0.0) << what;
-        EXPECT_LT(e["full 64x64x64"].meanAbs, 0.0) << what;
-        // A finer table in s is closer; partial beats full beats the average (Figure 8's ordering).
+        // Measured (perspective / parallel), the worst channel: full 64x64x64 max 9.7e-3 / 1.02e-2, mean
+        // 3.5e-4 / 3.8e-4; 16x16x64 max 2.9e-2 / 2.7e-2, mean 6.3e-3 / 6.9e-3; partial max 8.7e-6 / 6.8e-6;
+        // average max 2.3e-2 / 1.6e-2 but mean 1.3e-4 / 9.6e-5 (lower than full's: most of bluntfin's
+        // cells are small, where the average is good and full's s and l spacing is not). docs/harc.md.
+        EXPECT_LT(e["full 64x64x64"].maxAbs, 1.2e-2) << what;
+        EXPECT_LT(e["full 64x64x64"].meanAbs, 4.5e-4) << what;
+        // A finer table in s is closer; in max error partial beats full beats the average (Figure 8).
         EXPECT_LT(e["full 64x64x64"].maxAbs, e["full 16x16x64"].maxAbs) << what;
         EXPECT_LT(e["full 64x64x64"].meanAbs, e["full 16x16x64"].meanAbs) << what;
         EXPECT_LT(e["partial"].maxAbs, e["full 64x64x64"].maxAbs) << what;
@@ -674,11 +677,14 @@ TEST(HarcMeshes, FullPostErrors)
     for (const bool parallel : {false, true}) {
         auto e = integrationErrors(postCase(), parallel);
         const char* what = parallel ? "parallel" : "perspective";
-        // Measured (perspective / parallel): full 64x64x64 max ... / ..., mean ... / ...
-        EXPECT_LT(e["full 64x64x64"].maxAbs, 0.0) << what;
-        EXPECT_LT(e["full 64x64x64"].meanAbs, 0.0) << what;
+        // Measured (perspective / parallel), the worst channel: full 64x64x64 max 3.84e-4 / 3.87e-4, mean
+        // 3.3e-5 / 3.4e-5; 16x16x64 max 5.0e-3 / 5.3e-3; partial max 1.9e-6 / 1.3e-6; average max 6.3e-3.
+        EXPECT_LT(e["full 64x64x64"].maxAbs, 4.5e-4) << what;
+        EXPECT_LT(e["full 64x64x64"].meanAbs, 4e-5) << what;
         EXPECT_LT(e["full 64x64x64"].maxAbs, e["full 16x16x64"].maxAbs) << what;
+        EXPECT_LT(e["full 64x64x64"].meanAbs, e["full 16x16x64"].meanAbs) << what;
         EXPECT_LT(e["partial"].maxAbs, e["full 64x64x64"].maxAbs) << what;
+        EXPECT_LT(e["full 64x64x64"].maxAbs, e["average"].maxAbs) << what;
     }
 }
 
