@@ -166,7 +166,8 @@ float4 harc_full_lookup(global const float4* table, const int ns, const int nl, 
  * forward, right, up (orthonormal, relative to the mesh's shifted origin); params: x = tan(view_angle
  * / 2) or parallel_scale, y = aspect, z = 1 for a parallel camera. Ray e + λ d, |d| = 1, as
  * host/camera.cpp's Camera::ray. stats[p] = (steps, 1 if the step bound stopped the ray, pieces).
- * Out: (I + T background, 1 - T). */
+ * integration: HARC_INTEGRATION_*; full_table, full_ns, full_nl, full_params: harc_full_lookup's table
+ * (a one-element dummy unless integration is full). Out: (I + T background, 1 - T). */
 kernel void harc_render(global float4* out, global uint* stats, const int width, const int height,
                         global const float4* tets, global const uint* offsets, global const int2* entries,
                         global const float* tf, const int tf_count, global const float* psi, const int psi_n,

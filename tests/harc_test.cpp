@@ -419,7 +419,8 @@ TEST(Harc, FullTransferFunctionChangeRebuildsTheTableAndEqualsAFreshRenderer)
 {
     const TetMesh mesh = boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, 3}}, {0.5, 0.3, 0.2}, 0.1);
     // A different s range than rampTf ([-0.5, 1.5] vs [0, 1]): the rebuilt table's range moves too.
-    const TransferFunction other({{-0.5, {1.0, 0.2, 0.2}, 4.0}, {0.5, {0.2, 1.0, 0.2}, 0.0}, {1.5, {0.2, 0.2, 1.0}, 8.0}});
+    const TransferFunction other(
+        {{-0.5, {1.0, 0.2, 0.2}, 4.0}, {0.5, {0.2, 1.0, 0.2}, 0.0}, {1.5, {0.2, 0.2, 1.0}, 8.0}});
     const json full{{"integration", "full"}, {"full_table", {24, 16}}};
     const Scene scene = makeScene(perspective({1.7, 1.3, 2.4}), rampTf(), 40, full);
     auto renderer = makeHarcRenderer(test::device(), scene, mesh, handTopology(mesh));

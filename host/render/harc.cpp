@@ -286,7 +286,8 @@ HarcOptions parseHarcOptions(const nlohmann::json& options)
             const std::uint64_t bytes = std::uint64_t(o.fullScalarSamples) * o.fullScalarSamples *
                                         o.fullLengthSamples * sizeof(cl_float4);
             if (bytes > kMaxFullTableBytes)
-                badOption(key, value.dump() + " is a table of " + std::to_string(bytes >> 20) + " MiB (NS x NS x NL x 16 bytes); at most " +
+                badOption(key, value.dump() + " is a table of " + std::to_string(bytes >> 20) +
+                                   " MiB (NS x NS x NL x 16 bytes); at most " +
                                    std::to_string(kMaxFullTableBytes >> 20) + " MiB");
         } else if (key == "max_steps") {
             if (!value.is_number_integer() || value.get<long long>() < 1 || value.get<long long>() > 0xffffffffll)

@@ -3,8 +3,9 @@
 // per pixel walks the mesh through the cell adjacency from the first boundary front face its ray
 // crosses; each cell's segment is split at the transfer function's control points and each piece is
 // integrated by Eq. 2–4 (ψ from host/psi_table.h); or, with "integration": "full" (HARC-Full), each
-// whole segment is looked up in a 3D pre-integration table (host/preintegration_table.h). Non-convex meshes: a per-pixel list of boundary
-// front-face crossings sorted by depth, so a ray that leaves the mesh re-enters at the next one.
+// whole segment is looked up in a 3D pre-integration table (host/preintegration_table.h). Non-convex
+// meshes: a per-pixel list of boundary front-face crossings sorted by depth, so a ray that leaves the
+// mesh re-enters at the next one.
 // docs/harc.md.
 #pragma once
 
