@@ -2,7 +2,9 @@
 // (§3–4 and Figure 6 of seeds/001_cd12fd6b76f9cf96.txt). One work-item per pixel walks its ray from
 // tetrahedron to tetrahedron through the adjacency, splits each tetrahedron's segment at the transfer
 // function's control points, integrates each piece by Eq. 2 with ζ (Eq. 3) and ψ (Eq. 4, 2D table),
-// and composites front to back. Entry points come from a per-pixel list of boundary-face crossings
+// and composites front to back; or, with full pre-integration (HARC-Full, Figure 8), looks each whole
+// segment up in a 3D table over (s_f, s_b, l) built for the transfer function (host/preintegration_table.h).
+// Entry points come from a per-pixel list of boundary-face crossings
 // sorted by depth (host/render/harc.cpp); after the ray leaves the mesh it re-enters at the next one.
 // The host has validated everything; this file only does arithmetic.
 #include "clvr_common.h"
@@ -19,6 +21,7 @@
 
 #define HARC_INTEGRATION_PARTIAL 0
 #define HARC_INTEGRATION_AVERAGE 1
+#define HARC_INTEGRATION_FULL 2
 
 /* ψ of Eq. 4 from the γ-table of host/psi_table.h (bilinear; same arithmetic as PsiTable::lookup). */
 float harc_psi(global const float* psi, const int n, float tau_l_front, float tau_l_back)
@@ -133,18 +136,46 @@ void harc_segment_average(global const float* tf, const int n, const float s_f, 
     *transmittance *= zeta;
 }
 
+/* Full pre-integration: trilinear lookup of the segment (s_f -> s_b over length l) in the table of
+ * host/preintegration_table.h, table[(k * ns + j) * ns + i] = (premultiplied rgb, α) at s_f sample i,
+ * s_b sample j, l sample k. params = (s of sample 0, samples per unit s, samples per unit l); s is
+ * clamped to the sampled range and l to l_max (no segment is longer than the longest tet edge). Manual
+ * interpolation on a plain buffer, so that it runs where 3D images of float4 are missing or small; the
+ * same float arithmetic as PreintegrationTable::lookup. */
+float4 harc_full_lookup(global const float4* table, const int ns, const int nl, const float4 params,
+                        const float s_f, const float s_b, const float l)
+{
+    const float ns1 = (float)(ns - 1), nl1 = (float)(nl - 1);
+    const float x = clamp((s_f - params.x) * params.y, 0.0f, ns1);
+    const float y = clamp((s_b - params.x) * params.y, 0.0f, ns1);
+    const float z = clamp(l * params.z, 0.0f, nl1);
+    const int i = min((int)x, ns - 2), j = min((int)y, ns - 2), k = min((int)z, nl - 2);
+    const float fx = x - (float)i, fy = y - (float)j, fz = z - (float)k;
+    global const float4* c = table + ((size_t)k * ns + j) * ns + i;
+    const size_t dj = (size_t)ns, dk = (size_t)ns * ns;
+    const float4 c00 = c[0] + fx * (c[1] - c[0]);
+    const float4 c10 = c[dj] + fx * (c[dj + 1] - c[dj]);
+    const float4 c01 = c[dk] + fx * (c[dk + 1] - c[dk]);
+    const float4 c11 = c[dk + dj] + fx * (c[dk + dj + 1] - c[dk + dj]);
+    const float4 c0 = c00 + fy * (c10 - c00);
+    const float4 c1 = c01 + fy * (c11 - c01);
+    return c0 + fz * (c1 - c0);
+}
+
 /* One work-item per pixel. entries[offsets[p] .. offsets[p+1]) are the boundary front-face crossings
  * of pixel p's ray, sorted by ray parameter: (λ as float bits, tet * 4 + face). Camera: position,
  * forward, right, up (orthonormal, relative to the mesh's shifted origin); params: x = tan(view_angle
  * / 2) or parallel_scale, y = aspect, z = 1 for a parallel camera. Ray e + λ d, |d| = 1, as
  * host/camera.cpp's Camera::ray. stats[p] = (steps, 1 if the step bound stopped the ray, pieces).
- * Out: (I + T background, 1 - T). */
+ * integration: HARC_INTEGRATION_*; full_table, full_ns, full_nl, full_params: harc_full_lookup's table
+ * (a one-element dummy unless integration is full). Out: (I + T background, 1 - T). */
 kernel void harc_render(global float4* out, global uint* stats, const int width, const int height,
                         global const float4* tets, global const uint* offsets, global const int2* entries,
                         global const float* tf, const int tf_count, global const float* psi, const int psi_n,
                         const float4 cam_position, const float4 cam_forward, const float4 cam_right,
                         const float4 cam_up, const float4 cam_params, const uint max_steps, const int integration,
-                        const float ert_alpha, const float4 background)
+                        const float ert_alpha, const float4 background, global const float4* full_table,
+                        const int full_ns, const int full_nl, const float4 full_params)
 {
     CLVR_GUARD_2D(width, height);
     const int x = (int)get_global_id(0), y = (int)get_global_id(1);
@@ -207,7 +238,13 @@ kernel void harc_render(global float4* out, global uint* stats, const int width,
             const float lambda_exit = lambda + step;
             const float s_f = dot(grad.xyz, pos) + grad.w;                       /* Eq. 6 */
             const float s_b = dot(grad.xyz, e + lambda_exit * d) + grad.w;
-            if (integration == HARC_INTEGRATION_AVERAGE) {
+            if (integration == HARC_INTEGRATION_FULL) {
+                /* The whole segment at once: no split at control points (the table has them inside). */
+                const float4 c = harc_full_lookup(full_table, full_ns, full_nl, full_params, s_f, s_b, step);
+                color += transmittance * c.xyz;
+                transmittance *= 1.0f - c.w;
+                ++pieces;
+            } else if (integration == HARC_INTEGRATION_AVERAGE) {
                 harc_segment_average(tf, tf_count, s_f, s_b, step, &color, &transmittance);
                 ++pieces;
             } else {

@@ -4,6 +4,7 @@
 
 #include "host/errors.h"
 #include "host/parallel.h"
+#include "host/preintegration_table.h"
 #include "host/psi_table.h"
 #include "host/render/harc_entry.h"
 #include "host/render/slice3d.h"  // packTransferFunction: kernels/transfer_function.h's layout
@@ -21,7 +22,7 @@
 namespace clvr {
 namespace {
 
-constexpr const char* kKnownOptions = "integration, max_steps, early_termination, entry, max_layers";
+constexpr const char* kKnownOptions = "integration, full_table, max_steps, early_termination, entry, max_layers";
 
 [[noreturn]] void badOption(const std::string& key, const std::string& what)
 {
@@ -52,6 +53,9 @@ public:
     void setTransferFunction(const TransferFunction& tf) override;
 
 private:
+    void buildFullTable(const TransferFunction& tf);
+
+
     Device& device_;
     HarcOptions options_;
     Camera camera_;
@@ -66,6 +70,14 @@ private:
     std::unique_ptr<HarcRasterEntries> rasterEntries_;  // options_.entry == Raster
     std::uint64_t residentBytes_ = 0;
     std::uint64_t pointCount_ = 0, tetCount_ = 0, tetsRead_ = 0, tetsDegenerate_ = 0;
+    // Full pre-integration (options_.integration == Full): the table on the device, its s range (the
+    // hull of the transfer function's and the mesh's), its l range and the last build's time.
+    cl::Buffer full_;
+    glm::dvec2 meshScalarRange_{0.0};
+    double fullLMax_ = 1.0;
+    double fullSLo_ = 0.0, fullSHi_ = 1.0;
+    double fullBuildMs_ = 0.0;
+    std::uint64_t fullBytes_ = 0;
 };
 
 HarcRenderer::HarcRenderer(Device& device, const Scene& scene, const TetMesh& mesh, const TetTopology& topology)
@@ -102,6 +114,16 @@ HarcRenderer::HarcRenderer(Device& device, const Scene& scene, const TetMesh& me
     const PsiTable& psi = psiTable();
     psi_ = device_.upload("harc psi table", psi.values);
     residentBytes_ = tets.size() * sizeof(cl_float4) + tf.size() * sizeof(float) + psi.values.size() * sizeof(float);
+    meshScalarRange_ = mesh.scalarRange();
+    fullLMax_ = longestTetEdge(mesh);
+    if (!(fullLMax_ > 0.0))
+        fullLMax_ = 1.0;  // every cell flat: no segment has a length, any l range will do
+    if (options_.integration == HarcOptions::Integration::Full) {
+        buildFullTable(scene.transferFunction);
+        residentBytes_ += fullBytes_;
+    } else {
+        full_ = device_.buffer("harc full table (unused)", sizeof(cl_float4));  // no zero-size buffers
+    }
 
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
     out_ = device_.buffer("harc image", pixels * sizeof(cl_float4), CL_MEM_WRITE_ONLY);
@@ -112,8 +134,28 @@ HarcRenderer::HarcRenderer(Device& device, const Scene& scene, const TetMesh& me
                                                              image_.height, options_.maxLayers);
 }
 
+// The table over s in the hull of the transfer function's range and the mesh's: a segment whose s
+// leaves the transfer function's range still has to cross into it at the right λ, which clamping s to
+// that range would move. l runs to the longest tetrahedron edge, the longest segment any ray can have.
+void HarcRenderer::buildFullTable(const TransferFunction& tf)
+{
+    const auto start = std::chrono::steady_clock::now();
+    fullSLo_ = std::min(tf.sMin(), meshScalarRange_.x);
+    fullSHi_ = std::max(tf.sMax(), meshScalarRange_.y);
+    const PreintegrationTable table = buildPreintegrationTable(tf, fullSLo_, fullSHi_, fullLMax_,
+                                                               options_.fullScalarSamples, options_.fullLengthSamples);
+    full_ = device_.upload("harc full pre-integration table", table.values);
+    fullBytes_ = table.bytes();
+    fullBuildMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
 void HarcRenderer::setTransferFunction(const TransferFunction& tf)
 {
+    // Full pre-integration has to rebuild its whole table (same size, so residentBytes_ keeps it): the
+    // cost that partial pre-integration avoids (seeds/001 §1).
+    if (options_.integration == HarcOptions::Integration::Full)
+        buildFullTable(tf);
+
     // Partial pre-integration needs no table that depends on the transfer function: only the packed
     // control points change (the ψ table is the same for every transfer function).
     const std::vector<float> packed = packTransferFunction(tf);
@@ -161,9 +203,22 @@ Image4f HarcRenderer::render(FrameStats& stats)
     kernel_.setArg(a++, toCl4(camera_.up()));
     kernel_.setArg(a++, params);
     kernel_.setArg(a++, maxSteps);
-    kernel_.setArg(a++, static_cast<cl_int>(options_.integration == HarcOptions::Integration::Average ? 1 : 0));
+    const cl_int integration = options_.integration == HarcOptions::Integration::Average ? 1
+                               : options_.integration == HarcOptions::Integration::Full  ? 2
+                                                                                          : 0;
+    kernel_.setArg(a++, integration);  // HARC_INTEGRATION_* of kernels/harc.cl
     kernel_.setArg(a++, static_cast<cl_float>(ert));
     kernel_.setArg(a++, toCl4(image_.background));
+    // The table's sample spacing as PreintegrationTable::lookup computes it (float), so host and device
+    // interpolate alike.
+    const int ns = options_.fullScalarSamples, nl = options_.fullLengthSamples;
+    const cl_float4 fullParams{{static_cast<float>(fullSLo_),
+                                static_cast<float>(ns - 1) / static_cast<float>(fullSHi_ - fullSLo_),
+                                static_cast<float>(nl - 1) / static_cast<float>(fullLMax_), 0.0f}};
+    kernel_.setArg(a++, full_);
+    kernel_.setArg(a++, static_cast<cl_int>(ns));
+    kernel_.setArg(a++, static_cast<cl_int>(nl));
+    kernel_.setArg(a++, fullParams);
     device_.launch("harc: walk", kernel_, image_.width, image_.height);
 
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
@@ -202,7 +257,18 @@ Image4f HarcRenderer::render(FrameStats& stats)
     stats.extra["max_steps"] = maxSteps_;
     stats.extra["boundary_faces"] = topology_.boundary.size();
     stats.extra["entry_crossings"] = lists.entries.size();
-    stats.extra["integration"] = options_.integration == HarcOptions::Integration::Average ? "average" : "partial";
+    switch (options_.integration) {
+    case HarcOptions::Integration::Partial: stats.extra["integration"] = "partial"; break;
+    case HarcOptions::Integration::Average: stats.extra["integration"] = "average"; break;
+    case HarcOptions::Integration::Full:
+        stats.extra["integration"] = "full";
+        stats.extra["full_table"] = std::to_string(ns) + "x" + std::to_string(ns) + "x" + std::to_string(nl);
+        stats.extra["full_table_bytes"] = fullBytes_;
+        stats.extra["full_table_build_ms"] = fullBuildMs_;  // the last build: construction or TF change
+        stats.extra["full_table_l_max"] = fullLMax_;
+        stats.extra["full_table_s_range"] = {fullSLo_, fullSHi_};
+        break;
+    }
     stats.extra["early_termination"] = options_.earlyTermination;
     stats.extra["entry"] = rasterEntries_ ? "raster" : "host";
     stats.extra["entry_ms"] = entryMs;
@@ -232,8 +298,25 @@ HarcOptions parseHarcOptions(const nlohmann::json& options)
                 o.integration = HarcOptions::Integration::Partial;
             else if (s == "average")
                 o.integration = HarcOptions::Integration::Average;
+            else if (s == "full")
+                o.integration = HarcOptions::Integration::Full;
             else
-                badOption(key, "must be \"partial\" or \"average\", got " + value.dump());
+                badOption(key, "must be \"partial\", \"average\" or \"full\", got " + value.dump());
+        } else if (key == "full_table") {
+            const bool pair = value.is_array() && value.size() == 2;
+            for (std::size_t i = 0; pair && i < 2; ++i)
+                if (!value[i].is_number_integer() || value[i].get<long long>() < 2 || value[i].get<long long>() > 512)
+                    badOption(key, "must be [NS, NL], integers in [2, 512], got " + value.dump());
+            if (!pair)
+                badOption(key, "must be [NS, NL] (samples of s_f and s_b, samples of l), got " + value.dump());
+            o.fullScalarSamples = value[0].get<int>();
+            o.fullLengthSamples = value[1].get<int>();
+            const std::uint64_t bytes = std::uint64_t(o.fullScalarSamples) * o.fullScalarSamples *
+                                        o.fullLengthSamples * sizeof(cl_float4);
+            if (bytes > kMaxFullTableBytes)
+                badOption(key, value.dump() + " is a table of " + std::to_string(bytes >> 20) +
+                                   " MiB (NS x NS x NL x 16 bytes); at most " +
+                                   std::to_string(kMaxFullTableBytes >> 20) + " MiB");
         } else if (key == "entry") {
             const std::string s = value.is_string() ? value.get<std::string>() : "";
             if (s == "raster")
@@ -258,7 +341,21 @@ HarcOptions parseHarcOptions(const nlohmann::json& options)
             badOption(key, std::string("unknown option for harc (known: ") + kKnownOptions + ")");
         }
     }
+    if (options.contains("full_table") && o.integration != HarcOptions::Integration::Full)
+        badOption("full_table", "applies only to \"integration\": \"full\"");
     return o;
+}
+
+double longestTetEdge(const TetMesh& mesh)
+{
+    double longest2 = 0.0;
+    for (const glm::uvec4& t : mesh.tets)
+        for (int a = 0; a < 4; ++a)
+            for (int b = a + 1; b < 4; ++b) {
+                const glm::dvec3 e = mesh.points[t[a]] - mesh.points[t[b]];
+                longest2 = std::max(longest2, glm::dot(e, e));
+            }
+    return std::sqrt(longest2);
 }
 
 std::vector<cl_float4> packHarcTets(const TetMesh& mesh, const TetTopology& topology, const glm::dvec3& shift)

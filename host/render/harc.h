@@ -2,8 +2,10 @@
 // pre-integration (seeds/001_cd12fd6b76f9cf96.txt §3–4, Figure 6), kernels/harc.cl. One work-item
 // per pixel walks the mesh through the cell adjacency from the first boundary front face its ray
 // crosses; each cell's segment is split at the transfer function's control points and each piece is
-// integrated by Eq. 2–4 (ψ from host/psi_table.h). Non-convex meshes: a per-pixel list of boundary
-// front-face crossings sorted by depth, so a ray that leaves the mesh re-enters at the next one.
+// integrated by Eq. 2–4 (ψ from host/psi_table.h); or, with "integration": "full" (HARC-Full), each
+// whole segment is looked up in a 3D pre-integration table (host/preintegration_table.h). Non-convex
+// meshes: a per-pixel list of boundary front-face crossings sorted by depth, so a ray that leaves the
+// mesh re-enters at the next one.
 // docs/harc.md.
 #pragma once
 
@@ -20,8 +22,10 @@
 namespace clvr {
 
 struct HarcOptions {
-    enum class Integration { Partial, Average };
+    enum class Integration { Partial, Average, Full };
     Integration integration = Integration::Partial;
+    int fullScalarSamples = 64;     // "full_table": [NS, NL], the (s_f, s_b, l) table is NS x NS x NL
+    int fullLengthSamples = 64;
     std::uint64_t maxSteps = 0;     // per ray; 0 = the default, 4 * cbrt(tets) + 10000
     double earlyTermination = 1.0;  // stop once A >= this; 1.0 = off (the paper's benchmarks)
     // Where the per-pixel entry lists come from: the raster stage (depth peeling of the boundary front
@@ -31,11 +35,21 @@ struct HarcOptions {
     int maxLayers = 64;  // raster entry: peeling layers per frame (1..255); rays past them are counted
 };
 
-// Reads the scene's "options" for harc: "integration" ("partial" | "average"), "max_steps" (integer
+// Reads the scene's "options" for harc: "integration" ("partial" | "average" | "full"), "full_table"
+// ([NS, NL], integers in [2, 512], at most kMaxFullTableBytes, only with "full"), "max_steps" (integer
 // >= 1), "early_termination" (opacity in (0, 1]), "entry" ("raster" | "host"), "max_layers" (integer
 // in [1, 255]). InputError naming the key for unknown keys, wrong
 // types and values out of range.
 HarcOptions parseHarcOptions(const nlohmann::json& options);
+
+// The largest full pre-integration table "full_table" may ask for (16 bytes per entry): 256 MiB, e.g.
+// 256 x 256 x 256 or 512 x 512 x 64. It is built on the host at every transfer-function change.
+inline constexpr std::uint64_t kMaxFullTableBytes = std::uint64_t(256) << 20;
+
+// The longest segment a ray can have inside one cell of the mesh: its longest tetrahedron edge (a
+// tetrahedron's diameter is the distance between two of its vertices). World units; the l range of
+// the full pre-integration table.
+double longestTetEdge(const TetMesh& mesh);
 
 // The device layout, 5 float4 = 80 bytes per tetrahedron (kernels/harc.cl describes it): three
 // barycentric planes (the fourth is 1 minus their sum), the gradient and scalar term of Eq. 6, and the
