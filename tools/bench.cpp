@@ -477,6 +477,7 @@ int bench(const BenchOptions& options)
                          {"pocl_cache_dir", poclCache ? poclCache : "default (~/.cache/pocl)"}};
     report["frames"] = frames;
     report["scenes"] = nlohmann::json::array();
+    bool anyVolume = false;  // the raster-stage figures go with the regular-grid scenes
     std::cout << "clvr bench on " << device.description() << "\nplatform "
               << report["machine"]["platform_version"].get<std::string>() << "\nCPU " << cpuModel() << ", "
               << std::thread::hardware_concurrency() << " cores, " << utcNow() << ", load average "
@@ -490,6 +491,7 @@ int bench(const BenchOptions& options)
             report["scenes"].push_back(benchMeshScene(device, scenePath, scene, options, frames, prefix));
             continue;
         }
+        anyVolume = true;
         const Volume volume = loadVolume(scene.volume, scene.baseDir);
         const Camera camera = scene.camera ? *scene.camera : fitCamera(volume.boundsMin(), volume.boundsMax());
 
@@ -610,8 +612,10 @@ int bench(const BenchOptions& options)
     }
 
 #if CLVR_BENCH_RASTER
-    report["raster"] = rasterBench(device);
-    {
+    if (!anyVolume) {
+        report["raster"] = {{"skipped", "tetrahedral-mesh scenes only"}};
+    } else {
+        report["raster"] = rasterBench(device);
         const nlohmann::json& r = report["raster"];
         std::cout << "raster (raster::draw, 512x512, 1000 random blended triangles)\n"
                   << "  draw         " << fixed(r["draw_ms"].get<double>(), 2) << " ms median (first "
