@@ -99,6 +99,8 @@ def main():
     ap.add_argument("--frames", type=int, default=5)
     ap.add_argument("--out-png", default="vtk.png")
     ap.add_argument("--out-json", default="vtk.json")
+    ap.add_argument("--pixel-corners", type=int, default=0,
+                    help="1: leave VTK's rays through pixel corners (default 0: shifted to clvr's pixel centres)")
     args = ap.parse_args()
 
     with open(args.scene) as f:
@@ -159,6 +161,13 @@ def main():
         camera.SetParallelScale(camera_spec["parallel_scale"])
     else:
         camera.SetViewAngle(camera_spec.get("view_angle", 30.0))
+    if args.pixel_corners == 0:
+        # vtkUnstructuredGridBunykRayCastFunction casts the ray of pixel (i, j) through the point that
+        # projects to x = i, y = j (TransformPoints: (ndc + 1) / 2 * size; ComputePixelIntersections tests
+        # integer x, y): through a pixel's corner. clvr (DESIGN.md) casts through pixel centres, half a
+        # pixel up and right. The camera's window centre shifts the projection: ndc' = ndc - centre, so a
+        # centre of one pixel's NDC width puts VTK's rays through the same points as clvr's.
+        camera.SetWindowCenter(1.0 / width, 1.0 / height)
     renderer.ResetCameraClippingRange()
 
     t0 = time.perf_counter()
@@ -193,6 +202,7 @@ def main():
         "width": width,
         "height": height,
         "opacity_unit_distance": unit_distance,
+        "rays_through": "pixel corners" if args.pixel_corners else "pixel centres (window centre shifted half a pixel)",
         "load_ms": load_ms,
         "first_frame_ms": first_ms,
         "frame_ms": frame_ms,
