@@ -249,7 +249,14 @@ nlohmann::json benchMeshScene(Device& device, const fs::path& scenePath, Scene s
 
     const double compile0 = device.compileMs();
     t0 = Clock::now();
-    const std::unique_ptr<Renderer> renderer = makeMeshRenderer(device, scene, mesh);
+    std::unique_ptr<Renderer> renderer;
+    try {
+        renderer = makeMeshRenderer(device, scene, mesh);
+    } catch (const DeviceError&) {
+        throw;
+    } catch (const InputError& e) {  // technique or options (a mode not built yet): name the scene
+        throw InputError(scenePath.string() + ": " + e.what());
+    }
     const double setupMs = msSince(t0);
     FrameStats firstStats;
     t0 = Clock::now();
@@ -318,7 +325,10 @@ nlohmann::json benchMeshScene(Device& device, const fs::path& scenePath, Scene s
               << " ms; kernel compile " << fixed(compileMs, 1) << " ms of the two\n"
               << "  resident     " << fixed(f.bytesPerTet, 1) << " bytes/tet ("
               << si(static_cast<double>(renderer->residentBytes())) << "B)\n"
-              << std::flush;
+              << "  passes      ";
+    for (const PassTime& p : stats.passes)
+        std::cout << ' ' << p.name << ' ' << fixed(p.ms, 1) << " ms;";
+    std::cout << " (last frame)\n" << std::flush;
 
     if (options.peer) {
         const fs::path peerScene = prefix.string() + ".peer.json", peerMesh = prefix.string() + ".mesh.vtk";
@@ -350,7 +360,7 @@ void printMeshTable(const nlohmann::json& scenes)
     table << std::left << std::setw(22) << "mesh scene" << std::right << std::setw(9) << "tets" << std::setw(10)
           << "ms/frame" << std::setw(8) << "fps" << std::setw(10) << "tet/s" << std::setw(11) << "steps/s"
           << std::setw(10) << "bytes/tet" << std::setw(10) << "first ms" << std::setw(10) << "setup ms"
-          << std::setw(10) << "VTK ms" << std::setw(8) << "x VTK" << '\n';
+          << std::setw(10) << "VTK ms" << std::setw(8) << "x VTK" << "  integration" << '\n';
     int rows = 0;
     for (const nlohmann::json& r : scenes) {
         if (r.value("kind", std::string()) != "mesh")
@@ -364,7 +374,8 @@ void printMeshTable(const nlohmann::json& scenes)
               << std::setw(10) << fixed(r["bytes_per_tet"].get<double>(), 1) << std::setw(10)
               << fixed(r["first_frame_ms"].get<double>(), 0) << std::setw(10) << fixed(r["setup_ms"].get<double>(), 0)
               << std::setw(10) << (peer ? fixed(r["peer"]["frame_ms"].get<double>(), 0) : std::string("-"))
-              << std::setw(8) << (peer ? fixed(r["peer"]["clvr_speedup"].get<double>(), 2) : std::string("-")) << '\n';
+              << std::setw(8) << (peer ? fixed(r["peer"]["clvr_speedup"].get<double>(), 2) : std::string("-")) << "  "
+              << r["integration"].get<std::string>() << '\n';
     }
     if (rows > 0)
         std::cout << table.str() << '\n';
@@ -476,6 +487,7 @@ int bench(const BenchOptions& options)
                          {"load_average_start", loadAverage()},
                          {"pocl_cache_dir", poclCache ? poclCache : "default (~/.cache/pocl)"}};
     report["frames"] = frames;
+    report["overrides"] = options.overrides;
     report["scenes"] = nlohmann::json::array();
     bool anyVolume = false;  // the raster-stage figures go with the regular-grid scenes
     std::cout << "clvr bench on " << device.description() << "\nplatform "
@@ -486,7 +498,7 @@ int bench(const BenchOptions& options)
     for (const fs::path& scenePath : scenes) {
         const std::string name = scenePath.stem().string();
         const fs::path prefix = outDir / ("bench." + name);
-        const Scene scene = loadScene(scenePath);
+        const Scene scene = loadScene(scenePath, options.overrides);
         if (!scene.mesh.is_null()) {
             report["scenes"].push_back(benchMeshScene(device, scenePath, scene, options, frames, prefix));
             continue;

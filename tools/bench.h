@@ -19,6 +19,8 @@ struct BenchOptions {
                                        // tools/peer_vtk_unstructured.py for mesh scenes)
     int peerFrames = 0;                // the peer's steady frames; 0: as many as clvr's
     std::string meshCache;             // TetGen meshes of surface scenes; empty: bench-data beside clvr
+    std::vector<std::string> overrides;  // --set path=json, applied to every scene (as clvr render --set),
+                                         // e.g. options.integration="full" on the harc suite
 };
 
 // The scene files (under data/scenes/bench/) a suite runs: "slice3d" -> slice3d-{ml256,engine}.json,

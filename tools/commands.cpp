@@ -108,6 +108,8 @@ int run(int argc, char** argv)
     benchCommand->add_option("--peer-frames", benchOptions.peerFrames, "the peer's steady frames (0: as --frames)")
         ->check(CLI::Range(0, 100000))
         ->capture_default_str();
+    benchCommand->add_option("--set", benchOptions.overrides,
+                             "override a value of every scene, path=json (e.g. options.integration=\"full\")");
     benchCommand->add_option("--mesh-cache", benchOptions.meshCache,
                              "folder for TetGen meshes of surface scenes (default: bench-data beside clvr)");
 #endif
