@@ -38,7 +38,7 @@ from vtk.util import numpy_support
 
 def read_tetgen(path):
     """BASE.node / BASE.ele (0- or 1-based by the first node's number); scalar = first node attribute."""
-    base = path[:-5] if path.endswith(".node") or path.endswith(".ele") else path
+    base = os.path.splitext(path)[0] if path.endswith(".node") or path.endswith(".ele") else path
     def table(p):
         rows = []
         with open(p) as f:
