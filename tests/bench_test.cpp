@@ -1,13 +1,22 @@
-// tests/bench_test.cpp — correctness (never timing) of clvr bench's ceiling loop (tools/ceiling.h):
-// its image must be the emission-absorption integral of the scene, as host/reference_integral.h
-// computes it. tools/*.cpp are not in the test binary, so the loop's one file is compiled in here.
+// tests/bench_test.cpp — correctness (never timing) of clvr bench: the ceiling loop (tools/ceiling.h),
+// whose image must be the emission-absorption integral of the scene as host/reference_integral.h computes
+// it, and the mesh side (tools/bench_mesh.h): the harc bench scenes, the figures from a frame's stats, the
+// TetGen mesh cache and the peer's files. tools/*.cpp are not in the test binary, so their files are
+// compiled in here.
+#include "tools/bench_mesh.cpp"
 #include "tools/ceiling.cpp"
 
+#include "host/errors.h"
 #include "host/generators.h"
+#include "host/mesh_io.h"
 #include "host/reference_integral.h"
+#include "host/render/renderer.h"
 #include "tests/test_util.h"
 
 #include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
 
 namespace {
 
@@ -47,6 +56,174 @@ TEST(Ceiling, MatchesReferenceIntegralOnMarschnerLobb)
     // alpha, mean 1.2e-4).
     EXPECT_TRUE(clvr::test::imagesNear(result.image, expected, {.maxAbs = 6e-3, .meanAbs = 3e-4}));
     EXPECT_GT(result.samples, 0u);
+}
+
+// ---------------------------------------------------------------------------------------------------
+// BenchMesh: the harc bench scenes and the figures of seeds/001 Tables 2-3.
+
+std::filesystem::path benchScene(const std::string& name)
+{
+    return std::filesystem::path(CLVR_SOURCE_DIR) / "data/scenes/bench" / name;
+}
+
+TEST(BenchMesh, BluntfinScenesHaveTheStatedControlPointsAndImageSize)
+{
+    for (const auto& [name, points] : {std::pair{"harc-bluntfin-10.json", 11}, std::pair{"harc-bluntfin-255.json", 256}}) {
+        const clvr::Scene scene = clvr::loadScene(benchScene(name));
+        EXPECT_EQ(scene.technique, "harc") << name;
+        EXPECT_EQ(scene.transferFunction.points().size(), static_cast<std::size_t>(points)) << name;
+        EXPECT_EQ(scene.image.width, 512) << name;
+        EXPECT_EQ(scene.image.height, 512) << name;
+        EXPECT_FALSE(scene.camera) << name << ": like data/scenes/bluntfin.json, the camera is fitted to the mesh";
+        ASSERT_TRUE(scene.mesh.is_object()) << name;
+        EXPECT_EQ(scene.mesh.value("scalar", std::string()), "density") << name;
+        // The same data as data/scenes/bluntfin.json (whose paths are one folder shallower).
+        const clvr::Scene reference = clvr::loadScene(std::filesystem::path(CLVR_SOURCE_DIR) / "data/scenes/bluntfin.json");
+        EXPECT_EQ(std::filesystem::weakly_canonical(scene.baseDir / scene.mesh["file"].get<std::string>()),
+                  std::filesystem::weakly_canonical(reference.baseDir / reference.mesh["file"].get<std::string>()))
+            << name;
+        // Equal steps of s over the same range, so the two differ only in how finely they split a cell.
+        const auto& p = scene.transferFunction.points();
+        EXPECT_DOUBLE_EQ(p.front().s, 0.19) << name;
+        EXPECT_DOUBLE_EQ(p.back().s, 4.98) << name;
+        for (std::size_t i = 1; i < p.size(); ++i)
+            EXPECT_NEAR(p[i].s - p[i - 1].s, (4.98 - 0.19) / (points - 1), 1e-6) << name << " point " << i;
+    }
+}
+
+// The 1M scene's TetGen parameters, meshed as clvr bench meshes them (about 7 s of TetGen on one core;
+// measured 1,163,474 tetrahedra). TetGen's -a bounds each tetrahedron's volume, so the torus (volume 0.719)
+// needs at least 0.719 / max_volume = 575k; refinement leaves about twice that.
+TEST(BenchMesh, TetgenSceneMeshesToAMillionTetrahedra)
+{
+    const clvr::Scene scene = clvr::loadScene(benchScene("harc-tetgen-1m.json"));
+    EXPECT_EQ(scene.technique, "harc");
+    EXPECT_EQ(scene.image.width, 512);
+    EXPECT_EQ(scene.image.height, 512);
+    ASSERT_TRUE(scene.camera);
+    ASSERT_TRUE(scene.mesh.contains("surface"));
+    const clvr::TetMesh mesh = clvr::loadMesh(scene.mesh, scene.baseDir);
+    EXPECT_GE(mesh.tets.size(), 1000000u);
+    EXPECT_EQ(mesh.tetsDegenerate, 0u);
+    EXPECT_EQ(mesh.scalars.size(), mesh.points.size());
+}
+
+TEST(BenchMesh, FiguresFromAFrameRecord)
+{
+    const nlohmann::json extra = {{"tets", 225000}, {"tets_rendered", 224874}, {"steps", 3000000},
+                                  {"bytes_per_tet", 80.25}, {"pieces", 5000000}};
+    const clvr::tools::MeshFigures f = clvr::tools::meshFigures(extra, 250.0);
+    EXPECT_EQ(f.tets, 224874u);  // tets_rendered, not tets as read
+    EXPECT_EQ(f.steps, 3000000u);
+    EXPECT_DOUBLE_EQ(f.fps, 4.0);
+    EXPECT_DOUBLE_EQ(f.tetsPerS, 224874.0 * 4.0);
+    EXPECT_DOUBLE_EQ(f.stepsPerS, 12.0e6);
+    EXPECT_DOUBLE_EQ(f.bytesPerTet, 80.25);
+    EXPECT_DOUBLE_EQ(f.frameMs, 250.0);
+}
+
+TEST(BenchMesh, FiguresNeedMeshStatsAndAPositiveTime)
+{
+    const nlohmann::json extra = {{"tets_rendered", 10}, {"steps", 20}, {"bytes_per_tet", 80.0}};
+    EXPECT_THROW(clvr::tools::meshFigures(extra, 0.0), clvr::InputError);
+    EXPECT_THROW(clvr::tools::meshFigures(extra, -1.0), clvr::InputError);
+    for (const char* key : {"tets_rendered", "steps", "bytes_per_tet"}) {
+        nlohmann::json missing = extra;
+        missing.erase(key);
+        try {
+            clvr::tools::meshFigures(missing, 10.0);
+            ADD_FAILURE() << "no error without " << key;
+        } catch (const clvr::InputError& e) {
+            EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+        }
+    }
+}
+
+// A small surface scene: meshed once, then read from the cache as the same mesh; another option meshes again.
+TEST(BenchMesh, MeshCacheReturnsTheMeshTetgenMade)
+{
+    clvr::test::TempDir dir;
+    const std::string text = R"({"technique": "harc",
+        "mesh": {"surface": ")" + clvr::test::repoData("surfaces/torus.off") + R"(", "max_volume": 0.002, "scalar": "blobs"},
+        "transfer_function": {"points": [[0, 0, 0, 0, 0], [1, 1, 1, 1, 1]]}})";
+    const clvr::Scene scene = clvr::parseScene(text, "test scene", dir.path());
+    int meshed = 0;
+    const auto progress = [&](const std::string& line) {
+        ++meshed;
+        EXPECT_NE(line.find("TetGen"), std::string::npos) << line;
+    };
+    const clvr::TetMesh made = clvr::tools::loadBenchMesh(scene, "small", dir / "cache", progress);
+    EXPECT_EQ(meshed, 1);
+    EXPECT_GE(made.tets.size(), static_cast<std::size_t>(0.7193 / 0.002));  // the -a bound again
+    const clvr::TetMesh cached = clvr::tools::loadBenchMesh(scene, "small", dir / "cache", progress);
+    EXPECT_EQ(meshed, 1) << "the second load must read the cache";
+    ASSERT_EQ(cached.tets.size(), made.tets.size());
+    ASSERT_EQ(cached.points.size(), made.points.size());
+    EXPECT_EQ(cached.tets, made.tets);
+    EXPECT_EQ(cached.points, made.points);    // written with 17 digits: exact
+    EXPECT_EQ(cached.scalars, made.scalars);
+    EXPECT_EQ(cached.tetsRead, made.tetsRead);
+
+    clvr::Scene other = scene;
+    other.mesh["max_volume"] = 0.004;
+    EXPECT_NE(clvr::tools::meshCacheKey(other.mesh, other.baseDir), clvr::tools::meshCacheKey(scene.mesh, scene.baseDir));
+    clvr::tools::loadBenchMesh(other, "small", dir / "cache", progress);
+    EXPECT_EQ(meshed, 2);
+}
+
+TEST(BenchMesh, PeerSceneHoldsTheSameTetrahedraCameraAndTransferFunction)
+{
+    clvr::test::TempDir dir;
+    const clvr::Scene scene = clvr::loadScene(benchScene("harc-bluntfin-10.json"));
+    clvr::TetMesh mesh;
+    mesh.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 1}};
+    mesh.scalars = {0.5, 1.0, 2.0, 3.0, 4.5};
+    mesh.tets = {{0, 1, 2, 3}, {1, 2, 3, 4}};
+    clvr::checkMesh(mesh);
+    const clvr::Camera camera = clvr::fitCamera(mesh.boundsMin(), mesh.boundsMax());
+    clvr::tools::writePeerMeshScene(scene, mesh, camera, dir / "mesh.vtk", dir / "peer.json");
+
+    const nlohmann::json peer = nlohmann::json::parse(clvr::test::readFile(dir / "peer.json"));
+    EXPECT_EQ(peer["transfer_function"]["points"].size(), 11u);
+    EXPECT_EQ(peer["image"]["width"], 512);
+    const clvr::Scene reread = clvr::parseScene(peer.dump(), "peer.json", dir.path());  // a valid clvr scene
+    ASSERT_TRUE(reread.camera);
+    EXPECT_EQ(reread.camera->position, camera.position);
+    EXPECT_EQ(reread.camera->focalPoint, camera.focalPoint);
+    EXPECT_EQ(reread.camera->viewAngle, camera.viewAngle);
+    for (std::size_t i = 0; i < scene.transferFunction.points().size(); ++i) {
+        EXPECT_EQ(reread.transferFunction.points()[i].s, scene.transferFunction.points()[i].s);
+        EXPECT_EQ(reread.transferFunction.points()[i].tau, scene.transferFunction.points()[i].tau);
+    }
+    const clvr::TetMesh vtk = clvr::readVtkUnstructured(peer["mesh"]["file"].get<std::string>(), "scalars");
+    EXPECT_EQ(vtk.tets, mesh.tets);
+    EXPECT_EQ(vtk.points, mesh.points);
+    ASSERT_EQ(vtk.scalars.size(), mesh.scalars.size());
+    for (std::size_t i = 0; i < mesh.scalars.size(); ++i)
+        EXPECT_FLOAT_EQ(static_cast<float>(vtk.scalars[i]), static_cast<float>(mesh.scalars[i]));  // float SCALARS
+}
+
+// The two bluntfin scenes on a small image: both render, the rays cross the same cells, and 255 segments
+// split them into more pieces than 10 (what the bench compares). Counts only; no timing.
+TEST(BenchMesh, BluntfinScenesRenderAndMoreSegmentsSplitMore)
+{
+    const clvr::Scene scene10 = clvr::loadScene(benchScene("harc-bluntfin-10.json"), {"image={\"width\":24,\"height\":20}"});
+    const clvr::Scene scene255 = clvr::loadScene(benchScene("harc-bluntfin-255.json"), {"image={\"width\":24,\"height\":20}"});
+    const clvr::TetMesh mesh = clvr::loadMesh(scene10.mesh, scene10.baseDir);
+    clvr::FrameStats stats10, stats255;
+    const clvr::Image4f image10 = clvr::makeMeshRenderer(clvr::test::device(), scene10, mesh)->render(stats10);
+    const clvr::Image4f image255 = clvr::makeMeshRenderer(clvr::test::device(), scene255, mesh)->render(stats255);
+    EXPECT_EQ(image10.width(), 24);
+    EXPECT_EQ(image255.height(), 20);
+    const clvr::tools::MeshFigures f10 = clvr::tools::meshFigures(stats10.extra, 1.0);
+    const clvr::tools::MeshFigures f255 = clvr::tools::meshFigures(stats255.extra, 1.0);
+    EXPECT_EQ(f10.tets, f255.tets);
+    EXPECT_EQ(f10.tets, mesh.tets.size());  // tets_rendered: after the degenerate ones are dropped
+    EXPECT_EQ(stats10.extra["tets"].get<std::uint64_t>(), 39u * 31u * 31u * 6u);  // as split: 40x32x32 points, 6 per cell
+    EXPECT_GT(f10.tets, 39u * 31u * 31u * 6u * 99 / 100);
+    EXPECT_GT(f10.steps, 0u);
+    EXPECT_EQ(f10.steps, f255.steps);
+    EXPECT_GT(stats255.extra["pieces"].get<std::uint64_t>(), stats10.extra["pieces"].get<std::uint64_t>());
 }
 
 }  // namespace

@@ -1,14 +1,17 @@
 // tools/bench.cpp — `clvr bench` (DESIGN.md, "How results are judged": speed and peers). Steady-state
 // frames with the data already on the device, compilation reported apart, median of several frames;
-// the ceiling loop (tools/ceiling.h) and VTK (tools/peer_vtk.py) on the same scene in the same run.
+// the ceiling loop (tools/ceiling.h) and VTK (tools/peer_vtk.py, tools/peer_vtk_unstructured.py for
+// meshes) on the same scene in the same run.
 #include "tools/bench.h"
 
 #include "host/device.h"
 #include "host/errors.h"
 #include "host/image_io.h"
+#include "host/mesh.h"
 #include "host/render/renderer.h"
 #include "host/scene.h"
 #include "host/volume_io.h"
+#include "tools/bench_mesh.h"
 #include "tools/ceiling.h"
 
 #if __has_include("raster/rasterizer.h")
@@ -202,6 +205,182 @@ nlohmann::json runPeer(const fs::path& scenePath, int frames, double sampleDista
     return peer;
 }
 
+// tools/peer_vtk_unstructured.py under xvfb-run on the scene clvr bench wrote for it (the mesh clvr
+// loaded, as .vtk, and the camera it used); its figures, and its image against clvr's PNG.
+nlohmann::json runMeshPeer(const fs::path& peerScene, int frames, const fs::path& clvrPng, const fs::path& outPrefix)
+{
+    const fs::path script = repoFile("tools/peer_vtk_unstructured.py");
+    const fs::path png = outPrefix.string() + ".vtk.png", json = outPrefix.string() + ".vtk.json";
+    std::error_code ec;
+    fs::remove(json, ec);
+    std::ostringstream cmd;
+    cmd << "xvfb-run -a /usr/bin/python3 '" << script.string() << "' '" << peerScene.string() << "' --frames "
+        << frames << " --out-png '" << png.string() << "' --out-json '" << json.string() << "'";
+    std::cout << "  peer: " << cmd.str() << '\n' << std::flush;
+    const int rc = std::system(cmd.str().c_str());
+    std::ifstream in(json);
+    if (rc != 0 || !in)
+        return {{"error", "tools/peer_vtk_unstructured.py failed (status " + std::to_string(rc) + "); command: " +
+                              cmd.str()}};
+    nlohmann::json peer = nlohmann::json::parse(in);
+    const ImageDiff d = imageDiff(readImage(clvrPng.string()), readImage(png.string()));
+    peer["image"] = png.string();
+    peer["image_diff_vs_clvr"] = {{"mean", d.mean}, {"max", d.max}};
+    peer["image_diff_vs_clvr_8bit"] = {{"mean", 255.0 * d.mean}, {"max", 255.0 * d.max}};
+    return peer;
+}
+
+// One tetrahedral-mesh scene: load (or TetGen, cached), set-up, a first frame, steady frames; the
+// figures of seeds/001 Tables 2-3 (tools/bench_mesh.h); with --peer, VTK on the same tetrahedra.
+nlohmann::json benchMeshScene(Device& device, const fs::path& scenePath, Scene scene, const BenchOptions& options,
+                              int frames, const fs::path& prefix)
+{
+    const std::string name = scenePath.stem().string();
+    std::cout << name << " (" << scene.technique << ", " << scene.image.width << "x" << scene.image.height << ", "
+              << scene.transferFunction.points().size() - 1 << " transfer-function segments)\n" << std::flush;
+    const fs::path cacheDir = options.meshCache.empty() ? defaultMeshCacheDir() : fs::path(options.meshCache);
+    auto t0 = Clock::now();
+    const TetMesh mesh = loadBenchMesh(scene, name, cacheDir, [](const std::string& line) {
+        std::cout << "  " << line << '\n' << std::flush;
+    });
+    const double loadMs = msSince(t0);
+    if (!scene.camera)  // as clvr render: the whole mesh in view; the peer gets the same camera
+        scene.camera = fitCamera(mesh.boundsMin(), mesh.boundsMax());
+
+    const double compile0 = device.compileMs();
+    t0 = Clock::now();
+    std::unique_ptr<Renderer> renderer;
+    try {
+        renderer = makeMeshRenderer(device, scene, mesh);
+    } catch (const DeviceError&) {
+        throw;
+    } catch (const InputError& e) {  // technique or options (a mode not built yet): name the scene
+        throw InputError(scenePath.string() + ": " + e.what());
+    }
+    const double setupMs = msSince(t0);
+    FrameStats firstStats;
+    t0 = Clock::now();
+    renderer->render(firstStats);
+    const double firstFrameMs = msSince(t0);
+    const double compileMs = device.compileMs() - compile0;
+
+    std::vector<double> ms, statsMs;
+    FrameStats stats;
+    Image4f image;
+    for (int i = 0; i < frames; ++i) {
+        stats = FrameStats{};
+        t0 = Clock::now();
+        image = renderer->render(stats);
+        ms.push_back(msSince(t0));
+        statsMs.push_back(stats.frameMs);
+    }
+    const Spread s = spread(ms);
+    const MeshFigures f = meshFigures(stats.extra, s.median);
+    const fs::path clvrPng = prefix.string() + ".clvr.png";
+    writeImage(clvrPng.string(), image);
+
+    nlohmann::json r = {{"scene", scenePath.string()},
+                        {"name", name},
+                        {"technique", scene.technique},
+                        {"kind", "mesh"},
+                        {"width", scene.image.width},
+                        {"height", scene.image.height},
+                        {"mesh_source", mesh.source},
+                        {"points", mesh.points.size()},
+                        {"tf_control_points", scene.transferFunction.points().size()},
+                        {"tf_segments", scene.transferFunction.points().size() - 1},
+                        {"camera", cameraJson(*scene.camera)},
+                        {"load_average", loadAverage()},
+                        {"load_ms", loadMs},
+                        {"setup_ms", setupMs},
+                        {"compile_ms", compileMs},
+                        {"first_frame_ms", firstFrameMs},
+                        {"frame_ms", s.median},
+                        {"frame_ms_min", s.min},
+                        {"frame_ms_max", s.max},
+                        {"frame_ms_all", ms},
+                        {"frame_ms_renderer", spread(statsMs).median},
+                        {"fps", f.fps},
+                        {"tets", f.tets},
+                        {"tets_per_s", f.tetsPerS},
+                        {"steps", f.steps},
+                        {"steps_per_s", f.stepsPerS},
+                        {"bytes_per_tet", f.bytesPerTet},
+                        {"resident_bytes", renderer->residentBytes()},
+                        {"integration", stats.extra.value("integration", std::string("?"))},
+                        {"image", clvrPng.string()},
+                        {"extra", stats.extra}};
+    r["passes"] = nlohmann::json::array();
+    for (const PassTime& p : stats.passes)
+        r["passes"].push_back({{"name", p.name}, {"ms", p.ms}});
+
+    std::cout << "  mesh         " << mesh.source << ": " << mesh.points.size() << " points, " << f.tets
+              << " tetrahedra, loaded in " << fixed(loadMs, 0) << " ms\n"
+              << "  frame        " << fixed(s.median, 1) << " ms median (min " << fixed(s.min, 1) << ", max "
+              << fixed(s.max, 1) << ", " << frames << " frames), " << fixed(f.fps, 2) << " frames/s ("
+              << r["integration"].get<std::string>() << " integration)\n"
+              << "  throughput   " << si(f.tetsPerS) << " tet/s, " << si(f.stepsPerS) << " steps/s ("
+              << si(static_cast<double>(f.steps)) << " steps per frame)\n"
+              << "  first frame  " << fixed(firstFrameMs, 1) << " ms, after set-up " << fixed(setupMs, 1)
+              << " ms; kernel compile " << fixed(compileMs, 1) << " ms of the two\n"
+              << "  resident     " << fixed(f.bytesPerTet, 1) << " bytes/tet ("
+              << si(static_cast<double>(renderer->residentBytes())) << "B)\n"
+              << "  passes      ";
+    for (const PassTime& p : stats.passes)
+        std::cout << ' ' << p.name << ' ' << fixed(p.ms, 1) << " ms;";
+    std::cout << " (last frame)\n" << std::flush;
+
+    if (options.peer) {
+        const fs::path peerScene = prefix.string() + ".peer.json", peerMesh = prefix.string() + ".mesh.vtk";
+        writePeerMeshScene(scene, mesh, *scene.camera, peerMesh, peerScene);
+        nlohmann::json peer = runMeshPeer(peerScene, options.peerFrames > 0 ? options.peerFrames : frames, clvrPng,
+                                          prefix);
+        if (peer.contains("frame_ms")) {
+            peer["clvr_speedup"] = peer["frame_ms"].get<double>() / s.median;
+            peer["tets_per_s"] = static_cast<double>(f.tets) * 1000.0 / peer["frame_ms"].get<double>();
+            std::cout << "  VTK          " << fixed(peer["frame_ms"].get<double>(), 1) << " ms ("
+                      << peer.value("mapper", std::string("?")) << ", " << si(peer["tets_per_s"].get<double>())
+                      << " tet/s); clvr " << fixed(peer["clvr_speedup"].get<double>(), 2)
+                      << "x faster; image |diff| (8-bit levels) mean "
+                      << fixed(peer["image_diff_vs_clvr_8bit"]["mean"].get<double>(), 2) << ", max "
+                      << fixed(peer["image_diff_vs_clvr_8bit"]["max"].get<double>(), 0) << '\n';
+        } else {
+            std::cout << "  VTK          " << peer.value("error", std::string("failed")) << '\n';
+        }
+        r["peer"] = peer;
+    }
+    std::cout << '\n';
+    return r;
+}
+
+// The mesh scenes side by side: the columns of seeds/001 Tables 2-3, and VTK's when it ran.
+void printMeshTable(const nlohmann::json& scenes)
+{
+    std::ostringstream table;
+    table << std::left << std::setw(22) << "mesh scene" << std::right << std::setw(9) << "tets" << std::setw(10)
+          << "ms/frame" << std::setw(8) << "fps" << std::setw(10) << "tet/s" << std::setw(11) << "steps/s"
+          << std::setw(10) << "bytes/tet" << std::setw(10) << "first ms" << std::setw(10) << "setup ms"
+          << std::setw(10) << "VTK ms" << std::setw(8) << "x VTK" << "  integration" << '\n';
+    int rows = 0;
+    for (const nlohmann::json& r : scenes) {
+        if (r.value("kind", std::string()) != "mesh")
+            continue;
+        ++rows;
+        const bool peer = r.contains("peer") && r["peer"].contains("frame_ms");
+        table << std::left << std::setw(22) << r["name"].get<std::string>() << std::right << std::setw(9)
+              << r["tets"].get<std::uint64_t>() << std::setw(10) << fixed(r["frame_ms"].get<double>(), 1)
+              << std::setw(8) << fixed(r["fps"].get<double>(), 2) << std::setw(10)
+              << si(r["tets_per_s"].get<double>()) << std::setw(11) << si(r["steps_per_s"].get<double>())
+              << std::setw(10) << fixed(r["bytes_per_tet"].get<double>(), 1) << std::setw(10)
+              << fixed(r["first_frame_ms"].get<double>(), 0) << std::setw(10) << fixed(r["setup_ms"].get<double>(), 0)
+              << std::setw(10) << (peer ? fixed(r["peer"]["frame_ms"].get<double>(), 0) : std::string("-"))
+              << std::setw(8) << (peer ? fixed(r["peer"]["clvr_speedup"].get<double>(), 2) : std::string("-")) << "  "
+              << r["integration"].get<std::string>() << '\n';
+    }
+    if (rows > 0)
+        std::cout << table.str() << '\n';
+}
+
 #if CLVR_BENCH_RASTER
 // raster::draw on a 512x512 frame buffer: 1000 random triangles (fixed seed, splitmix64), blended
 // with SRC_ALPHA, ONE_MINUS_SRC_ALPHA, default fragment program; first draw apart, median of 5.
@@ -265,11 +444,27 @@ nlohmann::json rasterBench(Device& device)
 
 }  // namespace
 
+std::vector<std::string> benchSuiteScenes(const std::string& suite)
+{
+    const std::vector<std::string> slice3d = {"slice3d-ml256.json", "slice3d-engine.json"};
+    const std::vector<std::string> harc = {"harc-bluntfin-10.json", "harc-bluntfin-255.json", "harc-tetgen-1m.json"};
+    if (suite == "slice3d")
+        return slice3d;
+    if (suite == "harc")
+        return harc;
+    if (suite == "all") {
+        std::vector<std::string> all = slice3d;
+        all.insert(all.end(), harc.begin(), harc.end());
+        return all;
+    }
+    throw InputError("--suite: unknown suite \"" + suite + "\" (known: slice3d, harc, all)");
+}
+
 int bench(const BenchOptions& options)
 {
     std::vector<fs::path> scenes(options.scenes.begin(), options.scenes.end());
     if (scenes.empty())
-        for (const char* name : {"slice3d-ml256.json", "slice3d-engine.json"})
+        for (const std::string& name : benchSuiteScenes(options.suite))
             scenes.push_back(repoFile(fs::path("data/scenes/bench") / name));
     const int frames = std::max(options.frames, 5);
     const fs::path outJson = options.outJson;
@@ -292,7 +487,9 @@ int bench(const BenchOptions& options)
                          {"load_average_start", loadAverage()},
                          {"pocl_cache_dir", poclCache ? poclCache : "default (~/.cache/pocl)"}};
     report["frames"] = frames;
+    report["overrides"] = options.overrides;
     report["scenes"] = nlohmann::json::array();
+    bool anyVolume = false;  // the raster-stage figures go with the regular-grid scenes
     std::cout << "clvr bench on " << device.description() << "\nplatform "
               << report["machine"]["platform_version"].get<std::string>() << "\nCPU " << cpuModel() << ", "
               << std::thread::hardware_concurrency() << " cores, " << utcNow() << ", load average "
@@ -301,7 +498,12 @@ int bench(const BenchOptions& options)
     for (const fs::path& scenePath : scenes) {
         const std::string name = scenePath.stem().string();
         const fs::path prefix = outDir / ("bench." + name);
-        const Scene scene = loadScene(scenePath);
+        const Scene scene = loadScene(scenePath, options.overrides);
+        if (!scene.mesh.is_null()) {
+            report["scenes"].push_back(benchMeshScene(device, scenePath, scene, options, frames, prefix));
+            continue;
+        }
+        anyVolume = true;
         const Volume volume = loadVolume(scene.volume, scene.baseDir);
         const Camera camera = scene.camera ? *scene.camera : fitCamera(volume.boundsMin(), volume.boundsMax());
 
@@ -403,7 +605,8 @@ int bench(const BenchOptions& options)
                 stats.extra.contains("slice_spacing")
                     ? stats.extra["slice_spacing"].get<double>()
                     : planSlices(camera, volume.boundsMin(), volume.boundsMax(), Slice3dOptions{}).deltaS;
-            nlohmann::json peer = runPeer(scenePath, frames, sampleDistance, clvrPng, prefix);
+            nlohmann::json peer = runPeer(scenePath, options.peerFrames > 0 ? options.peerFrames : frames,
+                                          sampleDistance, clvrPng, prefix);
             if (peer.contains("frame_ms")) {
                 peer["clvr_speedup"] = peer["frame_ms"].get<double>() / s.median;
                 std::cout << "  VTK          " << fixed(peer["frame_ms"].get<double>(), 1) << " ms ("
@@ -421,8 +624,10 @@ int bench(const BenchOptions& options)
     }
 
 #if CLVR_BENCH_RASTER
-    report["raster"] = rasterBench(device);
-    {
+    if (!anyVolume) {
+        report["raster"] = {{"skipped", "tetrahedral-mesh scenes only"}};
+    } else {
+        report["raster"] = rasterBench(device);
         const nlohmann::json& r = report["raster"];
         std::cout << "raster (raster::draw, 512x512, 1000 random blended triangles)\n"
                   << "  draw         " << fixed(r["draw_ms"].get<double>(), 2) << " ms median (first "
@@ -436,6 +641,7 @@ int bench(const BenchOptions& options)
     report["raster"] = {{"skipped", "raster/rasterizer.h not wired into clvr bench yet"}};
 #endif
 
+    printMeshTable(report["scenes"]);
     report["machine"]["load_average_end"] = loadAverage();
     std::ofstream out(outJson);
     if (!out)

@@ -1,5 +1,6 @@
 // tools/bench.h — `clvr bench`: steady-state speed of the benchmark scenes, the plain C++ ceiling
-// loop and (with --peer) VTK on the same scenes, printed as a table and written as JSON.
+// loop and (with --peer) VTK on the same scenes, printed as a table and written as JSON. Regular-grid
+// scenes and tetrahedral-mesh scenes (tools/bench_mesh.h) alike.
 // docs/benchmarks.md says what each figure means and how it is measured.
 #pragma once
 
@@ -9,12 +10,22 @@
 namespace clvr::tools {
 
 struct BenchOptions {
-    std::vector<std::string> scenes;   // scene files; empty: data/scenes/bench/slice3d-{ml256,engine}.json
+    std::vector<std::string> scenes;   // scene files; empty: the suite's scenes (benchSuiteScenes)
+    std::string suite = "slice3d";     // without scene files: "slice3d", "harc" or "all"
     std::string outJson = "bench.json";  // figures and machine info; images go beside it
     std::string deviceSpec;            // as --device (else $CLVR_DEVICE, else the first CPU device)
     int frames = 5;                    // steady frames after the first (at least 5 are taken)
-    bool peer = false;                 // also render each scene with VTK (tools/peer_vtk.py)
+    bool peer = false;                 // also render each scene with VTK (tools/peer_vtk.py, or
+                                       // tools/peer_vtk_unstructured.py for mesh scenes)
+    int peerFrames = 0;                // the peer's steady frames; 0: as many as clvr's
+    std::string meshCache;             // TetGen meshes of surface scenes; empty: bench-data beside clvr
+    std::vector<std::string> overrides;  // --set path=json, applied to every scene (as clvr render --set),
+                                         // e.g. options.integration="full" on the harc suite
 };
+
+// The scene files (under data/scenes/bench/) a suite runs: "slice3d" -> slice3d-{ml256,engine}.json,
+// "harc" -> harc-bluntfin-{10,255}.json and harc-tetgen-1m.json, "all" -> both. InputError otherwise.
+std::vector<std::string> benchSuiteScenes(const std::string& suite);
 
 // Runs the benchmark; returns the exit status (0). Throws InputError / DeviceError like `render`.
 int bench(const BenchOptions& options);

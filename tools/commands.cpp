@@ -91,14 +91,27 @@ int run(int argc, char** argv)
     BenchOptions benchOptions;
     CLI::App* benchCommand = app.add_subcommand("bench", "run the benchmark scenes, print and write the figures");
     benchCommand->add_option("scenes", benchOptions.scenes,
-                             "scene files (default: data/scenes/bench/slice3d-{ml256,engine}.json)");
+                             "scene files (default: the --suite's scenes in data/scenes/bench/)");
+    benchCommand->add_option("--suite", benchOptions.suite,
+                             "without scene files: slice3d (slice3d-{ml256,engine}), harc (harc-bluntfin-{10,255}, "
+                             "harc-tetgen-1m) or all")
+        ->check(CLI::IsMember({"slice3d", "harc", "all"}))
+        ->capture_default_str();
     benchCommand->add_option("-o,--output", benchOptions.outJson, "figures as JSON; images go beside it")
         ->capture_default_str();
     benchCommand->add_option("--device", benchOptions.deviceSpec, deviceHelp);
     benchCommand->add_option("--frames", benchOptions.frames, "steady frames per scene after the first")
         ->check(CLI::Range(1, 100000))
         ->capture_default_str();
-    benchCommand->add_flag("--peer", benchOptions.peer, "also render each scene with VTK (tools/peer_vtk.py)");
+    benchCommand->add_flag("--peer", benchOptions.peer,
+                           "also render each scene with VTK (tools/peer_vtk.py; meshes: tools/peer_vtk_unstructured.py)");
+    benchCommand->add_option("--peer-frames", benchOptions.peerFrames, "the peer's steady frames (0: as --frames)")
+        ->check(CLI::Range(0, 100000))
+        ->capture_default_str();
+    benchCommand->add_option("--set", benchOptions.overrides,
+                             "override a value of every scene, path=json (e.g. options.integration=\"full\")");
+    benchCommand->add_option("--mesh-cache", benchOptions.meshCache,
+                             "folder for TetGen meshes of surface scenes (default: bench-data beside clvr)");
 #endif
 
     CLI::App* meshCommand = addMeshCommand(app);
