@@ -68,8 +68,14 @@ std::filesystem::path benchScene(const std::string& name)
 
 TEST(BenchMesh, BluntfinScenesHaveTheStatedControlPointsAndImageSize)
 {
-    for (const auto& [name, points] : {std::pair{"harc-bluntfin-10.json", 11}, std::pair{"harc-bluntfin-255.json", 256}}) {
+    for (const auto& [name, points] : {std::pair{"harc-bluntfin-10.json", 11}, std::pair{"harc-bluntfin-255.json", 256},
+                                       std::pair{"harc-bluntfin-10-full.json", 11}}) {
         const clvr::Scene scene = clvr::loadScene(benchScene(name));
+        // Partial pre-integration (the default) but for the -full scene, which is the 10-segment one.
+        const bool full = std::string(name).find("-full") != std::string::npos;
+        EXPECT_EQ(scene.options.is_object() ? scene.options.value("integration", std::string("partial")) : "partial",
+                  full ? "full" : "partial")
+            << name;
         EXPECT_EQ(scene.technique, "harc") << name;
         EXPECT_EQ(scene.transferFunction.points().size(), static_cast<std::size_t>(points)) << name;
         EXPECT_EQ(scene.image.width, 512) << name;

@@ -447,7 +447,8 @@ nlohmann::json rasterBench(Device& device)
 std::vector<std::string> benchSuiteScenes(const std::string& suite)
 {
     const std::vector<std::string> slice3d = {"slice3d-ml256.json", "slice3d-engine.json"};
-    const std::vector<std::string> harc = {"harc-bluntfin-10.json", "harc-bluntfin-255.json", "harc-tetgen-1m.json"};
+    const std::vector<std::string> harc = {"harc-bluntfin-10.json", "harc-bluntfin-255.json",
+                                           "harc-bluntfin-10-full.json", "harc-tetgen-1m.json"};
     if (suite == "slice3d")
         return slice3d;
     if (suite == "harc")

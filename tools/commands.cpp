@@ -94,7 +94,7 @@ int run(int argc, char** argv)
                              "scene files (default: the --suite's scenes in data/scenes/bench/)");
     benchCommand->add_option("--suite", benchOptions.suite,
                              "without scene files: slice3d (slice3d-{ml256,engine}), harc (harc-bluntfin-{10,255}, "
-                             "harc-tetgen-1m) or all")
+                             "harc-bluntfin-10-full, harc-tetgen-1m) or all")
         ->check(CLI::IsMember({"slice3d", "harc", "all"}))
         ->capture_default_str();
     benchCommand->add_option("-o,--output", benchOptions.outJson, "figures as JSON; images go beside it")

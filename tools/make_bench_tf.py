@@ -1,5 +1,7 @@
 #!/usr/bin/python3
-"""tools/make_bench_tf.py — writes the harc bench scenes data/scenes/bench/harc-bluntfin-{10,255}.json:
+"""tools/make_bench_tf.py — writes the harc bench scenes data/scenes/bench/harc-bluntfin-{10,255}.json
+(partial pre-integration) and harc-bluntfin-10-full.json (the 10-segment scene with full pre-integration,
+"integration": "full", the default 64x64x64 table):
 the bluntfin density mesh (as data/scenes/bluntfin.json: no camera, so clvr fits one to the bounds),
 512x512, and a transfer function of N linear segments (N + 1 control points) sampled from one smooth
 curve, so the two scenes show nearly the same picture and differ in how often a ray's segment in a cell
@@ -20,7 +22,8 @@ import os
 import sys
 
 S_MIN, S_MAX = 0.19, 4.98
-SEGMENTS = (10, 255)
+# (segments, integration): None is the renderer's default, partial pre-integration.
+VARIANTS = ((10, None), (255, None), (10, "full"))
 
 
 def control_points(segments):
@@ -36,7 +39,7 @@ def control_points(segments):
     return points
 
 
-def scene_text(segments):
+def scene_text(segments, integration):
     scene = {
         "technique": "harc",
         "mesh": {"file": "../../../../shared/data/bluntfin/bluntfinxyz.bin",
@@ -44,10 +47,14 @@ def scene_text(segments):
         "image": {"width": 512, "height": 512, "background": [0, 0, 0]},
         "transfer_function": {"points": control_points(segments)},
     }
+    if integration:
+        scene["options"] = {"integration": integration}
     # One key per line and one control point per line, as the hand-written scenes are laid out.
-    keys = ['  "%s": %s' % (k, json.dumps(v)) for k, v in scene.items() if k != "transfer_function"]
+    keys = ['  "%s": %s' % (k, json.dumps(v)) for k, v in scene.items() if k not in ("transfer_function", "options")]
     rows = ",\n".join("    " + json.dumps(p) for p in scene["transfer_function"]["points"])
-    return "{\n" + ",\n".join(keys) + ',\n  "transfer_function": {"points": [\n' + rows + "\n  ]}\n}\n"
+    options = ',\n  "options": %s' % json.dumps(scene["options"]) if "options" in scene else ""
+    return ("{\n" + ",\n".join(keys) + ',\n  "transfer_function": {"points": [\n' + rows + "\n  ]}" + options +
+            "\n}\n")
 
 
 def main():
@@ -56,9 +63,10 @@ def main():
     args = ap.parse_args()
     bench_dir = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data", "scenes", "bench")
     status = 0
-    for segments in SEGMENTS:
-        path = os.path.normpath(os.path.join(bench_dir, "harc-bluntfin-%d.json" % segments))
-        text = scene_text(segments)
+    for segments, integration in VARIANTS:
+        name = "harc-bluntfin-%d%s.json" % (segments, "-" + integration if integration else "")
+        path = os.path.normpath(os.path.join(bench_dir, name))
+        text = scene_text(segments, integration)
         if args.check:
             with open(path) as f:
                 if f.read() != text:
