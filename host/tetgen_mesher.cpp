@@ -143,9 +143,11 @@ TetMesh meshSurface(const fs::path& surface, const MesherOptions& options)
         mesh.points[i] = glm::dvec3(out.pointlist[3 * i], out.pointlist[3 * i + 1], out.pointlist[3 * i + 2]);
     const int corners = out.numberofcorners > 0 ? out.numberofcorners : 4;
     mesh.tets.resize(static_cast<std::size_t>(out.numberoftetrahedra));
+    // The 'z' switch numbers the output from 0 whatever the input's firstnumber; out.firstnumber still
+    // carries the input's (1 for an STL, whose load_stl numbers from 1), so it is not used here.
     for (std::size_t t = 0; t < mesh.tets.size(); ++t)
         for (int k = 0; k < 4; ++k)
-            mesh.tets[t][k] = static_cast<std::uint32_t>(out.tetrahedronlist[t * corners + k] - out.firstnumber);
+            mesh.tets[t][k] = static_cast<std::uint32_t>(out.tetrahedronlist[t * corners + k]);
     mesh.tetsRead = mesh.tets.size();
     assignScalar(mesh, options.scalar);
     checkMesh(mesh);

@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdio>
@@ -495,6 +496,48 @@ TEST(MeshIo, TetgenMesherLBlockPoly)
     expectError([&] { clvr::meshSurface(dir / "bad.off", options); }, "the surface is flat", "bad.off");
     options.scalar = "nosuch";
     expectError([&] { clvr::meshSurface(dir / "l.poly", options); }, "neither a generator");
+}
+
+// The two surface formats TetGen reads that the tests above do not use: an ASCII STL (triangles with
+// repeated corners, which TetGen merges) and a .smesh (nodes, then quadrilateral facets, no holes or
+// regions), both the unit cube: volume 1.
+TEST(MeshIo, TetgenMesherStlAndSmeshCubes)
+{
+    TempDir dir;
+    const glm::dvec3 corner[8] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+    const int quads[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+    std::ostringstream stl, smesh;
+    stl << "solid cube\n";
+    for (const auto& q : quads)
+        for (const std::array<int, 3> t : {std::array<int, 3>{q[0], q[1], q[2]}, std::array<int, 3>{q[0], q[2], q[3]}}) {
+            const glm::dvec3 n = glm::normalize(glm::cross(corner[t[1]] - corner[t[0]], corner[t[2]] - corner[t[0]]));
+            stl << "facet normal " << n.x << ' ' << n.y << ' ' << n.z << "\nouter loop\n";
+            for (const int v : t)
+                stl << "vertex " << corner[v].x << ' ' << corner[v].y << ' ' << corner[v].z << '\n';
+            stl << "endloop\nendfacet\n";
+        }
+    stl << "endsolid cube\n";
+    writeFile(dir / "cube.stl", stl.str());
+    smesh << "8 3 0 0\n";
+    for (int v = 0; v < 8; ++v)
+        smesh << v << ' ' << corner[v].x << ' ' << corner[v].y << ' ' << corner[v].z << '\n';
+    smesh << "6 0\n";
+    for (const auto& q : quads)
+        smesh << "4 " << q[0] << ' ' << q[1] << ' ' << q[2] << ' ' << q[3] << '\n';
+    smesh << "0\n0\n";
+    writeFile(dir / "cube.smesh", smesh.str());
+
+    clvr::MesherOptions options;
+    options.maxVolume = 0.01;
+    for (const char* name : {"cube.stl", "cube.smesh"}) {
+        SCOPED_TRACE(name);
+        const TetMesh meshed = clvr::meshSurface(dir / name, options);
+        expectGoodMesh(meshed, 1.0, 1e-12);
+        EXPECT_GT(meshed.tets.size(), 100u);  // the volume bound is honored
+        const glm::dvec3 lo = meshed.boundsMin(), hi = meshed.boundsMax();
+        EXPECT_EQ(lo, glm::dvec3(0.0));
+        EXPECT_EQ(hi, glm::dvec3(1.0));
+    }
 }
 
 TEST(MeshIo, SceneSurfaceIsMeshedAtLoad)
