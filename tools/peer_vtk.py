@@ -32,6 +32,8 @@ import numpy as np
 import vtk
 from vtk.util import numpy_support
 
+from peer_vtk_common import frame_figures, offscreen_view, timed_frames, volume_property, write_png
+
 
 def marschner_lobb(dims):
     """host/generators.h: grid point i at -1 + 2 i / (n - 1); f_M = 6, alpha = 0.25."""
@@ -118,12 +120,7 @@ def main():
             opacity.AddPoint(s0 + w * (s1 - s0), 1.0 - math.exp(-tau * unit_distance))
     opacity.AddPoint(points[-1][0], 1.0 - math.exp(-points[-1][4] * unit_distance))
 
-    prop = vtk.vtkVolumeProperty()
-    prop.SetColor(color)
-    prop.SetScalarOpacity(opacity)
-    prop.SetScalarOpacityUnitDistance(unit_distance)
-    prop.SetInterpolationTypeToLinear()
-    prop.ShadeOff()
+    prop = volume_property(color, opacity, unit_distance)
 
     mapper = vtk.vtkFixedPointVolumeRayCastMapper()
     mapper.SetInputData(image)
@@ -139,50 +136,9 @@ def main():
     mapper.SetSampleDistance(sample_distance)
     mapper.SetImageSampleDistance(1.0)
 
-    volume = vtk.vtkVolume()
-    volume.SetMapper(mapper)
-    volume.SetProperty(prop)
-
-    renderer = vtk.vtkRenderer()
-    renderer.AddVolume(volume)
-    renderer.SetBackground(*background)
-    window = vtk.vtkRenderWindow()
-    window.SetOffScreenRendering(1)
-    window.SetSize(width, height)
-    window.AddRenderer(renderer)
-    camera = renderer.GetActiveCamera()
-    if camera_spec is None:
-        renderer.ResetCamera()
-    else:
-        camera.SetPosition(*camera_spec["position"])
-        camera.SetFocalPoint(*camera_spec["focal_point"])
-        camera.SetViewUp(*camera_spec.get("view_up", [0, 1, 0]))
-        if camera_spec.get("projection") == "parallel":
-            camera.ParallelProjectionOn()
-            camera.SetParallelScale(camera_spec["parallel_scale"])
-        else:
-            camera.SetViewAngle(camera_spec.get("view_angle", 30.0))
-    renderer.ResetCameraClippingRange()
-
-    t0 = time.perf_counter()
-    window.Render()
-    first_ms = (time.perf_counter() - t0) * 1e3
-    times = []
-    for _ in range(max(args.frames, 1)):
-        camera.Modified()  # make sure every frame casts its rays again
-        t0 = time.perf_counter()
-        window.Render()
-        times.append((time.perf_counter() - t0) * 1e3)
-
-    grab = vtk.vtkWindowToImageFilter()
-    grab.SetInput(window)
-    grab.SetInputBufferTypeToRGB()
-    grab.ReadFrontBufferOff()
-    grab.Update()
-    writer = vtk.vtkPNGWriter()
-    writer.SetFileName(args.out_png)
-    writer.SetInputConnection(grab.GetOutputPort())
-    writer.Write()
+    window, camera = offscreen_view(mapper, prop, background, width, height, camera_spec)
+    first_ms, times = timed_frames(window, camera, args.frames)
+    write_png(window, args.out_png)
 
     result = {
         "renderer": "VTK " + vtk.vtkVersion.GetVTKVersion(),
@@ -195,11 +151,7 @@ def main():
         "sample_distance": sample_distance,
         "opacity_unit_distance": unit_distance,
         "load_ms": load_ms,
-        "first_frame_ms": first_ms,
-        "frame_ms": float(np.median(times)),
-        "frame_ms_min": min(times),
-        "frame_ms_max": max(times),
-        "frame_ms_all": times,
+        **frame_figures(first_ms, times),
         "image": args.out_png,
     }
     with open(args.out_json, "w") as f:

@@ -35,6 +35,8 @@ import numpy as np
 import vtk
 from vtk.util import numpy_support
 
+from peer_vtk_common import frame_figures, offscreen_view, timed_frames, volume_property, write_png
+
 
 def read_tetgen(path):
     """BASE.node / BASE.ele (0- or 1-based by the first node's number); scalar = first node attribute."""
@@ -128,12 +130,7 @@ def main():
         if not math.isclose(opacity.GetValue(s), tau * unit_distance, rel_tol=1e-9, abs_tol=1e-12):
             raise SystemExit("peer_vtk_unstructured.py: VTK's opacity function changed tau at s = %g" % s)
 
-    prop = vtk.vtkVolumeProperty()
-    prop.SetColor(color)
-    prop.SetScalarOpacity(opacity)
-    prop.SetScalarOpacityUnitDistance(unit_distance)
-    prop.SetInterpolationTypeToLinear()
-    prop.ShadeOff()
+    prop = volume_property(color, opacity, unit_distance)
 
     mapper = vtk.vtkUnstructuredGridVolumeRayCastMapper()
     mapper.SetInputData(grid)
@@ -141,26 +138,7 @@ def main():
     mapper.SetAutoAdjustSampleDistances(0)
     mapper.SetImageSampleDistance(1.0)
 
-    volume = vtk.vtkVolume()
-    volume.SetMapper(mapper)
-    volume.SetProperty(prop)
-
-    renderer = vtk.vtkRenderer()
-    renderer.AddVolume(volume)
-    renderer.SetBackground(*background)
-    window = vtk.vtkRenderWindow()
-    window.SetOffScreenRendering(1)
-    window.SetSize(width, height)
-    window.AddRenderer(renderer)
-    camera = renderer.GetActiveCamera()
-    camera.SetPosition(*camera_spec["position"])
-    camera.SetFocalPoint(*camera_spec["focal_point"])
-    camera.SetViewUp(*camera_spec.get("view_up", [0, 1, 0]))
-    if camera_spec.get("projection") == "parallel":
-        camera.ParallelProjectionOn()
-        camera.SetParallelScale(camera_spec["parallel_scale"])
-    else:
-        camera.SetViewAngle(camera_spec.get("view_angle", 30.0))
+    window, camera = offscreen_view(mapper, prop, background, width, height, camera_spec)
     if args.pixel_corners == 0:
         # vtkUnstructuredGridBunykRayCastFunction casts the ray of pixel (i, j) through the point that
         # projects to x = i, y = j (TransformPoints: (ndc + 1) / 2 * size; ComputePixelIntersections tests
@@ -168,27 +146,8 @@ def main():
         # pixel up and right. The camera's window centre shifts the projection: ndc' = ndc - centre, so a
         # centre of one pixel's NDC width puts VTK's rays through the same points as clvr's.
         camera.SetWindowCenter(1.0 / width, 1.0 / height)
-    renderer.ResetCameraClippingRange()
-
-    t0 = time.perf_counter()
-    window.Render()
-    first_ms = (time.perf_counter() - t0) * 1e3
-    times = []
-    for _ in range(max(args.frames, 1)):
-        camera.Modified()  # every frame casts its rays again
-        t0 = time.perf_counter()
-        window.Render()
-        times.append((time.perf_counter() - t0) * 1e3)
-
-    grab = vtk.vtkWindowToImageFilter()
-    grab.SetInput(window)
-    grab.SetInputBufferTypeToRGB()
-    grab.ReadFrontBufferOff()
-    grab.Update()
-    writer = vtk.vtkPNGWriter()
-    writer.SetFileName(args.out_png)
-    writer.SetInputConnection(grab.GetOutputPort())
-    writer.Write()
+    first_ms, times = timed_frames(window, camera, args.frames)
+    write_png(window, args.out_png)
 
     tets = grid.GetNumberOfCells()
     frame_ms = float(np.median(times))
@@ -204,11 +163,7 @@ def main():
         "opacity_unit_distance": unit_distance,
         "rays_through": "pixel corners" if args.pixel_corners else "pixel centres (window centre shifted half a pixel)",
         "load_ms": load_ms,
-        "first_frame_ms": first_ms,
-        "frame_ms": frame_ms,
-        "frame_ms_min": min(times),
-        "frame_ms_max": max(times),
-        "frame_ms_all": times,
+        **frame_figures(first_ms, times),
         "fps": 1000.0 / frame_ms,
         "tets_per_s": tets * 1000.0 / frame_ms,
         "image": args.out_png,
