@@ -171,6 +171,41 @@ TEST(Slice3dClip, InverseMatchesClippedReference)
     checkClip(makeScene(parallelCamera(), {{"mesh", kTorus}, {"inverse", true}}), 6, "torus_inverse_parallel");
 }
 
+// Front to back blends the same clipped slices in the other order: float rounding only (as
+// tests/slice3d_test.cpp's BackToFrontEqualsFrontToBack: 5e-5 max, 5e-6 mean), and it must be clipped
+// too, so it also meets the clipped reference.
+TEST(Slice3dClip, FrontToBackEqualsBackToFront)
+{
+    Scene scene = makeScene(perspectiveCamera(), {{"mesh", kTorus}}, 256);
+    const Image4f btf = render(scene);
+    scene.options["order"] = "front-to-back";
+    const Image4f ftb = render(scene);
+    Image4d want(btf.width(), btf.height());
+    for (std::size_t i = 0; i < btf.pixelCount(); ++i)
+        want.pixels()[i] = glm::dvec4(btf.pixels()[i]);
+    report("torus front-to-back vs back-to-front", test::imageError(ftb, want));
+    EXPECT_TRUE(test::imagesNear(ftb, want, {.maxAbs = 5e-5, .meanAbs = 5e-6}));
+    EXPECT_TRUE(test::imagesNear(ftb, clippedReference(scene), clipTolerance(scene, 6)));
+}
+
+// The camera inside the volume and inside the clip sphere: every face it sees is a back face, the
+// slices start at the camera, and the reference integrates from the camera on (4 boundaries: the
+// camera, the sphere, the box, with margin).
+TEST(Slice3dClip, CameraInsideTheMeshMatchesClippedReference)
+{
+    Camera camera;
+    camera.position = {0.2, 0.1, 0.45};
+    camera.focalPoint = {-0.1, -0.2, -1.0};
+    camera.viewAngle = 70.0;
+    const json sphere = {{"generator", "sphere"}, {"center", {0.1, 0.0, 0.2}}, {"radius", 0.6}, {"segments", 48}};
+    Scene scene = makeScene(camera, {{"mesh", sphere}});
+    scene.options.erase("slices");
+    scene.options["slice_spacing"] = 0.004;
+    checkClip(scene, 4, "camera_inside_sphere");
+    scene.options["clip"]["inverse"] = true;
+    checkClip(scene, 4, "camera_inside_sphere_inverse");
+}
+
 // The paper's Figure 2: back faces alone mark every pixel with some of the mesh behind the slice,
 // so the volume in front of the torus (and in its hole, in front of its far side) is kept as if it
 // were inside. Its error must be far above the tolerance the two-pass method meets.
