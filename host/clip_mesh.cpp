@@ -1,5 +1,5 @@
 // host/clip_mesh.cpp — clip surfaces: the scene's "mesh" spec, the readers (tetgenio for .off/.stl, a
-// small one for .obj), the generators, the closedness check, and ray parity for the CPU reference.
+// small one for .obj and binary .stl), the generators, the closedness check, and ray parity for the CPU reference.
 #include "host/clip_mesh.h"
 
 #include "host/errors.h"
@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <numbers>
@@ -113,6 +114,50 @@ ClipMesh readObj(const fs::path& path)
             addPolygon(mesh, polygon);
         }
         // vt, vn, o, g, s, usemtl, mtllib, l, ...: not geometry of a closed surface; ignored.
+    }
+    return mesh;
+}
+
+// Binary STL, which tetgenio::load_stl does not read: an 80-byte header, a little-endian uint32
+// triangle count, then per triangle 12 floats (normal, 3 corners) and a 2-byte attribute count.
+// Recognised by its exact size, 84 + 50 n (an ASCII file of that size would have to start "solid"
+// and still match by chance).
+bool isBinaryStl(const fs::path& path, std::uint32_t& count)
+{
+    std::ifstream in(path, std::ios::binary);
+    char header[84];
+    if (!in.read(header, 84))
+        return false;
+    count = static_cast<std::uint32_t>(static_cast<unsigned char>(header[80])) |
+            static_cast<std::uint32_t>(static_cast<unsigned char>(header[81])) << 8 |
+            static_cast<std::uint32_t>(static_cast<unsigned char>(header[82])) << 16 |
+            static_cast<std::uint32_t>(static_cast<unsigned char>(header[83])) << 24;
+    return fs::file_size(path) == 84 + 50ull * count;
+}
+
+ClipMesh readBinaryStl(const fs::path& path, std::uint32_t count)
+{
+    std::ifstream in(path, std::ios::binary);
+    in.seekg(84);
+    ClipMesh mesh;
+    mesh.source = path.string();
+    for (std::uint32_t t = 0; t < count; ++t) {
+        unsigned char record[50];
+        if (!in.read(reinterpret_cast<char*>(record), 50))
+            throw InputError(path.string() + ": binary STL ends inside triangle " + std::to_string(t));
+        const std::uint32_t base = static_cast<std::uint32_t>(mesh.points.size());
+        for (int corner = 0; corner < 3; ++corner) {
+            glm::dvec3 p;
+            for (int axis = 0; axis < 3; ++axis) {
+                const unsigned char* b = record + 12 + 12 * corner + 4 * axis;
+                const std::uint32_t bits = b[0] | b[1] << 8 | b[2] << 16 | static_cast<std::uint32_t>(b[3]) << 24;
+                float f;
+                std::memcpy(&f, &bits, 4);
+                p[axis] = f;
+            }
+            mesh.points.push_back(p);
+        }
+        mesh.triangles.push_back({base, base + 1, base + 2});
     }
     return mesh;
 }
@@ -250,6 +295,9 @@ ClipMesh readSurface(const fs::path& path)
     const std::string ext = lower(path.extension().string());
     if (ext == ".obj")
         return readObj(path);
+    std::uint32_t count = 0;
+    if (ext == ".stl" && isBinaryStl(path, count))
+        return readBinaryStl(path, count);
     if (ext == ".off" || ext == ".stl")
         return readWithTetgen(path, ext);
     throw InputError(path.string() + ": unknown surface format \"" + ext + "\" (.off, .stl, .obj)");

@@ -1,6 +1,6 @@
 // host/clip_mesh.h — closed triangle meshes that clip a volume (§2.1 of seeds/000_354856c7f65dc3f9.txt):
-// read from .off/.stl (TetGen's tetgenio readers, as host/tetgen_mesher.cpp) or .obj, or generated (box,
-// sphere, cylinder); checked closed and oriented outward; and, for the CPU reference, the parts of a
+// read from .off/ASCII .stl (TetGen's tetgenio readers, as host/tetgen_mesher.cpp), binary .stl or .obj,
+// or generated (box, sphere, cylinder); checked closed and oriented outward; and, for the CPU reference, the parts of a
 // ray inside the mesh by ray parity in double. slice3d draws them into the stencil buffer
 // (docs/slice3d.md, "Clipping with closed meshes").
 #pragma once
@@ -51,8 +51,9 @@ ClipMeshSpec parseClipMeshSpec(const nlohmann::json& spec, const std::string& ke
 ClipMesh loadClipMesh(const ClipMeshSpec& spec, const std::filesystem::path& baseDir);
 
 // A triangle surface as the file holds it (polygons fanned into triangles), not yet checked.
-// .off and .stl through tetgenio (load_off / load_stl); .obj ("v x y z", "f a b c ..." with a, a/t,
-// a/t/n or a//n, 1-based or negative; other statements ignored) by clvr.
+// .off and ASCII .stl through tetgenio (load_off / load_stl); binary .stl (which tetgenio does not
+// read) and .obj ("v x y z", "f a b c ..." with a, a/t, a/t/n or a//n, 1-based or negative; other
+// statements ignored) by clvr.
 ClipMesh readSurface(const std::filesystem::path& path);
 
 // Generated surfaces, counter-clockwise seen from outside. The sphere is a UV sphere of `segments`

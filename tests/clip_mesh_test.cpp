@@ -1,6 +1,6 @@
 // tests/clip_mesh_test.cpp — clip surfaces (host/clip_mesh.h): generators closed and facing out with
-// the right volume, the readers (.off and .stl through tetgenio, .obj), the closedness check, the
-// scene spec's errors, and ray parity (watertight at shared edges and points) against analytic shapes.
+// the right volume, the readers (.off and ASCII .stl through tetgenio, binary .stl and .obj by clvr),
+// the closedness check, the scene spec's errors, and ray parity (watertight at shared edges and points) against analytic shapes.
 #include "host/clip_mesh.h"
 
 #include "host/errors.h"
@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstring>
 #include <functional>
 #include <numbers>
 
@@ -96,7 +97,7 @@ TEST(ClipMesh, ReadsTheTorusOff)
     EXPECT_GT(signedVolume(torus), 0.97 * exact);
 }
 
-TEST(ClipMesh, ReadsObjAndStlWithPlacement)
+TEST(ClipMesh, ReadsObjAndAsciiAndBinaryStlWithPlacement)
 {
     test::TempDir dir;
     // A unit cube as OBJ quads, with texture/normal indices, a negative index, and ignored statements.
@@ -127,6 +128,33 @@ TEST(ClipMesh, ReadsObjAndStlWithPlacement)
     const ClipMesh read = loadClipMesh(parseClipMeshSpec("box.stl", "mesh"), dir.path());
     EXPECT_EQ(read.points.size(), 8u);
     EXPECT_NEAR(signedVolume(read), 8.0, 1e-12);
+
+    // The same box as binary STL (little-endian floats), which tetgenio cannot read.
+    std::string binary(80, ' ');
+    auto u32 = [&](std::uint32_t v) {
+        for (int i = 0; i < 4; ++i)
+            binary += static_cast<char>((v >> (8 * i)) & 0xff);
+    };
+    auto f32 = [&](float f) {
+        std::uint32_t v;
+        std::memcpy(&v, &f, 4);
+        u32(v);
+    };
+    u32(static_cast<std::uint32_t>(box.triangles.size()));
+    for (const auto& t : box.triangles) {
+        for (int i = 0; i < 3; ++i)
+            f32(0.0f);
+        for (std::uint32_t i : t)
+            for (int axis = 0; axis < 3; ++axis)
+                f32(static_cast<float>(box.points[i][axis]));
+        binary += std::string(2, '\0');
+    }
+    test::writeFile(dir / "box-binary.stl", binary);
+    const ClipMesh readBinary = loadClipMesh(parseClipMeshSpec("box-binary.stl", "mesh"), dir.path());
+    EXPECT_EQ(readBinary.points.size(), 8u);
+    EXPECT_NEAR(signedVolume(readBinary), 8.0, 1e-12);
+    test::writeFile(dir / "cut-binary.stl", binary.substr(0, binary.size() - 10));  // neither binary nor ASCII
+    expectInputError([&] { readSurface(dir / "cut-binary.stl"); }, "cut-binary.stl: TetGen's reader could not read a surface");
 
     test::writeFile(dir / "bad.obj", "v 0 0 0\nv 1 0 0\nf 1 2 3\n");
     expectInputError([&] { readSurface(dir / "bad.obj"); }, "bad.obj:3: face index 3 names no vertex read so far (2)");
