@@ -243,6 +243,7 @@ ClipMeshSpec parseClipMeshSpec(const json& spec, const std::string& key)
         if (spec.contains("scale")) {
             const json& v = spec["scale"];
             s.scale = v.is_number() ? glm::dvec3(v.get<double>()) : vec3(v, key + ".scale");
+            // Zero would flatten the mesh; negative mirrors it (closeClipMesh then turns it outward again).
             if (!std::isfinite(s.scale.x) || s.scale.x == 0.0 || s.scale.y == 0.0 || s.scale.z == 0.0)
                 badKey(key + ".scale", "must be a finite non-zero number or [x, y, z] of them, got " + v.dump());
         }
