@@ -132,13 +132,20 @@ Image4d referenceIntegral(const Volume& volume, const TransferFunction& tf, cons
                 glm::dvec4 v(0.0);
                 double t0, t1;
                 if (clipRayToBox(ray, lo, hi, 0.0, t0, t1)) {
-                    const RayResult r = integrateRay(volume, tf, ray, t0, t1, options);
-                    v = r.value;
+                    const std::vector<glm::dvec2> pieces =
+                        options.intervals ? options.intervals(ray, t0, t1) : std::vector<glm::dvec2>{{t0, t1}};
+                    bool converged = true;
+                    for (const glm::dvec2& piece : pieces) {
+                        const RayResult r = integrateRay(volume, tf, ray, piece.x, piece.y, options);
+                        // Front to back: the piece is seen through the transmittance 1 - A of those before it.
+                        v = glm::dvec4(glm::dvec3(v) + (1.0 - v.a) * glm::dvec3(r.value), v.a + (1.0 - v.a) * r.value.a);
+                        local.samples += r.samples;
+                        local.maxSegments = std::max(local.maxSegments, r.segments);
+                        converged = converged && r.converged;
+                        local.maxResidual = std::max(local.maxResidual, r.residual);
+                    }
                     ++local.rays;
-                    local.samples += r.samples;
-                    local.maxSegments = std::max(local.maxSegments, r.segments);
-                    local.raysNotConverged += r.converged ? 0 : 1;
-                    local.maxResidual = std::max(local.maxResidual, r.residual);
+                    local.raysNotConverged += converged ? 0 : 1;
                 }
                 // Final pixel of DESIGN.md: I + (1 - A) * background, alpha = A.
                 out.at(x, y) = glm::dvec4(glm::dvec3(v) + (1.0 - v.a) * image.background, v.a);

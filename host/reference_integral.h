@@ -12,6 +12,8 @@
 #include "host/volume.h"
 
 #include <cstdint>
+#include <functional>
+#include <vector>
 
 namespace clvr {
 
@@ -34,6 +36,10 @@ struct ReferenceOptions {
     int maxSegmentsPerRay = 1 << 20;
     int threads = 2;                     // std::thread workers over rows (<= 0: hardware_concurrency)
     ReferenceStats* stats = nullptr;     // filled when not null
+    // When set, only these sub-intervals of a ray's chord [t0, t1] count (in increasing order, within
+    // [t0, t1]): each is integrated (and converged) on its own and the pieces are composited front to
+    // back; the medium elsewhere is taken as empty. Clipping uses it (host/clip_mesh.h: clipIntervals).
+    std::function<std::vector<glm::dvec2>(const Ray& ray, double t0, double t1)> intervals;
 };
 
 // Integrates every pixel of an image.width x image.height image; the result pixel is

@@ -131,6 +131,14 @@ expect_error(2 "${WORK}/out.jpg" "out.jpg: unsupported image format \"\\.jpg\"" 
 expect_error(2 "${WORK}/no-dir/out.png" "no-dir/out.png: directory .*no-dir does not exist"
   ${CLVR} render -o ${WORK}/no-dir/out.png ${SMALL})
 expect_error(2 ${out} "default scene: image.width must be in 1..16384, got 0" ${CLVR} render -o ${out} --set image.width=0)
+# slice3d clip meshes (docs/slice3d.md): a bad key, a missing file, an open surface.
+expect_error(2 ${out} "options.clip.mesh.generator: must be \"box\", \"sphere\" or \"cylinder\""
+  ${CLVR} render -o ${out} ${SMALL} --set "options.clip={\"mesh\": {\"generator\": \"cone\"}}")
+expect_error(2 ${out} "no-such-mesh.off: no such file \\(clip mesh\\)"
+  ${CLVR} render -o ${out} ${SMALL} --set "options.clip={\"mesh\": \"${WORK}/no-such-mesh.off\"}")
+file(WRITE "${WORK}/open.obj" "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\n")
+expect_error(2 ${out} "open.obj: the clip mesh is not a closed, consistently oriented surface"
+  ${CLVR} render -o ${out} ${SMALL} --set "options.clip={\"mesh\": \"${WORK}/open.obj\"}")
 expect_error(2 ${out} "default scene: technique: unknown technique \"no-such-technique\"" ${CLVR} render -o ${out} ${SMALL} --set technique=no-such-technique)
 file(WRITE "${WORK}/nodata.json" [=[{
   "volume": {"file": "data/not-there.nrrd"},

@@ -161,6 +161,44 @@ TEST(ReferenceIntegral, LinearRampPerspectiveConverges) { checkLinearRamp(perspe
 
 TEST(ReferenceIntegral, LinearRampParallelConverges) { checkLinearRamp(parallelCamera()); }
 
+// ReferenceOptions::intervals (clipping): only the given pieces of the chord count. A constant
+// medium over the first and last thirds of each chord gives A = 1 - exp(-tau 2L/3) and I = C A
+// (the pieces composited front to back); no pieces give the background exactly.
+TEST(ReferenceIntegral, IntervalsIntegrateOnlyTheirPieces)
+{
+    const glm::dvec3 lo(-1.0, -0.8, -0.6), hi(0.9, 1.0, 0.7);
+    const Volume v = makeVolume({5, 6, 7}, lo, hi, [](glm::dvec3) { return 0.5; });
+    const glm::dvec3 color(0.9, 0.5, 0.2);
+    const double tau = 1.7;
+    const ImageSpec spec{32, 24, {0.1, 0.2, 0.3}};
+    const Camera camera = perspectiveCamera();
+    ReferenceOptions options;
+    options.intervals = [](const Ray&, double t0, double t1) {
+        const double third = (t1 - t0) / 3.0;
+        return std::vector<glm::dvec2>{{t0, t0 + third}, {t1 - third, t1}};
+    };
+    const Image4d img = referenceIntegral(v, constantTf(color, tau), camera, spec, options);
+    double worst = 0.0;
+    int hits = 0;
+    for (int y = 0; y < spec.height; ++y)
+        for (int x = 0; x < spec.width; ++x) {
+            const Ray ray = camera.ray(x, y, spec.width, spec.height);
+            double t0 = 0, t1 = 0, length = 0.0;
+            if (chordByBisection(ray, lo, hi, t0, t1)) {
+                length = 2.0 * (t1 - t0) / 3.0;
+                ++hits;
+            }
+            const double a = 1.0 - std::exp(-tau * length);
+            const glm::dvec4 d = glm::abs(img.at(x, y) - glm::dvec4(color * a + (1.0 - a) * spec.background, a));
+            worst = std::max({worst, d.r, d.g, d.b, d.a});
+        }
+    EXPECT_GT(hits, spec.width * spec.height / 8);
+    EXPECT_LT(worst, 1e-6);
+    options.intervals = [](const Ray&, double, double) { return std::vector<glm::dvec2>{}; };
+    for (const glm::dvec4& p : referenceIntegral(v, constantTf(color, tau), camera, spec, options).pixels())
+        ASSERT_EQ(p, glm::dvec4(spec.background, 0.0));
+}
+
 TEST(ReferenceIntegral, EmptyVolumeGivesBackgroundExactly)
 {
     const Volume v = makeVolume({4, 4, 4}, glm::dvec3(-1.0), glm::dvec3(1.0), [](glm::dvec3 p) { return p.x; });

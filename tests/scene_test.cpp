@@ -360,7 +360,8 @@ TEST(Scene, DefaultSceneTakesOverrides)
 
 TEST(Scene, ExampleScenesParse)
 {
-    for (const char* name : {"scenes/default.json", "scenes/headsq.json", "scenes/engine.json"}) {
+    for (const char* name : {"scenes/default.json", "scenes/headsq.json", "scenes/engine.json",
+                             "scenes/engine-clip-sphere.json", "scenes/engine-clip-torus.json"}) {
         SCOPED_TRACE(name);
         EXPECT_NO_THROW(clvr::loadScene(clvr::test::repoData(name)));
     }

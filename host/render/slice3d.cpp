@@ -18,7 +18,8 @@ namespace clvr {
 namespace {
 
 constexpr int kMaxSlices = 65536;
-constexpr const char* kKnownOptions = "slices, slice_spacing, order, early_termination, path, empty_space_skipping, voxel_type";
+constexpr const char* kKnownOptions =
+    "slices, slice_spacing, order, early_termination, path, empty_space_skipping, voxel_type, clip";
 
 [[noreturn]] void badOption(const std::string& key, const std::string& what)
 {
@@ -40,6 +41,8 @@ public:
 private:
     Image4f renderFused(FrameStats& stats);
     Image4f renderRaster(FrameStats& stats);
+    raster::DrawStats drawClipped(const std::vector<raster::Vertex>& slices, const std::vector<std::size_t>& firsts,
+                                  const raster::DrawState& sliceState, const glm::dmat4& viewProjection);
     cl_float4 cameraParams() const;
 
     Device& device_;
@@ -66,6 +69,9 @@ private:
     std::unique_ptr<raster::Framebuffer> framebuffer_;
     raster::FragmentProgram fragmentProgram_;
     cl::Kernel overBackground_;
+    // Clipping (raster path): the closed mesh and its farthest eye depth.
+    std::optional<ClipMesh> clipMesh_;
+    double clipDepthMax_ = 0.0;
 };
 
 Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volume& volume)
@@ -84,6 +90,12 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
     if (image_.width < 1 || image_.height < 1)
         throw InputError("image: width and height must be >= 1");
     plan_ = planSlices(camera_, lo_, hi_, options_);
+    if (options_.clip) {
+        clipMesh_ = loadClipMesh(options_.clip->mesh, scene.baseDir);
+        clipDepthMax_ = -std::numeric_limits<double>::infinity();
+        for (const glm::dvec3& p : clipMesh_->points)
+            clipDepthMax_ = std::max(clipDepthMax_, glm::dot(camera_.forward(), p - camera_.position));
+    }
 
     // On the fused path with voxel_type auto, uint8 or uint16 when every value is an integer in that
     // range (1 or 2 bytes per grid point, converted to float exactly in the kernel); else float32, 4
@@ -258,13 +270,16 @@ Image4f Slice3dRenderer::renderFused(FrameStats& stats)
 Image4f Slice3dRenderer::renderRaster(FrameStats& stats)
 {
     const bool frontToBack = options_.order == Slice3dOptions::Order::FrontToBack;
-    // Clip-space vertices of every slice polygon, fanned into a triangle list, in blending order.
+    // Clip-space vertices of every slice polygon, fanned into a triangle list, in blending order;
+    // firsts[i] is where the i-th slice drawn begins. The far plane lies beyond the box and the clip
+    // mesh (its back faces must not be cut); x, y and w do not depend on it, so neither do the slices.
     const glm::dvec3 forward = camera_.forward();
     const double nearZ = 0.5 * plan_.depth(0);
-    const double farZ = 2.0 * plan_.depthMax + 1.0;
+    const double farZ = 2.0 * std::max(plan_.depthMax, clipMesh_ ? clipDepthMax_ : 0.0) + 1.0;
     const glm::dmat4 viewProjection =
         camera_.projectionMatrix(image_.width, image_.height, nearZ, farZ) * camera_.viewMatrix();
     std::vector<raster::Vertex> vertices;
+    std::vector<std::size_t> firsts;
     vertices.reserve(static_cast<std::size_t>(plan_.count) * 12);
     for (int i = 0; i < plan_.count; ++i) {
         const int k = frontToBack ? i : plan_.count - 1 - i;
@@ -276,12 +291,14 @@ Image4f Slice3dRenderer::renderRaster(FrameStats& stats)
             v.attributes[0] = glm::vec4(glm::vec3(p), 1.0f);
             return v;
         };
+        firsts.push_back(vertices.size());
         for (std::size_t j = 1; j + 1 < polygon.size(); ++j) {
             vertices.push_back(vertex(polygon[0]));
             vertices.push_back(vertex(polygon[j]));
             vertices.push_back(vertex(polygon[j + 1]));
         }
     }
+    firsts.push_back(vertices.size());
     raster::DrawState state;
     state.fragment.blend.enabled = true;
     if (frontToBack) {  // "under": dst += (1 - dst.a) src
@@ -293,7 +310,9 @@ Image4f Slice3dRenderer::renderRaster(FrameStats& stats)
     }
     framebuffer_->clearColor(device_, glm::vec4(0.0f));
     raster::DrawStats drawStats;
-    if (!vertices.empty())
+    if (clipMesh_)
+        drawStats = drawClipped(vertices, firsts, state, viewProjection);
+    else if (!vertices.empty())
         drawStats = raster::draw(device_, *framebuffer_, state, raster::Topology::Triangles, vertices, fragmentProgram_);
     const std::size_t pixels = framebuffer_->pixelCount();
     overBackground_.setArg(0, framebuffer_->color());
@@ -304,7 +323,127 @@ Image4f Slice3dRenderer::renderRaster(FrameStats& stats)
     stats.passes = device_.takePassTimes();
     stats.samples = drawStats.fragments;  // fragments of slice polygons; those outside the grid are discarded
     stats.extra["triangles"] = drawStats.triangles;
+    if (clipMesh_) {
+        stats.extra["clip_triangles"] = clipMesh_->triangles.size();
+        stats.extra["clip_method"] = options_.clip->method == Slice3dClip::Method::TwoPass ? "two-pass" : "naive";
+        stats.extra["clip_inverse"] = options_.clip->inverse;
+    }
     return image;
+}
+
+// §2.1 of seeds/000, one slice at a time (docs/slice3d.md, "Clipping with closed meshes"). For a
+// pixel, the slice's point P is inside the closed mesh iff the first surface the ray meets beyond P
+// is a back face (the ray leaves there). So, with a user clip plane at the slice plane keeping only
+// what lies behind it:
+//   1. back faces, depth test LESS with depth writes, stencil := 1: the stencil marks pixels with any
+//      back face behind P, and the depth buffer holds the nearest one;
+//   2. front faces, depth test LESS without writes, stencil := 0 where one is in front of that
+//      nearest back face: the ray enters the mesh before it first leaves it, so P is outside
+//      (the naive method stops after 1 and keeps these pixels, Figure 2's error);
+//   3. the slice polygon where stencil == 1 (inside), or == 0 (inverse), blended as without clipping.
+raster::DrawStats Slice3dRenderer::drawClipped(const std::vector<raster::Vertex>& slices,
+                                               const std::vector<std::size_t>& firsts,
+                                               const raster::DrawState& sliceState, const glm::dmat4& viewProjection)
+{
+    const bool frontToBack = options_.order == Slice3dOptions::Order::FrontToBack;
+    const bool twoPass = options_.clip->method == Slice3dClip::Method::TwoPass;
+    const bool inverse = options_.clip->inverse;
+    std::vector<raster::Vertex> mesh;
+    mesh.reserve(clipMesh_->triangles.size() * 3);
+    for (const auto& t : clipMesh_->triangles)
+        for (std::uint32_t i : t) {
+            raster::Vertex v;
+            v.position = glm::vec4(viewProjection * glm::dvec4(clipMesh_->points[i], 1.0));
+            mesh.push_back(v);
+        }
+
+    raster::DrawState back;  // pass 1: no color writes, only stencil (and depth for pass 2)
+    back.fragment.colorMask = {false, false, false, false};
+    back.fragment.cull = raster::CullFace::Front;
+    back.fragment.stencil.test = true;
+    back.fragment.stencil.func = raster::CompareFunc::Always;
+    back.fragment.stencil.ref = 1;
+    back.fragment.stencil.dppass = raster::StencilOp::Replace;
+    back.fragment.depth.test = twoPass;
+    back.fragment.depth.func = raster::CompareFunc::Less;
+    back.fragment.depth.write = true;
+    raster::DrawState front = back;  // pass 2: clear where a front face is nearer than the nearest back face
+    front.fragment.cull = raster::CullFace::Back;
+    front.fragment.stencil.func = raster::CompareFunc::Equal;
+    front.fragment.stencil.dppass = raster::StencilOp::Zero;
+    front.fragment.depth.write = false;
+    raster::DrawState slice = sliceState;  // pass 3
+    slice.fragment.stencil.test = true;
+    slice.fragment.stencil.func = raster::CompareFunc::Equal;
+    slice.fragment.stencil.ref = inverse ? 0 : 1;
+
+    raster::DrawStats total;
+    const glm::dmat4 planeToClip = glm::transpose(glm::inverse(viewProjection));
+    for (int i = 0; i < plan_.count; ++i) {
+        if (firsts[i] == firsts[i + 1])
+            continue;  // the plane misses the box
+        const int k = frontToBack ? i : plan_.count - 1 - i;
+        const double offset = glm::dot(camera_.forward(), camera_.position) + plan_.depth(k);
+        const std::vector<raster::Vertex> polygon(slices.begin() + static_cast<std::ptrdiff_t>(firsts[i]),
+                                                  slices.begin() + static_cast<std::ptrdiff_t>(firsts[i + 1]));
+        raster::DrawState sliceHere = slice;
+        if (plan_.depth(k) >= clipDepthMax_) {
+            // No part of the mesh lies behind this slice: every point of it is outside (the passes
+            // would leave the stencil all 0), so skip them.
+            if (!inverse)
+                continue;
+            sliceHere.fragment.stencil.test = false;
+        } else {
+            framebuffer_->clearStencil(device_, 0);
+            if (twoPass)
+                framebuffer_->clearDepth(device_, 1.0f);
+            // Keep dot(forward, p) >= offset: the part of the mesh behind the slice plane. As
+            // raster::clipPlaneFromWorld, but in double (offset may be large next to the box).
+            back.clipPlanes = front.clipPlanes = {glm::vec4(planeToClip * glm::dvec4(camera_.forward(), -offset))};
+            raster::draw(device_, *framebuffer_, back, raster::Topology::Triangles, mesh);
+            if (twoPass)
+                raster::draw(device_, *framebuffer_, front, raster::Topology::Triangles, mesh);
+        }
+        const raster::DrawStats d =
+            raster::draw(device_, *framebuffer_, sliceHere, raster::Topology::Triangles, polygon, fragmentProgram_);
+        total.triangles += d.triangles;
+        total.fragments += d.fragments;
+    }
+    return total;
+}
+
+}  // namespace
+
+namespace {
+
+// options.clip: {"mesh": ..., "inverse": false, "method": "two-pass"|"naive"}; docs/slice3d.md.
+Slice3dClip parseClip(const nlohmann::json& value)
+{
+    if (!value.is_object())
+        badOption("clip", "must be an object such as {\"mesh\": \"torus.off\"}, got " + value.dump());
+    if (!value.contains("mesh"))
+        badOption("clip.mesh", "is missing (a surface file, or {\"generator\": \"box\"|\"sphere\"|\"cylinder\", ...})");
+    Slice3dClip clip;
+    for (const auto& [key, v] : value.items()) {
+        if (key == "mesh") {
+            clip.mesh = parseClipMeshSpec(v, "options.clip.mesh");
+        } else if (key == "inverse") {
+            if (!v.is_boolean())
+                badOption("clip.inverse", "must be true or false, got " + v.dump());
+            clip.inverse = v.get<bool>();
+        } else if (key == "method") {
+            const std::string m = v.is_string() ? v.get<std::string>() : "";
+            if (m == "two-pass")
+                clip.method = Slice3dClip::Method::TwoPass;
+            else if (m == "naive")
+                clip.method = Slice3dClip::Method::Naive;
+            else
+                badOption("clip.method", "must be \"two-pass\" or \"naive\", got " + v.dump());
+        } else {
+            badOption("clip." + key, "unknown key (known: mesh, inverse, method)");
+        }
+    }
+    return clip;
 }
 
 }  // namespace
@@ -360,9 +499,18 @@ Slice3dOptions parseSlice3dOptions(const nlohmann::json& options)
             if (!value.is_boolean())
                 badOption(key, "must be true or false, got " + value.dump());
             o.emptySpaceSkipping = value.get<bool>();
+        } else if (key == "clip") {
+            o.clip = parseClip(value);
         } else {
             badOption(key, std::string("unknown option for slice3d (known: ") + kKnownOptions + ")");
         }
+    }
+    if (o.clip) {
+        // The stencil passes run per slice, between the slice polygons: only the raster path has them.
+        if (options.contains("path") && o.path == Slice3dOptions::Path::Fused)
+            badOption("clip", "needs \"path\": \"raster\" (the clip mesh is drawn into the stencil buffer per slice; "
+                              "the fused kernel has no stencil), got \"path\": \"fused\"");
+        o.path = Slice3dOptions::Path::Raster;
     }
     if (options.contains("slices") && options.contains("slice_spacing"))
         badOption("slice_spacing", "give either slices or slice_spacing, not both");

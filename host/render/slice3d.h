@@ -5,14 +5,27 @@
 // raster::draw (slice polygons with a fragment program; the specification). docs/slice3d.md.
 #pragma once
 
+#include "host/clip_mesh.h"
 #include "host/render/renderer.h"
 
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
+#include <optional>
 #include <vector>
 
 namespace clvr {
+
+// Clipping with a closed triangle mesh through the stencil buffer (§2.1 of seeds/000; raster path only).
+struct Slice3dClip {
+    // TwoPass: the paper's method — back faces behind the slice set the stencil, front faces in
+    // front of the nearest such back face clear it. Naive: back faces only (its Figure 2: wrong
+    // wherever a part of the mesh lies behind the slice without the slice cutting it).
+    enum class Method { TwoPass, Naive };
+    ClipMeshSpec mesh;
+    bool inverse = false;  // false: keep the volume inside the mesh; true: keep it outside
+    Method method = Method::TwoPass;
+};
 
 struct Slice3dOptions {
     enum class Order { BackToFront, FrontToBack };
@@ -24,6 +37,7 @@ struct Slice3dOptions {
     Path path = Path::Fused;
     bool emptySpaceSkipping = true;  // fused path: step over bricks where tau is 0 (bit-identical image)
     bool nativeVoxels = true;  // fused path: uint8/uint16 on the device when every value fits (same bits)
+    std::optional<Slice3dClip> clip;  // needs the raster path (chosen by default when clip is given)
 };
 
 // Reads the scene's "options" for slice3d. Throws InputError naming the key ("options.slices: ...")
