@@ -14,24 +14,40 @@
 namespace clvr {
 namespace {
 
-// Trilinear reconstruction at grid coordinates g, clamped into the grid (the caller only asks for
-// points inside the box; the clamp absorbs rounding at its faces). Same formula as Volume::sample.
-double trilinear(const Volume& v, glm::dvec3 g)
+// Trilinear reconstruction at grid coordinates g of per-point data p (T = float or glm::vec4), clamped
+// into the grid (the caller only asks for points inside the box; the clamp absorbs rounding at its
+// faces). Same formula as Volume::sample.
+template <typename T, typename R>
+R trilinearOf(const std::vector<T>& data, const glm::ivec3& dims, glm::dvec3 g)
 {
-    const glm::dvec3 last(v.dims - 1);
+    const glm::dvec3 last(dims - 1);
     g = glm::clamp(g, glm::dvec3(0.0), last);
-    glm::ivec3 i0 = glm::clamp(glm::ivec3(glm::floor(g)), glm::ivec3(0), v.dims - 2);
+    glm::ivec3 i0 = glm::clamp(glm::ivec3(glm::floor(g)), glm::ivec3(0), dims - 2);
     const glm::dvec3 f = g - glm::dvec3(i0);
-    const std::size_t nx = static_cast<std::size_t>(v.dims.x);
-    const std::size_t nxy = nx * static_cast<std::size_t>(v.dims.y);
-    const float* p = v.values.data() + static_cast<std::size_t>(i0.z) * nxy + static_cast<std::size_t>(i0.y) * nx + i0.x;
-    const double c00 = p[0] * (1 - f.x) + p[1] * f.x;
-    const double c10 = p[nx] * (1 - f.x) + p[nx + 1] * f.x;
-    const double c01 = p[nxy] * (1 - f.x) + p[nxy + 1] * f.x;
-    const double c11 = p[nxy + nx] * (1 - f.x) + p[nxy + nx + 1] * f.x;
-    const double c0 = c00 * (1 - f.y) + c10 * f.y;
-    const double c1 = c01 * (1 - f.y) + c11 * f.y;
+    const std::size_t nx = static_cast<std::size_t>(dims.x);
+    const std::size_t nxy = nx * static_cast<std::size_t>(dims.y);
+    const T* p = data.data() + static_cast<std::size_t>(i0.z) * nxy + static_cast<std::size_t>(i0.y) * nx + i0.x;
+    auto at = [p](std::size_t k) { return R(p[k]); };
+    const R c00 = at(0) * (1 - f.x) + at(1) * f.x;
+    const R c10 = at(nx) * (1 - f.x) + at(nx + 1) * f.x;
+    const R c01 = at(nxy) * (1 - f.x) + at(nxy + 1) * f.x;
+    const R c11 = at(nxy + nx) * (1 - f.x) + at(nxy + nx + 1) * f.x;
+    const R c0 = c00 * (1 - f.y) + c10 * f.y;
+    const R c1 = c01 * (1 - f.y) + c11 * f.y;
     return c0 * (1 - f.z) + c1 * f.z;
+}
+
+double trilinear(const Volume& v, const glm::dvec3& g) { return trilinearOf<float, double>(v.values, v.dims, g); }
+
+// (r, g, b, tau) of the sample at grid coordinates g: classification after interpolation, and with
+// shading the color times the shade of the interpolated gradient.
+glm::dvec4 classify(const Volume& v, const TransferFunction& tf, const ReferenceShading* shading, const glm::dvec3& g)
+{
+    if (!shading)
+        return tf(trilinear(v, g));
+    const glm::dvec4 s = trilinearOf<glm::vec4, glm::dvec4>(*shading->gradients, v.dims, g);
+    const glm::dvec4 c = tf(s.w);
+    return glm::dvec4(glm::dvec3(c) * phongShade(shading->lighting, glm::dvec3(s), shading->toEye), c.a);
 }
 
 struct RayResult {
@@ -44,8 +60,8 @@ struct RayResult {
 
 // Midpoint composite with n segments over [t0, t1]. Stops once the transmittance is so small that
 // the rest cannot change the result by more than `negligible`.
-glm::dvec4 composite(const Volume& v, const TransferFunction& tf, const Ray& ray, double t0, double t1, int n,
-                     double negligible, std::uint64_t& samples)
+glm::dvec4 composite(const Volume& v, const TransferFunction& tf, const ReferenceShading* shading, const Ray& ray,
+                     double t0, double t1, int n, double negligible, std::uint64_t& samples)
 {
     const double h = (t1 - t0) / n;
     glm::dvec3 intensity(0.0);
@@ -54,7 +70,7 @@ glm::dvec4 composite(const Volume& v, const TransferFunction& tf, const Ray& ray
     const glm::dvec3 dg = ray.direction * h / v.spacing;
     for (int i = 0; i < n; ++i) {
         const glm::dvec3 g = g0 + (i + 0.5) * dg;
-        const glm::dvec4 c = tf(trilinear(v, g));  // classification after interpolation
+        const glm::dvec4 c = classify(v, tf, shading, g);
         ++samples;
         const double alpha = 1.0 - std::exp(-c.a * h);
         intensity += transmittance * alpha * glm::dvec3(c);
@@ -74,14 +90,14 @@ RayResult integrateRay(const Volume& v, const TransferFunction& tf, const Ray& r
     int n = static_cast<int>(std::min<double>(std::ceil((t1 - t0) / h0), o.maxSegmentsPerRay));
     n = std::max(n, 1);
     const double negligible = o.tolerance * 1e-3;
-    glm::dvec4 coarse = composite(v, tf, ray, t0, t1, n, negligible, r.samples);
+    glm::dvec4 coarse = composite(v, tf, o.shading, ray, t0, t1, n, negligible, r.samples);
     for (;;) {
         if (2 * static_cast<long long>(n) > o.maxSegmentsPerRay) {
             r.converged = false;
             break;
         }
         n *= 2;
-        const glm::dvec4 fine = composite(v, tf, ray, t0, t1, n, negligible, r.samples);
+        const glm::dvec4 fine = composite(v, tf, o.shading, ray, t0, t1, n, negligible, r.samples);
         const glm::dvec4 d = glm::abs(fine - coarse);
         r.residual = std::max({d.r, d.g, d.b, d.a});
         coarse = fine;

@@ -1,12 +1,14 @@
 // host/reference_integral.h — the CPU reference of DESIGN.md's optical model: per pixel, the
 // emission-absorption integral I = ∫ C(s) τ(s) exp(-∫τ) dλ (Eq. 1 of seeds/001_cd12fd6b76f9cf96.txt)
 // along the camera ray through the pixel center, in double, with trilinear reconstruction and
-// classification after interpolation (the transfer function of the interpolated value).
+// classification after interpolation (the transfer function of the interpolated value); optionally
+// shaded (ReferenceShading: the color times the Phong shade of the interpolated gradient, seeds/004).
 // Used by tests to judge every regular-grid technique; not a renderer.
 #pragma once
 
 #include "host/camera.h"
 #include "host/image.h"
+#include "host/reflectance_map.h"
 #include "host/scene.h"
 #include "host/transfer_function.h"
 #include "host/volume.h"
@@ -26,6 +28,15 @@ struct ReferenceStats {
     double maxResidual = 0.0;           // largest last |I_h - I_2h| (per channel, rgb and A) over rays
 };
 
+// Shaded emission (seeds/004 §2, the model of host/reflectance_map.h's phongShade): a sample's color is
+// the transfer function's color times phongShade of the gradient interpolated trilinearly (in double)
+// from `gradients` (host/gradient_volume.h's RGBA volume of the same grid); tau is not shaded.
+struct ReferenceShading {
+    const std::vector<glm::vec4>* gradients = nullptr;  // sobelGradientVolume(volume), not owned
+    Lighting lighting;
+    glm::dvec3 toEye{0.0, 0.0, 1.0};  // unit, towards the viewer: the camera's -forward
+};
+
 struct ReferenceOptions {
     // A ray's integral is refined (segment count doubled) until the change of every channel of
     // (I, A) is below this. The midpoint rule used is second order, so the remaining error is
@@ -40,6 +51,7 @@ struct ReferenceOptions {
     // [t0, t1]): each is integrated (and converged) on its own and the pieces are composited front to
     // back; the medium elsewhere is taken as empty. Clipping uses it (host/clip_mesh.h: clipIntervals).
     std::function<std::vector<glm::dvec2>(const Ray& ray, double t0, double t1)> intervals;
+    const ReferenceShading* shading = nullptr;  // null: unshaded (the color is the transfer function's)
 };
 
 // Integrates every pixel of an image.width x image.height image; the result pixel is

@@ -2,12 +2,14 @@
 #include "host/render/renderer.h"
 
 #include "host/errors.h"
+#include "host/render/blend.h"
 #include "host/render/harc.h"
+#include "host/render/planes.h"
 #include "host/render/slice3d.h"
 
 namespace clvr {
 
-std::vector<std::string> techniqueNames() { return {"slice3d", "harc"}; }
+std::vector<std::string> techniqueNames() { return {"slice3d", "planes", "blend", "harc"}; }
 
 std::unique_ptr<Renderer> makeRenderer(Device& device, const Scene& scene, const Volume& volume)
 {
@@ -15,6 +17,16 @@ std::unique_ptr<Renderer> makeRenderer(Device& device, const Scene& scene, const
         if (volume.values.empty())
             throw InputError("technique slice3d needs a regular-grid \"volume\", and the scene has none");
         return makeSlice3dRenderer(device, scene, volume);
+    }
+    if (scene.technique == "planes") {
+        if (volume.values.empty())
+            throw InputError("technique planes needs a regular-grid \"volume\", and the scene has none");
+        return makePlanesRenderer(device, scene, volume);
+    }
+    if (scene.technique == "blend") {
+        if (volume.values.empty())
+            throw InputError("technique blend needs a regular-grid \"volume\", and the scene has none");
+        return makeBlendRenderer(device, scene, volume);
     }
     if (scene.technique == "harc")
         throw InputError("technique harc needs a tetrahedral \"mesh\", and the scene has none");
@@ -28,7 +40,7 @@ std::unique_ptr<Renderer> makeMeshRenderer(Device& device, const Scene& scene, c
 {
     if (scene.technique == "harc")
         return makeHarcRenderer(device, scene, mesh, buildTopology(mesh));
-    if (scene.technique != "slice3d")
+    if (scene.technique != "slice3d" && scene.technique != "planes" && scene.technique != "blend")
         throw InputError("technique: unknown technique \"" + scene.technique + "\" (mesh techniques: harc)");
     throw InputError("technique \"" + scene.technique + "\" renders regular-grid volumes, and the scene has a \"mesh\" (mesh techniques: harc)");
 }
