@@ -14,7 +14,10 @@
 #include "tests/test_util.h"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -233,3 +236,59 @@ TEST(BenchMesh, BluntfinScenesRenderAndMoreSegmentsSplitMore)
 }
 
 }  // namespace
+
+// ---- resample-then-shade bench scenes (tools/make_rts_bench.py, `clvr bench --suite rts`) --------------
+
+namespace {
+
+std::vector<std::filesystem::path> rtsBenchScenes()
+{
+    std::vector<std::filesystem::path> out;
+    for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::path(CLVR_SOURCE_DIR) / "data/scenes/bench"))
+        if (entry.path().filename().string().starts_with("rts-"))
+            out.push_back(entry.path());
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+}  // namespace
+
+// Every scene is valid (loadScene checks every key), 512x512, planes or blend; the opaque transfer
+// function is the translucent one with 25x the extinction at every control point; the engine's
+// "no-ert" and "no-skip" scenes differ from their base scene in that one option only.
+TEST(BenchRts, ScenesAreValidAndDifferOnlyWhereTheyShould)
+{
+    const std::vector<std::filesystem::path> files = rtsBenchScenes();
+    ASSERT_EQ(files.size(), 16u);  // 3 volumes x 2 transfer functions x 2 techniques + 4 planes on/off
+    for (const auto& file : files) {
+        const clvr::Scene scene = clvr::loadScene(file);
+        EXPECT_TRUE(scene.technique == "planes" || scene.technique == "blend") << file;
+        EXPECT_EQ(scene.image.width, 512) << file;
+        EXPECT_EQ(scene.image.height, 512) << file;
+        const std::string name = file.filename().string();
+        const auto at = name.find("-opaque");
+        if (at != std::string::npos && name.find("-no-") == std::string::npos) {
+            std::string translucentName = name;
+            translucentName.replace(at, 7, "-translucent");
+            const clvr::Scene translucent = clvr::loadScene(file.parent_path() / translucentName);
+            const auto& o = scene.transferFunction.points();
+            const auto& t = translucent.transferFunction.points();
+            ASSERT_EQ(o.size(), t.size()) << name;
+            for (std::size_t i = 0; i < o.size(); ++i) {
+                EXPECT_EQ(o[i].s, t[i].s) << name;
+                EXPECT_NEAR(o[i].tau, 25.0 * t[i].tau, 1e-6 * (1.0 + o[i].tau)) << name << " point " << i;
+            }
+        }
+        for (const char* off : {"-no-ert", "-no-skip"}) {
+            const auto cut = name.find(off);
+            if (cut == std::string::npos)
+                continue;
+            const std::string baseName = name.substr(0, cut) + ".json";
+            const clvr::Scene base = clvr::loadScene(file.parent_path() / baseName);
+            nlohmann::json diff = nlohmann::json::diff(base.options, scene.options);
+            ASSERT_EQ(diff.size(), 1u) << name << ": " << diff.dump();
+            EXPECT_EQ(diff[0]["path"], std::string(off) == "-no-ert" ? "/early_termination" : "/opacity_threshold")
+                << name;
+        }
+    }
+}
