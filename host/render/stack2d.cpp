@@ -1,0 +1,284 @@
+// host/render/stack2d.cpp — options, stack choice, slice planning and the pass-by-pass rendering of
+// the stack2d technique: one raster::draw of all quads of the chosen stack, back to front, with
+// kernels/stack2d.cl as fragment program, then the background pass of slice3d.
+#include "host/render/stack2d.h"
+
+#include "host/embedded_kernels.h"
+#include "host/errors.h"
+#include "host/render/slice3d.h"  // packTransferFunction
+#include "raster/framebuffer.h"
+#include "raster/rasterizer.h"
+#include "raster/texture.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+namespace clvr {
+namespace {
+
+// The most intermediate slices per stack interval; 64 already samples far finer than the data.
+constexpr int kMaxIntermediate = 64;
+constexpr const char* kKnownOptions = "intermediate";
+constexpr const char* kAxisNames[3] = {"x", "y", "z"};
+
+[[noreturn]] void badOption(const std::string& key, const std::string& what)
+{
+    throw InputError("options." + key + ": " + what);
+}
+
+// The stack along `axis`: slice i (grid index i on that axis) is a 2D texture over the other two
+// axes (b, c) = ((axis + 1) % 3, (axis + 2) % 3) ordered as x < y < z, i.e. (y, z), (x, z), (x, y);
+// the first of them runs fastest. Slices follow one another in one buffer.
+struct StackShape {
+    int b = 0, c = 0;  // texture width along axis b, height along axis c
+};
+StackShape stackShape(int axis)
+{
+    const int p = (axis + 1) % 3, q = (axis + 2) % 3;
+    return {std::min(p, q), std::max(p, q)};
+}
+
+std::vector<float> stackTexels(const Volume& volume, int axis)
+{
+    const glm::ivec3 n = volume.dims;
+    const StackShape s = stackShape(axis);
+    std::vector<float> texels(volume.values.size());
+    std::size_t out = 0;
+    glm::ivec3 g;
+    for (g[axis] = 0; g[axis] < n[axis]; ++g[axis])
+        for (g[s.c] = 0; g[s.c] < n[s.c]; ++g[s.c])
+            for (g[s.b] = 0; g[s.b] < n[s.b]; ++g[s.b])
+                texels[out++] = volume.at(g.x, g.y, g.z);
+    return texels;
+}
+
+class Stack2dRenderer final : public Renderer {
+public:
+    Stack2dRenderer(Device& device, const Scene& scene, const Volume& volume);
+    Image4f render(FrameStats& stats) override;
+    std::uint64_t residentBytes() const override { return residentBytes_; }
+    void setTransferFunction(const TransferFunction& tf) override;
+
+private:
+    Device& device_;
+    Stack2dOptions options_;
+    Camera camera_;
+    ImageSpec image_;
+    glm::ivec3 dims_;
+    glm::dvec3 origin_, spacing_, lo_, hi_;
+    int axis_ = 2;
+    std::vector<StackSlice> slices_;
+    std::vector<raster::Texture> stacks_;  // x, y, z: all three stay resident, as on the paper's boards
+    cl::Buffer tf_;
+    std::size_t tfBytes_ = 0;
+    std::uint64_t residentBytes_ = 0;
+    std::unique_ptr<raster::Framebuffer> framebuffer_;
+    raster::FragmentProgram fragmentProgram_;
+    cl::Kernel overBackground_;
+};
+
+Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volume& volume)
+    : device_(device), options_(parseStack2dOptions(scene.options)), image_(scene.image)
+{
+    volume.validate();
+    if (!scene.lights.is_null())
+        throw InputError("lights: technique stack2d does not shade yet (docs/stack2d.md); remove \"lights\" "
+                         "or use planes or blend");
+    dims_ = volume.dims;
+    origin_ = volume.origin;
+    spacing_ = volume.spacing;
+    lo_ = volume.boundsMin();
+    hi_ = volume.boundsMax();
+    camera_ = scene.camera ? *scene.camera : fitCamera(lo_, hi_);
+    camera_.validate();
+    if (image_.width < 1 || image_.height < 1)
+        throw InputError("image: width and height must be >= 1");
+    axis_ = stackAxis(camera_);
+    slices_ = planStack(camera_, origin_, spacing_, dims_, axis_, options_.intermediate);
+
+    for (int a = 0; a < 3; ++a) {
+        const StackShape s = stackShape(a);
+        raster::TextureDesc desc;
+        desc.width = dims_[s.b];
+        desc.height = dims_[s.c];
+        desc.depth = dims_[a];
+        desc.channels = 1;
+        desc.filter = raster::Filter::Linear;
+        desc.wrap = raster::Wrap::ClampToEdge;
+        stacks_.emplace_back(device_, desc, stackTexels(volume, a));
+        residentBytes_ += stacks_.back().bytes();
+    }
+    setTransferFunction(scene.transferFunction);
+
+    framebuffer_ = std::make_unique<raster::Framebuffer>(device_, image_.width, image_.height);
+    overBackground_ = device_.kernel("slice3d.cl", "slice3d_over_background");
+    std::string_view source;
+    for (const EmbeddedKernel& k : embeddedKernels())
+        if (k.name == "stack2d.cl")
+            source = k.source;
+    fragmentProgram_.source = "#define CLVR_STACK2D_FRAGMENT 1\n" + std::string(source);
+    fragmentProgram_.buffers[0] = stacks_[axis_].buffer();
+    const double aspect = static_cast<double>(image_.width) / image_.height;
+    const double scale = camera_.parallel ? camera_.parallelScale : std::tan(glm::radians(camera_.viewAngle) * 0.5);
+    glm::vec4 axisVector(0.0f);
+    axisVector[axis_] = 1.0f;
+    const StackShape s = stackShape(axis_);
+    fragmentProgram_.uniforms = {
+        glm::vec4(glm::vec3(camera_.position), 0.0f),
+        glm::vec4(glm::vec3(camera_.forward()), 0.0f),
+        glm::vec4(glm::vec3(camera_.right()), 0.0f),
+        glm::vec4(glm::vec3(camera_.up()), 0.0f),
+        glm::vec4(static_cast<float>(scale), static_cast<float>(aspect), camera_.parallel ? 1.0f : 0.0f, 0.0f),
+        glm::vec4(image_.width, image_.height, 0.0f, 0.0f),  // z: tf_count, set with the transfer function
+        axisVector,
+        glm::vec4(dims_[s.b], dims_[s.c], 0.0f, 0.0f),
+    };
+    fragmentProgram_.uniforms[5].z = static_cast<float>(scene.transferFunction.points().size());
+    fragmentProgram_.buffers[1] = tf_;
+}
+
+void Stack2dRenderer::setTransferFunction(const TransferFunction& tf)
+{
+    const std::vector<float> packed = packTransferFunction(tf);
+    residentBytes_ -= tfBytes_;
+    tfBytes_ = packed.size() * sizeof(float);
+    residentBytes_ += tfBytes_;
+    tf_ = device_.upload("stack2d transfer function", packed);
+    fragmentProgram_.buffers[1] = tf_;
+    if (fragmentProgram_.uniforms.size() > 5)
+        fragmentProgram_.uniforms[5].z = static_cast<float>(tf.points().size());
+}
+
+Image4f Stack2dRenderer::render(FrameStats& stats)
+{
+    const auto start = std::chrono::steady_clock::now();
+    // Near and far planes around the box's eye-depth range; depth is not tested, so only the near
+    // plane matters: it removes what lies behind the camera (perspective) or in front of its image
+    // plane (parallel: depth 0, as the reference integral counts the ray from there).
+    double dMin = std::numeric_limits<double>::infinity(), dMax = -dMin;
+    for (int c = 0; c < 8; ++c) {
+        const glm::dvec3 corner((c & 1) ? hi_.x : lo_.x, (c & 2) ? hi_.y : lo_.y, (c & 4) ? hi_.z : lo_.z);
+        const double d = glm::dot(camera_.forward(), corner - camera_.position);
+        dMin = std::min(dMin, d);
+        dMax = std::max(dMax, d);
+    }
+    const double nearZ = camera_.parallel ? 0.0 : (dMin > 0.0 ? 0.5 * dMin : 1e-4 * std::max(dMax, 1e-30));
+    const double farZ = 2.0 * std::max(dMax, 0.0) + 1.0;
+    const glm::dmat4 viewProjection =
+        camera_.projectionMatrix(image_.width, image_.height, nearZ, farZ) * camera_.viewMatrix();
+    const StackShape s = stackShape(axis_);
+    // Quad corners in the (b, c) plane and their texture coordinates: grid point i of n is texel i,
+    // centered at (i + 0.5) / n, so the box [0, n - 1] maps to [0.5 / n, (n - 0.5) / n].
+    const glm::dvec2 uvLo(0.5 / dims_[s.b], 0.5 / dims_[s.c]);
+    const glm::dvec2 uvHi((dims_[s.b] - 0.5) / dims_[s.b], (dims_[s.c] - 0.5) / dims_[s.c]);
+    std::vector<raster::Vertex> vertices;
+    vertices.reserve(slices_.size() * 6);
+    for (const StackSlice& slice : slices_) {
+        auto vertex = [&](int cb, int cc) {
+            glm::dvec3 p;
+            p[axis_] = origin_[axis_] + slice.position * spacing_[axis_];
+            p[s.b] = cb ? hi_[s.b] : lo_[s.b];
+            p[s.c] = cc ? hi_[s.c] : lo_[s.c];
+            raster::Vertex v;
+            v.position = glm::vec4(viewProjection * glm::dvec4(p, 1.0));
+            v.attributes[0] = glm::vec4(static_cast<float>(cb ? uvHi.x : uvLo.x), static_cast<float>(cc ? uvHi.y : uvLo.y),
+                                        static_cast<float>(slice.lower), slice.weight);
+            v.attributes[1] = glm::vec4(static_cast<float>(slice.thickness), 0.0f, 0.0f, 0.0f);
+            return v;
+        };
+        for (const auto& [cb, cc] : std::array<std::pair<int, int>, 6>{{{0, 0}, {1, 0}, {1, 1}, {0, 0}, {1, 1}, {0, 1}}})
+            vertices.push_back(vertex(cb, cc));
+    }
+    raster::DrawState state;  // "over" on premultiplied color: dst = src + (1 - src.a) dst
+    state.fragment.blend.enabled = true;
+    state.fragment.blend.srcRgb = state.fragment.blend.srcAlpha = raster::BlendFactor::One;
+    state.fragment.blend.dstRgb = state.fragment.blend.dstAlpha = raster::BlendFactor::OneMinusSrcAlpha;
+    framebuffer_->clearColor(device_, glm::vec4(0.0f));
+    const raster::DrawStats drawStats =
+        raster::draw(device_, *framebuffer_, state, raster::Topology::Triangles, vertices, fragmentProgram_);
+    const std::size_t pixels = framebuffer_->pixelCount();
+    overBackground_.setArg(0, framebuffer_->color());
+    overBackground_.setArg(1, static_cast<cl_int>(pixels));
+    overBackground_.setArg(2, cl_float4{{static_cast<float>(image_.background.r), static_cast<float>(image_.background.g),
+                                         static_cast<float>(image_.background.b), 0.0f}});
+    device_.launch("stack2d: over background", overBackground_, pixels);
+    Image4f image = framebuffer_->readColor(device_);
+    stats.passes = device_.takePassTimes();
+    stats.frameMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    stats.samples = drawStats.fragments;  // one sample per fragment of a quad
+    stats.extra["axis"] = kAxisNames[axis_];
+    stats.extra["slices"] = slices_.size();
+    stats.extra["intermediate"] = options_.intermediate;
+    stats.extra["triangles"] = drawStats.triangles;
+    stats.extra["voxels"] = static_cast<std::uint64_t>(dims_.x) * dims_.y * dims_.z;
+    stats.extra["resident_bytes"] = residentBytes_;
+    return image;
+}
+
+}  // namespace
+
+Stack2dOptions parseStack2dOptions(const nlohmann::json& options)
+{
+    Stack2dOptions o;
+    if (options.is_null())
+        return o;
+    if (!options.is_object())
+        throw InputError("options: must be an object");
+    for (const auto& [key, value] : options.items()) {
+        if (key == "intermediate") {
+            if (!value.is_number_integer() || value.get<long long>() < 0 || value.get<long long>() > kMaxIntermediate)
+                badOption(key, "must be an integer in [0, " + std::to_string(kMaxIntermediate) + "], got " + value.dump());
+            o.intermediate = static_cast<int>(value.get<long long>());
+        } else {
+            badOption(key, std::string("unknown option for stack2d (known: ") + kKnownOptions + ")");
+        }
+    }
+    return o;
+}
+
+int stackAxis(const Camera& camera)
+{
+    const glm::dvec3 f = glm::abs(camera.forward());
+    int axis = 0;
+    for (int a = 1; a < 3; ++a)
+        if (f[a] > f[axis])
+            axis = a;
+    return axis;
+}
+
+std::vector<StackSlice> planStack(const Camera& camera, const glm::dvec3& origin, const glm::dvec3& spacing,
+                                  const glm::ivec3& dims, int axis, int intermediate)
+{
+    const int perCell = intermediate + 1;
+    const int count = (dims[axis] - 1) * perCell + 1;
+    std::vector<StackSlice> slices(count);
+    for (int j = 0; j < count; ++j) {
+        StackSlice& s = slices[j];
+        s.lower = j / perCell;
+        s.weight = static_cast<float>(j % perCell) / static_cast<float>(perCell);
+        s.position = s.lower + static_cast<double>(j % perCell) / perCell;
+        s.thickness = spacing[axis] / perCell * (j == 0 || j == count - 1 ? 0.5 : 1.0);
+    }
+    // Back to front. Perspective: the rays that meet a plane come from the camera, so along every
+    // ray the planes follow in increasing distance |camera - plane| along the axis (planes on the
+    // other side of the camera are behind it and clipped away). Parallel: depth along forward.
+    const double forwardAxis = camera.forward()[axis];
+    auto farness = [&](const StackSlice& s) {
+        const double x = origin[axis] + s.position * spacing[axis];
+        return camera.parallel ? forwardAxis * x : std::abs(x - camera.position[axis]);
+    };
+    std::stable_sort(slices.begin(), slices.end(),
+                     [&](const StackSlice& a, const StackSlice& b) { return farness(a) > farness(b); });
+    return slices;
+}
+
+std::unique_ptr<Renderer> makeStack2dRenderer(Device& device, const Scene& scene, const Volume& volume)
+{
+    return std::make_unique<Stack2dRenderer>(device, scene, volume);
+}
+
+}  // namespace clvr

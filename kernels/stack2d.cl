@@ -1,0 +1,60 @@
+// kernels/stack2d.cl — fragment program of the 2D texture stacks (seeds/003_e49ee09fcdafadac.txt;
+// host/render/stack2d.cpp, docs/stack2d.md). The host appends this file, with CLVR_STACK2D_FRAGMENT
+// defined, after kernels/raster.cl; compiled on its own (the offline syntax test) it pulls in
+// raster.cl itself, so that the fragment program is checked in the context it runs in.
+// The host has validated everything; this file only does arithmetic.
+#include "transfer_function.h"
+#ifndef CLVR_STACK2D_FRAGMENT
+#include "raster.cl"
+#endif
+
+/* One fragment of a stack quad. attr[0] = (u, v, lower, weight): the 2D texture coordinates on the
+ * slice (texel i of n centered at (i + 0.5) / n, so grid point i is texel i), the stack slice to
+ * sample and the weight of slice lower + 1 (0 on a stack slice itself); attr[1].x = the slab's
+ * thickness along the stack axis, world units. All but (u, v) are constant over a quad.
+ * uniforms: 0..3 camera position, forward, right, up; 4 (tan(view_angle / 2) or parallel_scale,
+ * aspect, 1 if parallel, 0); 5 (image width, height, tf_count, 0); 6 the stack axis as a unit vector;
+ * 7 (texture width, height, 0, 0) of one slice. buffer[0] the stack (slices one after another,
+ * x fastest), buffer[1] the transfer function (transfer_function.h).
+ * Sample: bilinear in each slice; an intermediate slice lerps two bilinear samples, the paper's
+ * register-combiner step, which makes the sample trilinear. Classified after interpolation;
+ * alpha = 1 - exp(-tau Delta) with Delta the ray's length through the slab, thickness / |cos| of
+ * the angle between the pixel's ray and the axis. Output premultiplied (C alpha, alpha). */
+int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* color)
+{
+    constant float4* u = r->uniforms;
+    ClTexture slice;
+    slice.width = (cl_uint)u[7].x;
+    slice.height = (cl_uint)u[7].y;
+    slice.depth = 1u;
+    slice.channels = 1u;
+    slice.filter = CLVR_FILTER_LINEAR;
+    slice.wrap = CLVR_WRAP_CLAMP_TO_EDGE;
+    slice.pad0 = slice.pad1 = 0u;
+    slice.border = (float4)(0.0f);
+    const size_t texels = (size_t)slice.width * slice.height;
+    /* lower and weight are interpolated constants: round lower, take weight as it comes (its
+     * rounding error is a few ulp) */
+    const int lower = (int)round(f->attr[0].z);
+    const float weight = f->attr[0].w;
+    global const float* s0 = r->buffer[0] + (size_t)lower * texels;
+    float s = clvr_tex2d(s0, slice, f->attr[0].xy).x;
+    if (weight > 0.0f)
+        s = mix(s, clvr_tex2d(s0 + texels, slice, f->attr[0].xy).x, weight);
+
+    /* The pixel's ray direction (host/camera.cpp's Camera::ray): forward for a parallel camera, else
+     * forward + x right + y up through the pixel center. */
+    const float2 ndc = (float2)(f->window.x / u[5].x * 2.0f - 1.0f, 1.0f - f->window.y / u[5].y * 2.0f);
+    float3 d = u[1].xyz;
+    if (u[4].z == 0.0f)
+        d += (ndc.x * u[4].x * u[4].y) * u[2].xyz + (ndc.y * u[4].x) * u[3].xyz;
+    /* a fragment's ray meets the quad's plane, so cos_theta > 0; the floor only keeps tau = 0 times
+     * an infinite Delta (a plane seen exactly edge-on, rounded) from giving NaN */
+    const float cos_theta = fmax(fabs(dot(d, u[6].xyz)) / length(d), 1e-20f);
+    const float delta = f->attr[1].x / cos_theta;
+
+    const float4 ct = clvr_tf_eval(r->buffer[1], (int)u[5].z, s);
+    const float alpha = 1.0f - exp(-ct.w * delta);
+    *color = (float4)(ct.xyz * alpha, alpha);
+    return 1;
+}

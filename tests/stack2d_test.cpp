@@ -1,0 +1,270 @@
+// tests/stack2d_test.cpp — 2D texture stacks: options, stack choice per view, slice planning (order,
+// weights, slabs), the image against the CPU reference integral with the error falling as
+// intermediate slices are added (the artifact of plain stacks), both cameras, identical bits.
+#include "host/render/stack2d.h"
+
+#include "host/errors.h"
+#include "host/generators.h"
+#include "host/reference_integral.h"
+#include "host/render/renderer.h"
+#include "tests/test_util.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <map>
+
+namespace clvr {
+namespace {
+
+using nlohmann::json;
+
+TransferFunction mlTransferFunction()
+{
+    // As tests/slice3d_test.cpp: s in [0,1], tau per world unit (the box is 2 wide).
+    return TransferFunction({{0.0, {0, 0, 0}, 0.0}, {0.5, {1, 0.5, 0}, 4.0}, {1.0, {1, 1, 1}, 8.0}});
+}
+constexpr double kTauMax = 8.0;
+
+Camera perspectiveCamera()  // the camera of tests/slice3d_test.cpp: 26 degrees off the z axis
+{
+    Camera c;
+    c.position = {1.2, 1.6, 3.7};
+    c.viewAngle = 40.0;
+    return c;
+}
+
+Camera parallelCamera()  // ... and its parallel one: x stack, 33 degrees off the x axis
+{
+    Camera c;
+    c.position = {3.5, 1.0, 1.9};
+    c.viewUp = {0.0, 0.0, 1.0};
+    c.parallel = true;
+    c.parallelScale = 1.8;
+    return c;
+}
+
+Scene makeScene(const Camera& camera, int size, json options = json::object())
+{
+    Scene s;
+    s.technique = "stack2d";
+    s.camera = camera;
+    s.image = ImageSpec{size, size, {0.1, 0.2, 0.3}};
+    s.transferFunction = mlTransferFunction();
+    s.options = std::move(options);
+    return s;
+}
+
+const Volume& marschnerLobb41()
+{
+    static const Volume v = generateVolume("marschner-lobb", {41, 41, 41});
+    return v;
+}
+
+Image4f renderScene(const Scene& scene, const Volume& volume, FrameStats* statsOut = nullptr)
+{
+    auto renderer = makeRenderer(test::device(), scene, volume);
+    FrameStats stats;
+    Image4f image = renderer->render(stats);
+    if (statsOut)
+        *statsOut = stats;
+    return image;
+}
+
+// The reference of each camera, computed once per process (seconds each).
+const Image4d& reference(const Camera& camera, int size)
+{
+    static std::map<std::pair<bool, int>, Image4d> cache;
+    const auto key = std::make_pair(camera.parallel, size);
+    auto it = cache.find(key);
+    if (it == cache.end()) {
+        ReferenceStats stats;
+        ReferenceOptions options;
+        options.stats = &stats;
+        const Scene scene = makeScene(camera, size);
+        it = cache.emplace(key, referenceIntegral(marschnerLobb41(), scene.transferFunction, camera, scene.image, options))
+                 .first;
+        EXPECT_EQ(stats.raysNotConverged, 0u);
+    }
+    return it->second;
+}
+
+double maxChannel(const glm::dvec4& v) { return std::max({v.r, v.g, v.b, v.a}); }
+
+// Smallest |cos| between a pixel's ray and the stack axis over the image: the longest slab.
+double minCos(const Camera& camera, int size, int axis)
+{
+    double c = 1.0;
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) {
+            const Ray r = camera.ray(x + 0.5, y + 0.5, size, size);
+            c = std::min(c, std::abs(glm::normalize(r.direction)[axis]));
+        }
+    return c;
+}
+
+// ---- options, stack choice, planning -----------------------------------------------------------
+
+void expectInputError(const json& options, const std::string& fragment)
+{
+    try {
+        parseStack2dOptions(options);
+        ADD_FAILURE() << "no InputError for " << options.dump();
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    }
+}
+
+TEST(Stack2dOptions, BadOptionsThrowInputErrorNamingTheKey)
+{
+    expectInputError({{"foo", 1}}, "options.foo: unknown option for stack2d (known: intermediate)");
+    expectInputError({{"intermediate", -1}}, "options.intermediate: must be an integer in [0, 64], got -1");
+    expectInputError({{"intermediate", 65}}, "options.intermediate");
+    expectInputError({{"intermediate", 1.5}}, "options.intermediate");
+    expectInputError({{"intermediate", "2"}}, "options.intermediate");
+    expectInputError(json::array(), "options: must be an object");
+    EXPECT_EQ(parseStack2dOptions({{"intermediate", 3}}).intermediate, 3);
+    EXPECT_EQ(parseStack2dOptions(json()).intermediate, 0);
+}
+
+TEST(Stack2dOptions, LightsAreAnInputErrorUntilShadingExists)
+{
+    Scene scene = makeScene(perspectiveCamera(), 8);
+    scene.lights = json::array({{{"direction", {0, 0, 1}}}});
+    EXPECT_THROW(makeRenderer(test::device(), scene, marschnerLobb41()), InputError);
+}
+
+TEST(Stack2dAxis, TheStackMostParallelToTheViewDirectionIsChosen)
+{
+    Camera c;
+    c.position = {0.3, -0.2, 4.0};
+    EXPECT_EQ(stackAxis(c), 2);
+    c.position = {-4.0, 1.0, 0.5};
+    EXPECT_EQ(stackAxis(c), 0);
+    c.position = {0.5, 3.0, -2.9};
+    c.viewUp = {1.0, 0.0, 0.0};
+    EXPECT_EQ(stackAxis(c), 1);
+    EXPECT_EQ(stackAxis(parallelCamera()), 0);
+}
+
+TEST(Stack2dAxis, RotatingTheCameraSwitchesTheStack)
+{
+    // The camera on a circle in the x-z plane around the volume: the z stack up to 45 degrees, the x
+    // stack beyond, z again past 135; the renderer reports the stack it drew.
+    const int expected[] = {2, 2, 0, 0, 2, 2};
+    const double degrees[] = {0.0, 40.0, 50.0, 120.0, 140.0, 180.0};
+    for (int i = 0; i < 6; ++i) {
+        Camera c;
+        const double a = glm::radians(degrees[i]);
+        c.position = {4.0 * std::sin(a), 0.3, 4.0 * std::cos(a)};
+        FrameStats stats;
+        renderScene(makeScene(c, 8), marschnerLobb41(), &stats);
+        EXPECT_EQ(stats.extra["axis"], (const char*[]){"x", "y", "z"}[expected[i]]) << degrees[i] << " degrees";
+    }
+}
+
+TEST(Stack2dPlan, SlicesTileTheBoxBackToFrontWithLerpWeights)
+{
+    const glm::dvec3 origin(-1.0, 0.5, 2.0), spacing(0.5, 0.25, 0.2);
+    const glm::ivec3 dims(5, 7, 9);
+    for (const int intermediate : {0, 3}) {
+        for (const bool parallel : {false, true}) {
+            Camera c;
+            c.position = {0.2, 1.1, -3.0};  // below the z range: the nearest plane is z = 2
+            c.focalPoint = {0.0, 1.0, 2.5};
+            c.parallel = parallel;
+            const std::vector<StackSlice> s = planStack(c, origin, spacing, dims, 2, intermediate);
+            ASSERT_EQ(s.size(), static_cast<std::size_t>(8 * (intermediate + 1) + 1));
+            double total = 0.0;
+            for (std::size_t i = 0; i < s.size(); ++i) {
+                total += s[i].thickness;
+                EXPECT_DOUBLE_EQ(s[i].lower + s[i].weight, s[i].position);
+                EXPECT_GE(s[i].weight, 0.0f);
+                EXPECT_LT(s[i].weight, 1.0f);
+                if (i > 0)
+                    EXPECT_LT(s[i].position, s[i - 1].position) << "back (high z) to front";
+            }
+            EXPECT_NEAR(total, 8 * 0.2, 1e-12);  // the slabs cover the box's z extent exactly
+            EXPECT_DOUBLE_EQ(s.front().thickness, 0.1 / (intermediate + 1));
+            EXPECT_DOUBLE_EQ(s.back().position, 0.0);
+        }
+    }
+    // A camera inside the z range: planes farther from it in either direction come first.
+    Camera inside;
+    inside.position = {0.0, 1.0, 2.7};  // grid z coordinate 3.5
+    inside.focalPoint = {0.0, 1.0, 0.0};
+    const std::vector<StackSlice> s = planStack(inside, origin, spacing, dims, 2, 0);
+    EXPECT_EQ(s.front().position, 8.0);
+    EXPECT_TRUE((s.back().position == 3.0 || s.back().position == 4.0));
+}
+
+// ---- against the reference ---------------------------------------------------------------------
+
+struct Measured {
+    test::ImageError error;
+    double deltaMax = 0.0;  // the longest slab along any pixel's ray
+};
+
+Measured measure(const Camera& camera, int size, int intermediate)
+{
+    const Image4f image = renderScene(makeScene(camera, size, {{"intermediate", intermediate}}), marschnerLobb41());
+    Measured m;
+    m.error = test::imageError(image, reference(camera, size));
+    const double spacing = 2.0 / 40.0;
+    m.deltaMax = spacing / (intermediate + 1) / minCos(camera, size, stackAxis(camera));
+    std::printf("[ measured ] %s, intermediate %d: max %.3g %.3g %.3g %.3g, mean %.2g %.2g %.2g %.2g, "
+                "Delta_max %.4f\n",
+                camera.parallel ? "parallel" : "perspective", intermediate, m.error.maxAbs.r, m.error.maxAbs.g,
+                m.error.maxAbs.b, m.error.maxAbs.a, m.error.meanAbs.r, m.error.meanAbs.g, m.error.meanAbs.b,
+                m.error.meanAbs.a, m.deltaMax);
+    return m;
+}
+
+void expectErrorFallsWithIntermediateSlices(const Camera& camera)
+{
+    const int size = 64;
+    double previousMean = 1e30;
+    for (const int intermediate : {0, 1, 3}) {
+        const Measured m = measure(camera, size, intermediate);
+        EXPECT_EQ(m.error.nanCount, 0u);
+        // Tolerance (docs/stack2d.md): a ray entering or leaving through a side face of the box (parallel
+        // to the slices) gains or loses at most one slab's opacity there, max <= 2 (1 - exp(-tau_max
+        // Delta_max)); the mean is first order in the slab, c tau_max Delta_max with c = 0.02 as slice3d's.
+        const double maxTolerance = 2.0 * (1.0 - std::exp(-kTauMax * m.deltaMax));
+        const double meanTolerance = 0.02 * kTauMax * m.deltaMax;
+        EXPECT_LE(maxChannel(m.error.maxAbs), maxTolerance) << "intermediate " << intermediate;
+        EXPECT_LE(maxChannel(m.error.meanAbs), meanTolerance) << "intermediate " << intermediate;
+        // The artifact of plain stacks: the error falls as intermediate slices are added.
+        EXPECT_LT(maxChannel(m.error.meanAbs), previousMean) << "intermediate " << intermediate;
+        previousMean = maxChannel(m.error.meanAbs);
+    }
+}
+
+TEST(Stack2dReference, PerspectiveErrorFallsWithIntermediateSlices)
+{
+    expectErrorFallsWithIntermediateSlices(perspectiveCamera());
+}
+
+TEST(Stack2dReference, ParallelErrorFallsWithIntermediateSlices)
+{
+    expectErrorFallsWithIntermediateSlices(parallelCamera());
+}
+
+TEST(Stack2dRender, TwoRendersGiveIdenticalBits)
+{
+    const Scene scene = makeScene(perspectiveCamera(), 24, {{"intermediate", 1}});
+    auto renderer = makeRenderer(test::device(), scene, marschnerLobb41());
+    FrameStats stats;
+    const Image4f a = renderer->render(stats);
+    const Image4f b = renderer->render(stats);
+    const Image4f c = renderScene(scene, marschnerLobb41());
+    ASSERT_EQ(a.pixels().size(), b.pixels().size());
+    EXPECT_EQ(std::memcmp(a.pixels().data(), b.pixels().data(), a.pixels().size() * sizeof(glm::vec4)), 0);
+    EXPECT_EQ(std::memcmp(a.pixels().data(), c.pixels().data(), a.pixels().size() * sizeof(glm::vec4)), 0);
+    EXPECT_EQ(stats.extra["slices"], 81);
+    EXPECT_EQ(renderer->residentBytes(), 3u * 41 * 41 * 41 * 4 + 4 * (4 + 8 * 3));
+}
+
+}  // namespace
+}  // namespace clvr
