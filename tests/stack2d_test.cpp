@@ -152,7 +152,7 @@ TEST(Stack2dAxis, RotatingTheCameraSwitchesTheStack)
 {
     // The camera on a circle in the x-z plane around the volume: the z stack up to 45 degrees, the x
     // stack beyond, z again past 135; the renderer reports the stack it drew.
-    const int expected[] = {2, 2, 0, 0, 2, 2};
+    const char* expected[] = {"z", "z", "x", "x", "z", "z"};
     const double degrees[] = {0.0, 40.0, 50.0, 120.0, 140.0, 180.0};
     for (int i = 0; i < 6; ++i) {
         Camera c;
@@ -160,7 +160,7 @@ TEST(Stack2dAxis, RotatingTheCameraSwitchesTheStack)
         c.position = {4.0 * std::sin(a), 0.3, 4.0 * std::cos(a)};
         FrameStats stats;
         renderScene(makeScene(c, 8), marschnerLobb41(), &stats);
-        EXPECT_EQ(stats.extra["axis"], (const char*[]){"x", "y", "z"}[expected[i]]) << degrees[i] << " degrees";
+        EXPECT_EQ(stats.extra["axis"], expected[i]) << degrees[i] << " degrees";
     }
 }
 
@@ -182,8 +182,9 @@ TEST(Stack2dPlan, SlicesTileTheBoxBackToFrontWithLerpWeights)
                 EXPECT_DOUBLE_EQ(s[i].lower + s[i].weight, s[i].position);
                 EXPECT_GE(s[i].weight, 0.0f);
                 EXPECT_LT(s[i].weight, 1.0f);
-                if (i > 0)
+                if (i > 0) {
                     EXPECT_LT(s[i].position, s[i - 1].position) << "back (high z) to front";
+                }
             }
             EXPECT_NEAR(total, 8 * 0.2, 1e-12);  // the slabs cover the box's z extent exactly
             EXPECT_DOUBLE_EQ(s.front().thickness, 0.1 / (intermediate + 1));
