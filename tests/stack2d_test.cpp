@@ -27,7 +27,7 @@ TransferFunction mlTransferFunction()
 }
 constexpr double kTauMax = 8.0;
 
-Camera perspectiveCamera()  // the camera of tests/slice3d_test.cpp: 26 degrees off the z axis
+Camera perspectiveCamera()  // the camera of tests/slice3d_test.cpp: 28 degrees off the z axis
 {
     Camera c;
     c.position = {1.2, 1.6, 3.7};
@@ -35,7 +35,7 @@ Camera perspectiveCamera()  // the camera of tests/slice3d_test.cpp: 26 degrees 
     return c;
 }
 
-Camera parallelCamera()  // ... and its parallel one: x stack, 33 degrees off the x axis
+Camera parallelCamera()  // ... and its parallel one: x stack, 32 degrees off the x axis
 {
     Camera c;
     c.position = {3.5, 1.0, 1.9};
