@@ -4,6 +4,7 @@
 // raster.cl itself, so that the fragment program is checked in the context it runs in.
 // The host has validated everything; this file only does arithmetic.
 #include "transfer_function.h"
+#include "reflectance_map.h"
 #ifndef CLVR_STACK2D_FRAGMENT
 #include "raster.cl"
 #endif
@@ -14,10 +15,15 @@
  * thickness along the stack axis, world units. All but (u, v) are constant over a quad.
  * uniforms: 0..3 camera position, forward, right, up; 4 (tan(view_angle / 2) or parallel_scale,
  * aspect, 1 if parallel, 0); 5 (image width, height, tf_count, 0); 6 the stack axis as a unit vector;
- * 7 (texture width, height, 0, 0) of one slice. buffer[0] the stack (slices one after another,
- * x fastest), buffer[1] the transfer function (transfer_function.h).
+ * 7 (texture width, height, channels, 0) of one slice; 8 (reflectance map n, 1 if shaded, 0, 0);
+ * 9 the unit vector towards the eye (-forward). buffer[0] the stack (slices one after another, x
+ * fastest): 1 channel, the value, returned as (v, v, v, v); or, shaded, 4 channels (gradient, value)
+ * from host/gradient_volume.h. buffer[1] the transfer function (transfer_function.h); buffer[2] the
+ * reflectance map (reflectance_map.h), shaded only.
  * Sample: bilinear in each slice; an intermediate slice lerps two bilinear samples, the paper's
- * register-combiner step, which makes the sample trilinear. Classified after interpolation;
+ * register-combiner step, which makes the sample (and the gradient) trilinear. Classified after
+ * interpolation; shaded, the color is C times the map's shade of the interpolated gradient (the
+ * model of host/reflectance_map.h, as planes and blend; tau is not shaded);
  * alpha = 1 - exp(-tau Delta) with Delta the ray's length through the slab, thickness / |cos| of
  * the angle between the pixel's ray and the axis. Output premultiplied (C alpha, alpha). */
 int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* color)
@@ -27,20 +33,20 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
     slice.width = (cl_uint)u[7].x;
     slice.height = (cl_uint)u[7].y;
     slice.depth = 1u;
-    slice.channels = 1u;
+    slice.channels = (cl_uint)u[7].z;
     slice.filter = CLVR_FILTER_LINEAR;
     slice.wrap = CLVR_WRAP_CLAMP_TO_EDGE;
     slice.pad0 = slice.pad1 = 0u;
     slice.border = (float4)(0.0f);
-    const size_t texels = (size_t)slice.width * slice.height;
+    const size_t texels = (size_t)slice.width * slice.height * slice.channels;
     /* lower and weight are interpolated constants: round lower, take weight as it comes (its
      * rounding error is a few ulp) */
     const int lower = (int)round(f->attr[0].z);
     const float weight = f->attr[0].w;
     global const float* s0 = r->buffer[0] + (size_t)lower * texels;
-    float s = clvr_tex2d(s0, slice, f->attr[0].xy).x;
+    float4 sample = clvr_tex2d(s0, slice, f->attr[0].xy);
     if (weight > 0.0f)
-        s = mix(s, clvr_tex2d(s0 + texels, slice, f->attr[0].xy).x, weight);
+        sample = mix(sample, clvr_tex2d(s0 + texels, slice, f->attr[0].xy), weight);
 
     /* The pixel's ray direction (host/camera.cpp's Camera::ray): forward for a parallel camera, else
      * forward + x right + y up through the pixel center. */
@@ -53,8 +59,11 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
     const float cos_theta = fmax(fabs(dot(d, u[6].xyz)) / length(d), 1e-20f);
     const float delta = f->attr[1].x / cos_theta;
 
-    const float4 ct = clvr_tf_eval(r->buffer[1], (int)u[5].z, s);
+    const float4 ct = clvr_tf_eval(r->buffer[1], (int)u[5].z, sample.w);
     const float alpha = 1.0f - exp(-ct.w * delta);
-    *color = (float4)(ct.xyz * alpha, alpha);
+    float3 c = ct.xyz;
+    if (u[8].y != 0.0f)
+        c *= clvr_reflectance((global const float4*)r->buffer[2], (int)u[8].x, sample.xyz, u[9].xyz);
+    *color = (float4)(c * alpha, alpha);
     return 1;
 }

@@ -5,7 +5,9 @@
 
 #include "host/errors.h"
 #include "host/generators.h"
+#include "host/gradient_volume.h"
 #include "host/reference_integral.h"
+#include "host/reflectance_map.h"
 #include "host/render/renderer.h"
 #include "tests/test_util.h"
 
@@ -118,7 +120,8 @@ void expectInputError(const json& options, const std::string& fragment)
 
 TEST(Stack2dOptions, BadOptionsThrowInputErrorNamingTheKey)
 {
-    expectInputError({{"foo", 1}}, "options.foo: unknown option for stack2d (known: intermediate)");
+    expectInputError({{"foo", 1}}, "options.foo: unknown option for stack2d (known: intermediate, reflectance_map_size)");
+    expectInputError({{"reflectance_map_size", 0}}, "options.reflectance_map_size: must be an integer in [1, 1024]");
     expectInputError({{"intermediate", -1}}, "options.intermediate: must be an integer in [0, 64], got -1");
     expectInputError({{"intermediate", 65}}, "options.intermediate");
     expectInputError({{"intermediate", 1.5}}, "options.intermediate");
@@ -128,12 +131,6 @@ TEST(Stack2dOptions, BadOptionsThrowInputErrorNamingTheKey)
     EXPECT_EQ(parseStack2dOptions(json()).intermediate, 0);
 }
 
-TEST(Stack2dOptions, LightsAreAnInputErrorUntilShadingExists)
-{
-    Scene scene = makeScene(perspectiveCamera(), 8);
-    scene.lights = json::array({{{"direction", {0, 0, 1}}}});
-    EXPECT_THROW(makeRenderer(test::device(), scene, marschnerLobb41()), InputError);
-}
 
 TEST(Stack2dAxis, TheStackMostParallelToTheViewDirectionIsChosen)
 {
@@ -265,6 +262,83 @@ TEST(Stack2dRender, TwoRendersGiveIdenticalBits)
     EXPECT_EQ(std::memcmp(a.pixels().data(), c.pixels().data(), a.pixels().size() * sizeof(glm::vec4)), 0);
     EXPECT_EQ(stats.extra["slices"], 81);
     EXPECT_EQ(renderer->residentBytes(), 3u * 41 * 41 * 41 * 4 + 4 * (4 + 8 * 3));
+}
+
+// ---- shaded (diffuse shading of semi-transparent volumes) ----------------------------------------
+
+const Volume& sphere33()
+{
+    static const Volume v = generateVolume("sphere", {33, 33, 33});
+    return v;
+}
+
+// The shaded scene of tests/blend_test.cpp: shells of "sphere" (gradient length 1), two lights.
+Scene shadedScene(const Camera& camera, json options)
+{
+    Scene s = makeScene(camera, 40, std::move(options));
+    s.transferFunction = TransferFunction({{0.2, {0.2, 0.4, 1.0}, 0.0}, {0.3, {0.3, 0.6, 1.0}, 3.0},
+                                           {0.5, {1.0, 0.8, 0.3}, 6.0}, {0.6, {1.0, 0.9, 0.7}, 0.0}});
+    s.lights = json::parse(R"([{"direction": [0.4, 0.6, 1.0]}, {"direction": [-1.0, -0.2, 0.3], "color": [0.3, 0.3, 0.5]}])");
+    s.material = json::parse(R"({"ambient": 0.15, "diffuse": 0.7, "specular": 0.3, "shininess": 10})");
+    return s;
+}
+
+Image4d shadedReference(const Scene& scene)
+{
+    static const std::vector<glm::vec4> gradients = sobelGradientVolume(sphere33());
+    const ReferenceShading shading{&gradients, sceneLighting(scene), -scene.camera->forward()};
+    ReferenceOptions options;
+    options.shading = &shading;
+    return referenceIntegral(sphere33(), scene.transferFunction, *scene.camera, scene.image, options);
+}
+
+// Tolerance: as unshaded, with the emission scaled by the largest shade, 0.15 + (0.7 + 0.3) +
+// 0.5 (0.7 + 0.3) = 1.65 (a slab's color is at most 1.65 alpha), plus the map's quantization bound
+// (reflectanceMapBound) for the max; tau_max = 6, spacing 2/32.
+TEST(Stack2dShaded, MatchesShadedReferenceAndErrorFallsWithIntermediateSlices)
+{
+    const int size = 40;
+    for (const Camera& camera : {perspectiveCamera(), parallelCamera()}) {
+        double previousMean = 1e30;
+        Scene first;
+        for (const int intermediate : {0, 3}) {
+            const Scene scene = shadedScene(camera, {{"intermediate", intermediate}, {"reflectance_map_size", 256}});
+            if (intermediate == 0)
+                first = scene;
+            FrameStats stats;
+            const Image4f image = renderScene(scene, sphere33(), &stats);
+            EXPECT_EQ(stats.extra["shaded"], true);
+            const Image4d expected = shadedReference(first);
+            const test::ImageError e = test::imageError(image, expected);
+            const double deltaMax = 2.0 / 32.0 / (intermediate + 1) / minCos(camera, size, stackAxis(camera));
+            std::printf("[ measured ] shaded %s, intermediate %d: max %.3g %.3g %.3g %.3g, mean %.2g %.2g %.2g %.2g, "
+                        "Delta_max %.4f\n",
+                        camera.parallel ? "parallel" : "perspective", intermediate, e.maxAbs.r, e.maxAbs.g, e.maxAbs.b,
+                        e.maxAbs.a, e.meanAbs.r, e.meanAbs.g, e.meanAbs.b, e.meanAbs.a, deltaMax);
+            const double slab = 1.0 - std::exp(-6.0 * deltaMax);
+            const double mapBound = reflectanceMapBound(sceneLighting(scene), 256);
+            EXPECT_TRUE(test::imagesNear(image, expected, {.maxAbs = 2.0 * 1.65 * slab + mapBound,
+                                                           .meanAbs = 1.65 * 0.02 * 6.0 * deltaMax}))
+                << (camera.parallel ? "parallel" : "perspective") << ", intermediate " << intermediate;
+            EXPECT_LT(maxChannel(e.meanAbs), previousMean);
+            previousMean = maxChannel(e.meanAbs);
+        }
+    }
+}
+
+TEST(Stack2dShaded, LightsChangeTheImage)
+{
+    const Scene shaded = shadedScene(perspectiveCamera(), {{"intermediate", 1}});
+    Scene unshaded = shaded;
+    unshaded.lights = json();
+    unshaded.material = json();
+    const Image4f a = renderScene(shaded, sphere33()), b = renderScene(unshaded, sphere33());
+    Image4d bd(b.width(), b.height());
+    for (std::size_t i = 0; i < b.pixelCount(); ++i)
+        bd.pixels()[i] = glm::dvec4(b.pixels()[i]);
+    const test::ImageError e = test::imageError(a, bd);
+    EXPECT_GT(e.maxAbs.b, 0.1);      // shading changes the color ...
+    EXPECT_LT(e.maxAbs.a, 1e-6);     // ... never the opacity (tau is not shaded)
 }
 
 }  // namespace

@@ -5,6 +5,8 @@
 
 #include "host/embedded_kernels.h"
 #include "host/errors.h"
+#include "host/gradient_volume.h"
+#include "host/reflectance_map.h"
 #include "host/render/slice3d.h"  // packTransferFunction
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
@@ -22,7 +24,8 @@ namespace {
 
 // The most intermediate slices per stack interval; 64 already samples far finer than the data.
 constexpr int kMaxIntermediate = 64;
-constexpr const char* kKnownOptions = "intermediate";
+constexpr int kMaxMapSize = 1024;
+constexpr const char* kKnownOptions = "intermediate, reflectance_map_size";
 constexpr const char* kAxisNames[3] = {"x", "y", "z"};
 
 [[noreturn]] void badOption(const std::string& key, const std::string& what)
@@ -42,17 +45,19 @@ StackShape stackShape(int axis)
     return {std::min(p, q), std::max(p, q)};
 }
 
-std::vector<float> stackTexels(const Volume& volume, int axis)
+// The texels of that stack from `channels` floats per grid point (x fastest, then y, then z).
+std::vector<float> stackTexels(const float* points, const glm::ivec3& n, int channels, int axis)
 {
-    const glm::ivec3 n = volume.dims;
     const StackShape s = stackShape(axis);
-    std::vector<float> texels(volume.values.size());
-    std::size_t out = 0;
+    std::vector<float> texels(static_cast<std::size_t>(n.x) * n.y * n.z * channels);
+    float* out = texels.data();
     glm::ivec3 g;
     for (g[axis] = 0; g[axis] < n[axis]; ++g[axis])
         for (g[s.c] = 0; g[s.c] < n[s.c]; ++g[s.c])
-            for (g[s.b] = 0; g[s.b] < n[s.b]; ++g[s.b])
-                texels[out++] = volume.at(g.x, g.y, g.z);
+            for (g[s.b] = 0; g[s.b] < n[s.b]; ++g[s.b]) {
+                const float* p = points + ((static_cast<std::size_t>(g.z) * n.y + g.y) * n.x + g.x) * channels;
+                out = std::copy(p, p + channels, out);
+            }
     return texels;
 }
 
@@ -70,10 +75,11 @@ private:
     ImageSpec image_;
     glm::ivec3 dims_;
     glm::dvec3 origin_, spacing_, lo_, hi_;
+    Lighting lighting_;
     int axis_ = 2;
     std::vector<StackSlice> slices_;
     std::vector<raster::Texture> stacks_;  // x, y, z: all three stay resident, as on the paper's boards
-    cl::Buffer tf_;
+    cl::Buffer tf_, map_;
     std::size_t tfBytes_ = 0;
     std::uint64_t residentBytes_ = 0;
     std::unique_ptr<raster::Framebuffer> framebuffer_;
@@ -82,12 +88,9 @@ private:
 };
 
 Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volume& volume)
-    : device_(device), options_(parseStack2dOptions(scene.options)), image_(scene.image)
+    : device_(device), options_(parseStack2dOptions(scene.options)), image_(scene.image), lighting_(sceneLighting(scene))
 {
     volume.validate();
-    if (!scene.lights.is_null())
-        throw InputError("lights: technique stack2d does not shade yet (docs/stack2d.md); remove \"lights\" "
-                         "or use planes or blend");
     dims_ = volume.dims;
     origin_ = volume.origin;
     spacing_ = volume.spacing;
@@ -100,17 +103,30 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
     axis_ = stackAxis(camera_);
     slices_ = planStack(camera_, origin_, spacing_, dims_, axis_, options_.intermediate);
 
+    // Unshaded: the values (1 channel). Shaded: (gradient, value) per texel, the paper's RGBA slices
+    // with the gradient in RGB, so that one bilinear fetch (and the lerp) interpolates both.
+    const int channels = lighting_.shaded() ? 4 : 1;
+    std::vector<glm::vec4> rgba;
+    if (lighting_.shaded())
+        rgba = sobelGradientVolume(volume);
+    const float* points = lighting_.shaded() ? &rgba[0].x : volume.values.data();
     for (int a = 0; a < 3; ++a) {
         const StackShape s = stackShape(a);
         raster::TextureDesc desc;
         desc.width = dims_[s.b];
         desc.height = dims_[s.c];
         desc.depth = dims_[a];
-        desc.channels = 1;
+        desc.channels = channels;
         desc.filter = raster::Filter::Linear;
         desc.wrap = raster::Wrap::ClampToEdge;
-        stacks_.emplace_back(device_, desc, stackTexels(volume, a));
+        stacks_.emplace_back(device_, desc, stackTexels(points, dims_, channels, a));
         residentBytes_ += stacks_.back().bytes();
+    }
+    // The map holds one view direction for the image (-forward), as in planes and blend.
+    if (lighting_.shaded()) {
+        const ReflectanceMap map = buildReflectanceMap(lighting_, -camera_.forward(), options_.reflectanceMapSize);
+        map_ = device_.upload("stack2d reflectance map", map.entries);
+        residentBytes_ += map.entries.size() * sizeof(glm::vec4);
     }
     setTransferFunction(scene.transferFunction);
 
@@ -135,8 +151,11 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
         glm::vec4(static_cast<float>(scale), static_cast<float>(aspect), camera_.parallel ? 1.0f : 0.0f, 0.0f),
         glm::vec4(image_.width, image_.height, 0.0f, 0.0f),  // z: tf_count, set with the transfer function
         axisVector,
-        glm::vec4(dims_[s.b], dims_[s.c], 0.0f, 0.0f),
+        glm::vec4(dims_[s.b], dims_[s.c], channels, 0.0f),
+        glm::vec4(options_.reflectanceMapSize, lighting_.shaded() ? 1.0f : 0.0f, 0.0f, 0.0f),
+        glm::vec4(glm::vec3(-camera_.forward()), 0.0f),
     };
+    fragmentProgram_.buffers[2] = map_;
     fragmentProgram_.uniforms[5].z = static_cast<float>(scene.transferFunction.points().size());
     fragmentProgram_.buffers[1] = tf_;
 }
@@ -213,6 +232,8 @@ Image4f Stack2dRenderer::render(FrameStats& stats)
     stats.extra["axis"] = kAxisNames[axis_];
     stats.extra["slices"] = slices_.size();
     stats.extra["intermediate"] = options_.intermediate;
+    stats.extra["shaded"] = lighting_.shaded();
+    stats.extra["reflectance_map_size"] = options_.reflectanceMapSize;
     stats.extra["triangles"] = drawStats.triangles;
     stats.extra["voxels"] = static_cast<std::uint64_t>(dims_.x) * dims_.y * dims_.z;
     stats.extra["resident_bytes"] = residentBytes_;
@@ -233,6 +254,10 @@ Stack2dOptions parseStack2dOptions(const nlohmann::json& options)
             if (!value.is_number_integer() || value.get<long long>() < 0 || value.get<long long>() > kMaxIntermediate)
                 badOption(key, "must be an integer in [0, " + std::to_string(kMaxIntermediate) + "], got " + value.dump());
             o.intermediate = static_cast<int>(value.get<long long>());
+        } else if (key == "reflectance_map_size") {
+            if (!value.is_number_integer() || value.get<long long>() < 1 || value.get<long long>() > kMaxMapSize)
+                badOption(key, "must be an integer in [1, " + std::to_string(kMaxMapSize) + "], got " + value.dump());
+            o.reflectanceMapSize = static_cast<int>(value.get<long long>());
         } else {
             badOption(key, std::string("unknown option for stack2d (known: ") + kKnownOptions + ")");
         }

@@ -1,7 +1,9 @@
 // host/render/stack2d.h — 2D texture stacks (seeds/003_e49ee09fcdafadac.txt): the volume held as three
 // stacks of 2D textures, one per axis; per view the stack whose axis is most parallel to the view
 // direction is drawn as object-aligned quads, back to front, each sampled bilinearly, classified after
-// interpolation and blended "over". Intermediate slices between two stack slices lerp the bilinear
+// interpolation and blended "over"; with "lights", the color is shaded by the interpolated gradient
+// (the paper's shading of semi-transparent volumes, with planes/blend's Phong model and reflectance
+// map). Intermediate slices between two stack slices lerp the bilinear
 // samples of both (the paper's multi-texture combiner), so their sampling is trilinear. Pass by pass
 // through raster::draw with kernels/stack2d.cl as fragment program. docs/stack2d.md.
 #pragma once
@@ -18,6 +20,7 @@ namespace clvr {
 
 struct Stack2dOptions {
     int intermediate = 0;  // slices interpolated between two neighbouring stack slices (0: the stack itself)
+    int reflectanceMapSize = 128;  // shaded ("lights" in the scene): n, 6 n^2 shades (host/reflectance_map.h)
 };
 
 // Reads the scene's "options" for stack2d. Throws InputError naming the key ("options.intermediate: ...").
@@ -46,8 +49,8 @@ struct StackSlice {
 std::vector<StackSlice> planStack(const Camera& camera, const glm::dvec3& origin, const glm::dvec3& spacing,
                                   const glm::ivec3& dims, int axis, int intermediate);
 
-// Renderer for "stack2d". Uploads three float32 stacks (3 x 4 bytes per grid point) and the packed
-// transfer function; throws InputError for bad options, DeviceError when the stacks do not fit.
+// Renderer for "stack2d". Uploads three float32 stacks (3 x 4 bytes per grid point; shaded, with the
+// Sobel gradient: 3 x 16 bytes) and the packed transfer function (and the reflectance map); throws InputError for bad options, DeviceError when the stacks do not fit.
 std::unique_ptr<Renderer> makeStack2dRenderer(Device& device, const Scene& scene, const Volume& volume);
 
 }  // namespace clvr
