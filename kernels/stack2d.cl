@@ -9,14 +9,16 @@
 #include "raster.cl"
 #endif
 
-/* One fragment of a stack quad. attr[0] = (u, v, lower, weight): the 2D texture coordinates on the
+/* One fragment of a stack quad (direct volume rendering; iso-surfaces below). attr[0] = (u, v, lower, weight): the 2D texture coordinates on the
  * slice (texel i of n centered at (i + 0.5) / n, so grid point i is texel i), the stack slice to
  * sample and the weight of slice lower + 1 (0 on a stack slice itself); attr[1].x = the slab's
  * thickness along the stack axis, world units. All but (u, v) are constant over a quad.
  * uniforms: 0..3 camera position, forward, right, up; 4 (tan(view_angle / 2) or parallel_scale,
  * aspect, 1 if parallel, 0); 5 (image width, height, tf_count, 0); 6 the stack axis as a unit vector;
  * 7 (texture width, height, channels, 0) of one slice; 8 (reflectance map n, 1 if shaded, 0, 0);
- * 9 the unit vector towards the eye (-forward). buffer[0] the stack (slices one after another, x
+ * 9 the unit vector towards the eye (-forward); 10 (data minimum, 1 if iso-surface, ambient, diffuse);
+ * 11 (surface color, 1 if gradient-shaded); 12 (unit vector towards the light, 1 / (data range)):
+ * iso-surfaces only. buffer[0] the stack (slices one after another, x
  * fastest): 1 channel, the value, returned as (v, v, v, v); or, shaded, 4 channels (gradient, value)
  * from host/gradient_volume.h. buffer[1] the transfer function (transfer_function.h); buffer[2] the
  * reflectance map (reflectance_map.h), shaded only.
@@ -28,6 +30,11 @@
  * the angle between the pixel's ray and the axis. Output premultiplied (C alpha, alpha). */
 int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* color)
 {
+    /* Iso-surface mode (the paper's fast shaded iso-surfaces): output (shaded color, value mapped to
+     * [0, 1] over the data range, as the paper's 8-bit alpha); the draw's alpha test (GEQUAL the
+     * iso-value mapped alike) keeps the fragments inside the surface, and back-to-front drawing
+     * without blending leaves the front-most one. Diffuse shading with the two-sided normal of the
+     * interpolated gradient: ambient + diffuse max(0, N.L), N turned to face the viewer. */
     constant float4* u = r->uniforms;
     ClTexture slice;
     slice.width = (cl_uint)u[7].x;
@@ -48,6 +55,19 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
     if (weight > 0.0f)
         sample = mix(sample, clvr_tex2d(s0 + texels, slice, f->attr[0].xy), weight);
 
+    if (u[10].y != 0.0f) {
+        float shade = 1.0f;
+        if (u[11].w != 0.0f) {
+            const float len = length(sample.xyz);
+            float3 n = len > 0.0f ? sample.xyz / len : (float3)(0.0f);
+            if (dot(n, u[9].xyz) < 0.0f)
+                n = -n;
+            shade = u[10].z + u[10].w * fmax(0.0f, dot(n, u[12].xyz));
+        }
+        *color = (float4)(u[11].xyz * shade, (sample.w - u[10].x) * u[12].w);
+        return 1;
+    }
+
     /* The pixel's ray direction (host/camera.cpp's Camera::ray): forward for a parallel camera, else
      * forward + x right + y up through the pixel center. */
     const float2 ndc = (float2)(f->window.x / u[5].x * 2.0f - 1.0f, 1.0f - f->window.y / u[5].y * 2.0f);
@@ -66,4 +86,14 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
         c *= clvr_reflectance((global const float4*)r->buffer[2], (int)u[8].x, sample.xyz, u[9].xyz);
     *color = (float4)(c * alpha, alpha);
     return 1;
+}
+
+/* Iso-surface mode's last pass: where a fragment passed the alpha test (stencil 1) the pixel is the
+ * surface, opaque; elsewhere the background, A = 0. */
+kernel void stack2d_iso_finish(global float4* color, global const uchar* stencil, const int count,
+                               const float4 background)
+{
+    CLVR_GUARD_1D(count);
+    const size_t i = get_global_id(0);
+    color[i] = stencil[i] != 0 ? (float4)(color[i].xyz, 1.0f) : (float4)(background.xyz, 0.0f);
 }

@@ -100,7 +100,7 @@ double minCos(const Camera& camera, int size, int axis)
     double c = 1.0;
     for (int y = 0; y < size; ++y)
         for (int x = 0; x < size; ++x) {
-            const Ray r = camera.ray(x + 0.5, y + 0.5, size, size);
+            const Ray r = camera.ray(x, y, size, size);
             c = std::min(c, std::abs(glm::normalize(r.direction)[axis]));
         }
     return c;
@@ -339,6 +339,62 @@ TEST(Stack2dShaded, LightsChangeTheImage)
     const test::ImageError e = test::imageError(a, bd);
     EXPECT_GT(e.maxAbs.b, 0.1);      // shading changes the color ...
     EXPECT_LT(e.maxAbs.a, 1e-6);     // ... never the opacity (tau is not shaded)
+}
+
+// ---- shaded iso-surfaces ----------------------------------------------------------------------
+
+// The iso-surface 0.5 of "sphere" (1 - |p|) is the sphere of radius 0.5, seen by both cameras; no
+// transfer function, so the surface is white: ambient + diffuse max(0, N.L), N the outward normal.
+// Rays that pass the sphere by more than a margin must give the background (A = 0), rays through its
+// inner part the surface (A = 1) with the analytic shade. Margin and shade tolerance: the hit lies on
+// the first slice inside the surface, up to one slab Delta behind it, and the Sobel gradient of the
+// trilinear field tilts the normal. Measured (48x48, 3 intermediate slices): no pixel wrong by coverage
+// with a margin of 0.03 (half a grid spacing); shade error over the 88 (perspective) and 68 (parallel)
+// inner pixels max 0.011 / 0.018, mean 0.0034 / 0.0045. Bounds: 0.04 and 0.01, about twice that.
+TEST(Stack2dIso, SphereSilhouetteAndShadeMatchTheAnalyticSurface)
+{
+    const double r = 0.5, ambient = 0.15, diffuse = 0.8;
+    const glm::dvec3 light = glm::normalize(glm::dvec3(0.4, 0.6, 1.0));
+    for (const Camera& camera : {perspectiveCamera(), parallelCamera()}) {
+        Scene scene = makeScene(camera, 48, {{"intermediate", 3}});
+        scene.transferFunction = TransferFunction();
+        scene.iso = {{"value", 0.5}, {"light", {0.4, 0.6, 1.0}}, {"ambient", ambient}, {"diffuse", diffuse}};
+        FrameStats stats;
+        const Image4f image = renderScene(scene, sphere33(), &stats);
+        EXPECT_EQ(stats.extra["iso"], true);
+        int inside = 0, outside = 0;
+        double maxShadeError = 0.0, meanShadeError = 0.0;
+        for (int y = 0; y < 48; ++y)
+            for (int x = 0; x < 48; ++x) {
+                const glm::vec4 p = image.pixels()[static_cast<std::size_t>(y) * 48 + x];
+                const Ray ray = camera.ray(x, y, 48, 48);
+                const double tc = -glm::dot(ray.origin, ray.direction);  // closest approach to the center
+                const double d = glm::length(ray.origin + tc * ray.direction);
+                if (d > r + 0.03) {
+                    ++outside;
+                    EXPECT_EQ(p.a, 0.0f) << x << ", " << y;
+                    EXPECT_NEAR(p.b, 0.3, 1e-6) << x << ", " << y;
+                } else if (d < r - 0.03) {
+                    ASSERT_EQ(p.a, 1.0f) << x << ", " << y;
+                    if (d > 0.35)
+                        continue;  // near the silhouette the slab offset moves the normal most
+                    ++inside;
+                    const glm::dvec3 hit = ray.origin + (tc - std::sqrt(r * r - d * d)) * ray.direction;
+                    const double shade = ambient + diffuse * std::max(0.0, glm::dot(glm::normalize(hit), light));
+                    const double e = std::abs(p.r - shade);
+                    maxShadeError = std::max(maxShadeError, e);
+                    meanShadeError += e;
+                    EXPECT_EQ(p.r, p.b);  // white surface
+                }
+            }
+        meanShadeError /= std::max(inside, 1);
+        std::printf("[ measured ] iso %s: %d inner pixels, shade error max %.3g mean %.3g; %d outside\n",
+                    camera.parallel ? "parallel" : "perspective", inside, maxShadeError, meanShadeError, outside);
+        EXPECT_GT(inside, 50);
+        EXPECT_GT(outside, 1000);
+        EXPECT_LT(maxShadeError, 0.04);
+        EXPECT_LT(meanShadeError, 0.01);
+    }
 }
 
 }  // namespace

@@ -18,6 +18,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <optional>
 
 namespace clvr {
 namespace {
@@ -76,6 +77,17 @@ private:
     glm::ivec3 dims_;
     glm::dvec3 origin_, spacing_, lo_, hi_;
     Lighting lighting_;
+    // Iso-surface mode (scene "iso"): the alpha test on the value keeps the slice fragments inside the
+    // surface, the front-most one stays.
+    struct Iso {
+        double value = 0.0;
+        bool gradientShading = true;  // "shading": "gradient"; "none": flat surface color
+        glm::dvec3 light{0.0};        // towards the light; default: the headlight, -forward
+        double ambient = 0.1, diffuse = 0.9;
+        glm::dvec3 color{1.0};        // the transfer function's color at the value, or white
+        double dataMin = 0.0, dataMax = 1.0;
+    };
+    std::optional<Iso> iso_;
     int axis_ = 2;
     std::vector<StackSlice> slices_;
     std::vector<raster::Texture> stacks_;  // x, y, z: all three stay resident, as on the paper's boards
@@ -84,7 +96,7 @@ private:
     std::uint64_t residentBytes_ = 0;
     std::unique_ptr<raster::Framebuffer> framebuffer_;
     raster::FragmentProgram fragmentProgram_;
-    cl::Kernel overBackground_;
+    cl::Kernel overBackground_, isoFinish_;
 };
 
 Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volume& volume)
@@ -100,16 +112,37 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
     camera_.validate();
     if (image_.width < 1 || image_.height < 1)
         throw InputError("image: width and height must be >= 1");
+    if (!scene.iso.is_null()) {  // keys and types checked by parseScene
+        Iso iso;
+        iso.value = scene.iso["value"].get<double>();
+        const std::string shading = scene.iso.value("shading", std::string("gradient"));
+        if (shading != "gradient" && shading != "none")
+            throw InputError("iso.shading: stack2d knows \"gradient\" and \"none\", got \"" + shading + "\"");
+        iso.gradientShading = shading == "gradient";
+        iso.light = scene.iso.contains("light")
+                        ? glm::normalize(glm::dvec3(scene.iso["light"][0].get<double>(), scene.iso["light"][1].get<double>(),
+                                                    scene.iso["light"][2].get<double>()))
+                        : -camera_.forward();
+        iso.ambient = scene.iso.value("ambient", iso.ambient);
+        iso.diffuse = scene.iso.value("diffuse", iso.diffuse);
+        if (!scene.transferFunction.points().empty())
+            iso.color = glm::dvec3(scene.transferFunction(iso.value));
+        const auto [mn, mx] = std::minmax_element(volume.values.begin(), volume.values.end());
+        iso.dataMin = *mn;
+        iso.dataMax = *mx;
+        iso_ = iso;
+    }
     axis_ = stackAxis(camera_);
     slices_ = planStack(camera_, origin_, spacing_, dims_, axis_, options_.intermediate);
 
     // Unshaded: the values (1 channel). Shaded: (gradient, value) per texel, the paper's RGBA slices
     // with the gradient in RGB, so that one bilinear fetch (and the lerp) interpolates both.
-    const int channels = lighting_.shaded() ? 4 : 1;
+    const bool gradients = lighting_.shaded() || iso_;
+    const int channels = gradients ? 4 : 1;
     std::vector<glm::vec4> rgba;
-    if (lighting_.shaded())
+    if (gradients)
         rgba = sobelGradientVolume(volume);
-    const float* points = lighting_.shaded() ? &rgba[0].x : volume.values.data();
+    const float* points = gradients ? &rgba[0].x : volume.values.data();
     for (int a = 0; a < 3; ++a) {
         const StackShape s = stackShape(a);
         raster::TextureDesc desc;
@@ -154,7 +187,18 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
         glm::vec4(dims_[s.b], dims_[s.c], channels, 0.0f),
         glm::vec4(options_.reflectanceMapSize, lighting_.shaded() ? 1.0f : 0.0f, 0.0f, 0.0f),
         glm::vec4(glm::vec3(-camera_.forward()), 0.0f),
+        glm::vec4(0.0f),  // 10..12: iso-surface mode
+        glm::vec4(0.0f),
+        glm::vec4(0.0f),
     };
+    if (iso_) {
+        const double range = iso_->dataMax > iso_->dataMin ? iso_->dataMax - iso_->dataMin : 1.0;
+        fragmentProgram_.uniforms[10] = glm::vec4(static_cast<float>(iso_->dataMin), 1.0f,
+                                                  static_cast<float>(iso_->ambient), static_cast<float>(iso_->diffuse));
+        fragmentProgram_.uniforms[11] = glm::vec4(glm::vec3(iso_->color), iso_->gradientShading ? 1.0f : 0.0f);
+        fragmentProgram_.uniforms[12] = glm::vec4(glm::vec3(iso_->light), static_cast<float>(1.0 / range));
+        isoFinish_ = device_.kernel("stack2d.cl", "stack2d_iso_finish");
+    }
     fragmentProgram_.buffers[2] = map_;
     fragmentProgram_.uniforms[5].z = static_cast<float>(scene.transferFunction.points().size());
     fragmentProgram_.buffers[1] = tf_;
@@ -162,7 +206,9 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
 
 void Stack2dRenderer::setTransferFunction(const TransferFunction& tf)
 {
-    const std::vector<float> packed = packTransferFunction(tf);
+    std::vector<float> packed = packTransferFunction(tf);
+    if (packed.empty())
+        packed.push_back(0.0f);  // an iso-surface scene without a transfer function: never read
     residentBytes_ -= tfBytes_;
     tfBytes_ = packed.size() * sizeof(float);
     residentBytes_ += tfBytes_;
@@ -212,19 +258,42 @@ Image4f Stack2dRenderer::render(FrameStats& stats)
         for (const auto& [cb, cc] : std::array<std::pair<int, int>, 6>{{{0, 0}, {1, 0}, {1, 1}, {0, 0}, {1, 1}, {0, 1}}})
             vertices.push_back(vertex(cb, cc));
     }
-    raster::DrawState state;  // "over" on premultiplied color: dst = src + (1 - src.a) dst
-    state.fragment.blend.enabled = true;
-    state.fragment.blend.srcRgb = state.fragment.blend.srcAlpha = raster::BlendFactor::One;
-    state.fragment.blend.dstRgb = state.fragment.blend.dstAlpha = raster::BlendFactor::OneMinusSrcAlpha;
+    raster::DrawState state;
+    if (!iso_) {  // "over" on premultiplied color: dst = src + (1 - src.a) dst
+        state.fragment.blend.enabled = true;
+        state.fragment.blend.srcRgb = state.fragment.blend.srcAlpha = raster::BlendFactor::One;
+        state.fragment.blend.dstRgb = state.fragment.blend.dstAlpha = raster::BlendFactor::OneMinusSrcAlpha;
+    } else {
+        // Alpha test on the value mapped to [0, 1] as the fragment program maps it: GEQUAL the mapped
+        // iso-value (an iso-value above the data passes nothing); the stencil marks covered pixels.
+        const double range = iso_->dataMax > iso_->dataMin ? iso_->dataMax - iso_->dataMin : 1.0;
+        state.fragment.alpha.test = true;
+        state.fragment.alpha.func = iso_->value > iso_->dataMax ? raster::CompareFunc::Never : raster::CompareFunc::GEqual;
+        state.fragment.alpha.ref = static_cast<float>(std::clamp((iso_->value - iso_->dataMin) / range, 0.0, 1.0));
+        state.fragment.stencil.test = true;
+        state.fragment.stencil.func = raster::CompareFunc::Always;
+        state.fragment.stencil.ref = 1;
+        state.fragment.stencil.dppass = raster::StencilOp::Replace;
+        framebuffer_->clearStencil(device_, 0);
+    }
     framebuffer_->clearColor(device_, glm::vec4(0.0f));
     const raster::DrawStats drawStats =
         raster::draw(device_, *framebuffer_, state, raster::Topology::Triangles, vertices, fragmentProgram_);
     const std::size_t pixels = framebuffer_->pixelCount();
-    overBackground_.setArg(0, framebuffer_->color());
-    overBackground_.setArg(1, static_cast<cl_int>(pixels));
-    overBackground_.setArg(2, cl_float4{{static_cast<float>(image_.background.r), static_cast<float>(image_.background.g),
-                                         static_cast<float>(image_.background.b), 0.0f}});
-    device_.launch("stack2d: over background", overBackground_, pixels);
+    const cl_float4 background{{static_cast<float>(image_.background.r), static_cast<float>(image_.background.g),
+                                static_cast<float>(image_.background.b), 0.0f}};
+    if (iso_) {
+        isoFinish_.setArg(0, framebuffer_->color());
+        isoFinish_.setArg(1, framebuffer_->stencil());
+        isoFinish_.setArg(2, static_cast<cl_int>(pixels));
+        isoFinish_.setArg(3, background);
+        device_.launch("stack2d: iso-surface over background", isoFinish_, pixels);
+    } else {
+        overBackground_.setArg(0, framebuffer_->color());
+        overBackground_.setArg(1, static_cast<cl_int>(pixels));
+        overBackground_.setArg(2, background);
+        device_.launch("stack2d: over background", overBackground_, pixels);
+    }
     Image4f image = framebuffer_->readColor(device_);
     stats.passes = device_.takePassTimes();
     stats.frameMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -233,6 +302,7 @@ Image4f Stack2dRenderer::render(FrameStats& stats)
     stats.extra["slices"] = slices_.size();
     stats.extra["intermediate"] = options_.intermediate;
     stats.extra["shaded"] = lighting_.shaded();
+    stats.extra["iso"] = iso_.has_value();
     stats.extra["reflectance_map_size"] = options_.reflectanceMapSize;
     stats.extra["triangles"] = drawStats.triangles;
     stats.extra["voxels"] = static_cast<std::uint64_t>(dims_.x) * dims_.y * dims_.z;
