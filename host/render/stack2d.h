@@ -3,9 +3,10 @@
 // direction is drawn as object-aligned quads, back to front, each sampled bilinearly, classified after
 // interpolation and blended "over"; with "lights", the color is shaded by the interpolated gradient
 // (the paper's shading of semi-transparent volumes, with planes/blend's Phong model and reflectance
-// map). Intermediate slices between two stack slices lerp the bilinear
-// samples of both (the paper's multi-texture combiner), so their sampling is trilinear. Pass by pass
-// through raster::draw with kernels/stack2d.cl as fragment program. docs/stack2d.md.
+// map); with "iso", a shaded iso-surface through the alpha test. Intermediate slices between two stack
+// slices lerp the bilinear samples of both (the paper's multi-texture combiner), so their sampling is
+// trilinear. Pass by pass through raster::draw with kernels/stack2d.cl as fragment program.
+// docs/stack2d.md.
 #pragma once
 
 #include "host/camera.h"
