@@ -264,6 +264,19 @@ TEST(Stack2dRender, TwoRendersGiveIdenticalBits)
     EXPECT_EQ(renderer->residentBytes(), 3u * 41 * 41 * 41 * 4 + 4 * (4 + 8 * 3));
 }
 
+TEST(Stack2dRender, NewTransferFunctionGivesTheImageOfANewRenderer)
+{
+    Scene scene = makeScene(parallelCamera(), 24, {{"intermediate", 1}});
+    auto renderer = makeRenderer(test::device(), scene, marschnerLobb41());
+    const TransferFunction other({{0.2, {0.1, 0.9, 0.3}, 0.0}, {0.6, {0.9, 0.2, 0.1}, 12.0}, {0.9, {1, 1, 1}, 2.0}});
+    renderer->setTransferFunction(other);
+    FrameStats stats;
+    const Image4f a = renderer->render(stats);
+    scene.transferFunction = other;
+    const Image4f b = renderScene(scene, marschnerLobb41());
+    EXPECT_EQ(std::memcmp(a.pixels().data(), b.pixels().data(), a.pixels().size() * sizeof(glm::vec4)), 0);
+}
+
 // ---- shaded (diffuse shading of semi-transparent volumes) ----------------------------------------
 
 const Volume& sphere33()

@@ -135,8 +135,8 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
     axis_ = stackAxis(camera_);
     slices_ = planStack(camera_, origin_, spacing_, dims_, axis_, options_.intermediate);
 
-    // Unshaded: the values (1 channel). Shaded: (gradient, value) per texel, the paper's RGBA slices
-    // with the gradient in RGB, so that one bilinear fetch (and the lerp) interpolates both.
+    // Unshaded: the values (1 channel). Shaded or iso-surface: (gradient, value) per texel, the paper's
+    // RGBA slices with the gradient in RGB, so that one bilinear fetch (and the lerp) interpolates both.
     const bool gradients = lighting_.shaded() || iso_;
     const int channels = gradients ? 4 : 1;
     std::vector<glm::vec4> rgba;
@@ -214,8 +214,12 @@ void Stack2dRenderer::setTransferFunction(const TransferFunction& tf)
     residentBytes_ += tfBytes_;
     tf_ = device_.upload("stack2d transfer function", packed);
     fragmentProgram_.buffers[1] = tf_;
-    if (fragmentProgram_.uniforms.size() > 5)
+    if (fragmentProgram_.uniforms.size() > 5)  // not yet during construction, which sets them itself
         fragmentProgram_.uniforms[5].z = static_cast<float>(tf.points().size());
+    if (iso_ && fragmentProgram_.uniforms.size() > 11 && !tf.points().empty()) {  // the surface color
+        iso_->color = glm::dvec3(tf(iso_->value));
+        fragmentProgram_.uniforms[11] = glm::vec4(glm::vec3(iso_->color), fragmentProgram_.uniforms[11].w);
+    }
 }
 
 Image4f Stack2dRenderer::render(FrameStats& stats)
