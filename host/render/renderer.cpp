@@ -6,10 +6,11 @@
 #include "host/render/harc.h"
 #include "host/render/planes.h"
 #include "host/render/slice3d.h"
+#include "host/render/stack2d.h"
 
 namespace clvr {
 
-std::vector<std::string> techniqueNames() { return {"slice3d", "planes", "blend", "harc"}; }
+std::vector<std::string> techniqueNames() { return {"slice3d", "stack2d", "planes", "blend", "harc"}; }
 
 std::unique_ptr<Renderer> makeRenderer(Device& device, const Scene& scene, const Volume& volume)
 {
@@ -17,6 +18,11 @@ std::unique_ptr<Renderer> makeRenderer(Device& device, const Scene& scene, const
         if (volume.values.empty())
             throw InputError("technique slice3d needs a regular-grid \"volume\", and the scene has none");
         return makeSlice3dRenderer(device, scene, volume);
+    }
+    if (scene.technique == "stack2d") {
+        if (volume.values.empty())
+            throw InputError("technique stack2d needs a regular-grid \"volume\", and the scene has none");
+        return makeStack2dRenderer(device, scene, volume);
     }
     if (scene.technique == "planes") {
         if (volume.values.empty())
@@ -40,7 +46,7 @@ std::unique_ptr<Renderer> makeMeshRenderer(Device& device, const Scene& scene, c
 {
     if (scene.technique == "harc")
         return makeHarcRenderer(device, scene, mesh, buildTopology(mesh));
-    if (scene.technique != "slice3d" && scene.technique != "planes" && scene.technique != "blend")
+    if (scene.technique != "slice3d" && scene.technique != "stack2d" && scene.technique != "planes" && scene.technique != "blend")
         throw InputError("technique: unknown technique \"" + scene.technique + "\" (mesh techniques: harc)");
     throw InputError("technique \"" + scene.technique + "\" renders regular-grid volumes, and the scene has a \"mesh\" (mesh techniques: harc)");
 }
