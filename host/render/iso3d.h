@@ -1,0 +1,62 @@
+// host/render/iso3d.h — shaded iso-surfaces by the alpha test (§3 of seeds/000_354856c7f65dc3f9.txt):
+// view-aligned slices through an RGBA volume (encoded normal, value) drawn front to back through the
+// raster stage; the alpha test (GEQUAL iso) keeps samples at or above the iso-value and the depth test
+// (LESS) the nearest, so each pixel ends up holding the first slice sample on the surface. Gradient
+// shading then copies the frame buffer onto itself through the paper's color matrix, with the diffuse
+// reflectivity as scale and the ambient term as bias. docs/iso3d.md.
+#pragma once
+
+#include "host/render/renderer.h"
+
+#include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
+
+#include <memory>
+#include <vector>
+
+namespace clvr {
+
+struct Iso3dOptions {
+    int slices = 256;           // slices across the box's eye-depth range ...
+    double sliceSpacing = 0.0;  // ... or, when > 0, this spacing in world units
+};
+
+// Reads the scene's "options" for iso3d (slices, slice_spacing). Throws InputError naming the key.
+Iso3dOptions parseIso3dOptions(const nlohmann::json& options);
+
+// The scene's "iso" as iso3d uses it (scene-format.md, iso), with iso3d's defaults.
+struct IsoSurface {
+    enum class Shading { Gradient, None };
+    double value = 0.0;                   // data units
+    Shading shading = Shading::Gradient;  // None: the flat surface color
+    glm::dvec3 light{0.0, 0.0, 1.0};      // towards the light, world space, unit length
+    double ambient = 0.1, diffuse = 0.9;  // I_a and k_d of the paper
+    glm::dvec3 color{1.0};                // the transfer function's color at the value, or white
+};
+
+// Throws InputError ("iso: ...", "iso.shading: ...") when the scene has no "iso" or names an unknown shading.
+IsoSurface parseIsoSurface(const Scene& scene);
+
+// Per grid point (0.5 N + 0.5, value), N = -grad/|grad| from the Sobel gradient (host/gradient_volume.h),
+// the unit normal pointing out of the region at or above any iso-value (towards lower values); (0.5, 0.5,
+// 0.5) where the gradient is 0. The paper's "gradient components scaled and translated by 0.5", in float32.
+std::vector<glm::vec4> encodedNormalVolume(const Volume& volume);
+
+// The paper's color matrix for gradient shading:
+//   CM = [L L L 0]^T-rows * M_rot * [2I | -1] (the decode 2c - 1 of the encoded normal),
+// rows 0..2 = (L^T M_rot) applied to 2 rgb - 1, row 3 passes alpha. `rotation` takes the volume's frame
+// to the light's (identity when both are world space, as in clvr's scenes).
+glm::dmat4 isoColorMatrix(const glm::dvec3& light, const glm::dmat3& rotation = glm::dmat3(1.0));
+
+// Renderer for "iso3d". hitDepth() gives the last frame's eye depth (along the camera's forward axis,
+// world units) of the surface per pixel, row 0 at the top, +infinity where no sample passed.
+class Iso3dRenderer : public Renderer {
+public:
+    virtual std::vector<double> hitDepth() = 0;
+    virtual double sliceSpacing() const = 0;  // deltaS, world units along forward
+};
+
+// Throws InputError for bad options or "iso", DeviceError when the volume does not fit.
+std::unique_ptr<Iso3dRenderer> makeIso3dRenderer(Device& device, const Scene& scene, const Volume& volume);
+
+}  // namespace clvr
