@@ -160,7 +160,7 @@ IsoReference isoReference(const Volume& volume, const Camera& camera, const Imag
     auto worker = [&] {
         for (int y; (y = nextRow.fetch_add(1)) < spec.height;) {
             for (int x = 0; x < spec.width; ++x) {
-                const Ray ray = rays.at(x + 0.5, y + 0.5);
+                const Ray ray = rays.at(x, y);  // the center of pixel (x, y)
                 const std::optional<double> t = firstIsoHit(volume, ray, iso.value);
                 glm::dvec4& pixel = out.image.at(x, y);
                 if (!t) {

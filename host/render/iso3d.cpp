@@ -154,14 +154,9 @@ Image4f Iso3dRendererImpl::render(FrameStats& stats)
 
     const bool shaded = iso_.shading == IsoSurface::Shading::Gradient;
     if (shaded) {
-        // Gradient shading: the frame buffer copied onto itself through
-        //   [I_a c, 0] + [k_d c, 1] * CM * (R, G, B, alpha)   (§3, c the surface color per channel),
-        // giving c (k_d <L, N> + I_a) in RGB and alpha unchanged.
-        raster::PixelTransfer xf;
-        xf.colorMatrix = glm::mat4(isoColorMatrix(iso_.light));
-        xf.scale = glm::vec4(glm::vec3(iso_.diffuse * iso_.color), 1.0f);
-        xf.bias = glm::vec4(glm::vec3(iso_.ambient * iso_.color), 0.0f);
-        raster::applyPixelTransfer(device_, *framebuffer_, xf);
+        // Gradient shading (§3): the frame buffer copied onto itself through the color matrix with the
+        // reflectivity as scale and the ambient term as bias, giving c (k_d <L, N> + I_a) in RGB.
+        raster::applyPixelTransfer(device_, *framebuffer_, isoShadingTransfer(iso_));
     }
     const std::size_t pixels = framebuffer_->pixelCount();
     int a = 0;
@@ -286,6 +281,18 @@ glm::dmat4 isoColorMatrix(const glm::dvec3& light, const glm::dmat3& rotation)
             lightRows[c][r] = light[c];
     lightRows[3][3] = 1.0;
     return lightRows * rot * decode;
+}
+
+raster::PixelTransfer isoShadingTransfer(const IsoSurface& iso, const glm::dmat3& rotation)
+{
+    glm::dmat4 matrix = isoColorMatrix(iso.light, rotation);
+    matrix[3] = glm::dvec4(0.0, 0.0, 0.0, 1.0);  // the alpha column: no -1 there, alpha passes
+    const double decodeBias = glm::dot(iso.light, rotation * glm::dvec3(1.0));  // <L, M_rot (1, 1, 1)>
+    raster::PixelTransfer xf;
+    xf.colorMatrix = glm::mat4(matrix);
+    xf.scale = glm::vec4(glm::vec3(iso.diffuse * iso.color), 1.0f);
+    xf.bias = glm::vec4(glm::vec3(iso.color * (iso.ambient - iso.diffuse * decodeBias)), 0.0f);
+    return xf;
 }
 
 std::unique_ptr<Iso3dRenderer> makeIso3dRenderer(Device& device, const Scene& scene, const Volume& volume)

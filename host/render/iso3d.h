@@ -7,6 +7,7 @@
 #pragma once
 
 #include "host/render/renderer.h"
+#include "raster/pixel_transfer.h"
 
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
@@ -42,11 +43,19 @@ IsoSurface parseIsoSurface(const Scene& scene);
 // 0.5) where the gradient is 0. The paper's "gradient components scaled and translated by 0.5", in float32.
 std::vector<glm::vec4> encodedNormalVolume(const Volume& volume);
 
-// The paper's color matrix for gradient shading:
-//   CM = [L L L 0]^T-rows * M_rot * [2I | -1] (the decode 2c - 1 of the encoded normal),
-// rows 0..2 = (L^T M_rot) applied to 2 rgb - 1, row 3 passes alpha. `rotation` takes the volume's frame
-// to the light's (identity when both are world space, as in clvr's scenes).
+// The paper's color matrix for gradient shading, as printed in §3:
+//   CM = (rows L^T, L^T, L^T, e_4^T) * M_rot * (2 I_3 | -1; 0 | 1),
+// `rotation` (M_rot) taking the volume's frame to the light's (identity when both are world space, as in
+// clvr's scenes). The decode's -1 sits in the alpha column, so CM (R, G, B, alpha) = <L, M_rot (2 rgb -
+// alpha)>: <L, N> only for alpha = 1, and alpha holds the material value (at least the iso-value).
 glm::dmat4 isoColorMatrix(const glm::dvec3& light, const glm::dmat3& rotation = glm::dmat3(1.0));
+
+// What iso3d loads into the pixel transfer instead: the same matrix with the -1 moved out of the alpha
+// column into the bias (GL's post-color-matrix bias, an equivalent state for any alpha):
+//   matrix = (rows L^T, L^T, L^T, e_4^T) * M_rot * diag(2, 2, 2, 1),
+//   scale = (k_d c, 1),  bias = (c (I_a - k_d <L, M_rot 1>), 0),
+// so that bias + scale * (matrix (0.5 N + 0.5, alpha)) = (c (k_d <L, M_rot N> + I_a), alpha), c the surface color.
+raster::PixelTransfer isoShadingTransfer(const IsoSurface& iso, const glm::dmat3& rotation = glm::dmat3(1.0));
 
 // Renderer for "iso3d". hitDepth() gives the last frame's eye depth (along the camera's forward axis,
 // world units) of the surface per pixel, row 0 at the top, +infinity where no sample passed.
