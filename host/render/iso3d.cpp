@@ -10,6 +10,7 @@
 #include "raster/framebuffer.h"
 #include "raster/pixel_transfer.h"
 #include "raster/rasterizer.h"
+#include "raster/texture.h"
 
 #include <algorithm>
 #include <chrono>
@@ -55,6 +56,11 @@ private:
     std::unique_ptr<raster::Framebuffer> framebuffer_;
     raster::FragmentProgram fragmentProgram_;
     cl::Kernel finish_;
+    // Gradientless shading: the scalar volume as a 3D texture (texel centers at the grid points) and
+    // the shift Delta L in texture coordinates.
+    std::unique_ptr<raster::Texture> scalarTexture_;
+    double gradientlessStep_ = 0.0;
+    glm::vec4 textureShift_{0.0f};
 };
 
 Iso3dRendererImpl::Iso3dRendererImpl(Device& device, const Scene& scene, const Volume& volume)
@@ -96,12 +102,29 @@ Iso3dRendererImpl::Iso3dRendererImpl(Device& device, const Scene& scene, const V
             source = k.source;
     fragmentProgram_.source = "#define CLVR_ISO3D_FRAGMENT 1\n" + std::string(source);
     fragmentProgram_.buffers[0] = volume_;
+    const bool gradientless = iso_.shading == IsoSurface::Shading::Gradientless;
     fragmentProgram_.uniforms = {
         glm::vec4(glm::vec3(volume.origin), 0.0f),
         glm::vec4(glm::vec3(1.0 / volume.spacing), 0.0f),
         glm::vec4(volume.dims.x, volume.dims.y, volume.dims.z, 0.0f),
-        glm::vec4(valueLo, scale, 0.0f, 0.0f),
+        glm::vec4(valueLo, scale, gradientless ? 1.0f : 0.0f, 0.0f),
     };
+    if (gradientless) {
+        raster::TextureDesc desc;
+        desc.width = volume.dims.x;
+        desc.height = volume.dims.y;
+        desc.depth = volume.dims.z;
+        desc.channels = 1;
+        desc.filter = raster::Filter::Linear;
+        desc.wrap = raster::Wrap::ClampToEdge;
+        scalarTexture_ = std::make_unique<raster::Texture>(device_, desc, volume.values);
+        residentBytes_ += scalarTexture_->bytes();
+        gradientlessStep_ = options_.gradientlessStep > 0.0
+                                ? options_.gradientlessStep
+                                : std::min({volume.spacing.x, volume.spacing.y, volume.spacing.z});
+        // Delta L in world units -> grid units (/ spacing) -> texture coordinates (/ n).
+        textureShift_ = glm::vec4(glm::vec3(gradientlessStep_ * iso_.light / (volume.spacing * glm::dvec3(volume.dims))), 0.0f);
+    }
 }
 
 void Iso3dRendererImpl::setTransferFunction(const TransferFunction& tf)
@@ -152,11 +175,28 @@ Image4f Iso3dRendererImpl::render(FrameStats& stats)
     if (!vertices.empty())
         drawStats = raster::draw(device_, *framebuffer_, state, raster::Topology::Triangles, vertices, fragmentProgram_);
 
-    const bool shaded = iso_.shading == IsoSurface::Shading::Gradient;
-    if (shaded) {
+    const bool shaded = iso_.shading != IsoSurface::Shading::None;
+    if (iso_.shading == IsoSurface::Shading::Gradient) {
         // Gradient shading (§3): the frame buffer copied onto itself through the color matrix with the
         // reflectivity as scale and the ambient term as bias, giving c (k_d <L, N> + I_a) in RGB.
         raster::applyPixelTransfer(device_, *framebuffer_, isoShadingTransfer(iso_));
+    } else if (shaded) {
+        // Gradientless shading (§3): the frame buffer holds the surface points' texture coordinates;
+        // read back and drawn twice through the pixel texture: X(p0), then X(p0 + Delta L) (the shift as
+        // the pixel bias) subtracted from it by blending. X(p0) - X(p0 + Delta L) ~ -Delta dX/dL =
+        // Delta |grad X| <L, N>, so scale 1 / Delta turns it into <L, N> where |grad X| = 1 (a distance
+        // field); elsewhere the shade is off by the factor |grad X| (the paper's condition, docs/iso3d.md).
+        const Image4f positions = framebuffer_->readColor(device_);
+        raster::drawPixels(device_, *framebuffer_, positions, {0, 0}, raster::PixelTransfer{},
+                           raster::DrawPixelsBlend::Replace, scalarTexture_.get());
+        raster::PixelTransfer shift;
+        shift.bias = textureShift_;
+        raster::drawPixels(device_, *framebuffer_, positions, {0, 0}, shift, raster::DrawPixelsBlend::ReverseSubtract,
+                           scalarTexture_.get());
+        raster::PixelTransfer light;
+        light.scale = glm::vec4(glm::vec3(iso_.diffuse / gradientlessStep_ * iso_.color), 1.0f);
+        light.bias = glm::vec4(glm::vec3(iso_.ambient * iso_.color), 0.0f);
+        raster::applyPixelTransfer(device_, *framebuffer_, light);
     }
     const std::size_t pixels = framebuffer_->pixelCount();
     int a = 0;
@@ -176,7 +216,9 @@ Image4f Iso3dRendererImpl::render(FrameStats& stats)
     stats.extra["slice_spacing"] = plan_.deltaS;
     stats.extra["triangles"] = drawStats.triangles;
     stats.extra["iso_value"] = iso_.value;
-    stats.extra["shading"] = shaded ? "gradient" : "none";
+    stats.extra["shading"] = iso_.shading == IsoSurface::Shading::Gradient       ? "gradient"
+                             : iso_.shading == IsoSurface::Shading::Gradientless ? "gradientless"
+                                                                                 : "none";
     stats.extra["resident_bytes"] = residentBytes_;
     return image;
 }
@@ -218,8 +260,12 @@ Iso3dOptions parseIso3dOptions(const nlohmann::json& options)
             if (!value.is_number() || !(value.get<double>() > 0.0) || !std::isfinite(value.get<double>()))
                 badOption(key, "must be a positive number (world units), got " + value.dump());
             o.sliceSpacing = value.get<double>();
+        } else if (key == "gradientless_step") {
+            if (!value.is_number() || !(value.get<double>() > 0.0) || !std::isfinite(value.get<double>()))
+                badOption(key, "must be a positive number (world units), got " + value.dump());
+            o.gradientlessStep = value.get<double>();
         } else {
-            badOption(key, "unknown option for iso3d (known: slices, slice_spacing)");
+            badOption(key, "unknown option for iso3d (known: slices, slice_spacing, gradientless_step)");
         }
     }
     if (options.contains("slices") && options.contains("slice_spacing"))
@@ -239,10 +285,12 @@ IsoSurface parseIsoSurface(const Scene& scene)
         const std::string s = v["shading"].get<std::string>();
         if (s == "gradient")
             iso.shading = IsoSurface::Shading::Gradient;
+        else if (s == "gradientless")
+            iso.shading = IsoSurface::Shading::Gradientless;
         else if (s == "none")
             iso.shading = IsoSurface::Shading::None;
         else
-            throw InputError("iso.shading: must be \"gradient\" or \"none\" for iso3d, got \"" + s + "\"");
+            throw InputError("iso.shading: must be \"gradient\", \"gradientless\" or \"none\" for iso3d, got \"" + s + "\"");
     }
     if (v.contains("light")) {
         const auto l = v["light"];

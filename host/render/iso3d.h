@@ -20,16 +20,17 @@ namespace clvr {
 struct Iso3dOptions {
     int slices = 256;           // slices across the box's eye-depth range ...
     double sliceSpacing = 0.0;  // ... or, when > 0, this spacing in world units
+    double gradientlessStep = 0.0;  // Delta of gradientless shading, world units; 0: the smallest grid spacing
 };
 
-// Reads the scene's "options" for iso3d (slices, slice_spacing). Throws InputError naming the key.
+// Reads the scene's "options" for iso3d (slices, slice_spacing, gradientless_step). Throws InputError naming the key.
 Iso3dOptions parseIso3dOptions(const nlohmann::json& options);
 
 // The scene's "iso" as iso3d uses it (scene-format.md, iso), with iso3d's defaults.
 struct IsoSurface {
-    enum class Shading { Gradient, None };
+    enum class Shading { Gradient, Gradientless, None };
     double value = 0.0;                   // data units
-    Shading shading = Shading::Gradient;  // None: the flat surface color
+    Shading shading = Shading::Gradient;  // Gradientless: forward differences (docs/iso3d.md); None: flat color
     glm::dvec3 light{0.0, 0.0, 1.0};      // towards the light, world space, unit length
     double ambient = 0.1, diffuse = 0.9;  // I_a and k_d of the paper
     glm::dvec3 color{1.0};                // the transfer function's color at the value, or white
