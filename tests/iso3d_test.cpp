@@ -122,6 +122,7 @@ TEST(Iso3dOptions, Parses)
     EXPECT_EQ(parseIso3dOptions(json{{"slices", 64}}).slices, 64);
     EXPECT_DOUBLE_EQ(parseIso3dOptions(json{{"slice_spacing", 0.01}}).sliceSpacing, 0.01);
     EXPECT_DOUBLE_EQ(parseIso3dOptions(json{{"gradientless_step", 0.05}}).gradientlessStep, 0.05);
+    EXPECT_DOUBLE_EQ(parseIso3dOptions(json{{"gradientless_scale", 3.0}}).gradientlessScale, 3.0);
     Scene s = makeScene(parallelCamera(), 0.5);
     s.iso["shading"] = "gradientless";
     EXPECT_EQ(parseIsoSurface(s).shading, IsoSurface::Shading::Gradientless);
@@ -142,6 +143,7 @@ TEST(Iso3dOptions, RejectsBadValuesNamingTheKey)
     EXPECT_EQ(message(json{{"slice_spacing", -1}}).rfind("options.slice_spacing: ", 0), 0u);
     EXPECT_EQ(message(json{{"slices", 8}, {"slice_spacing", 0.1}}).rfind("options.slice_spacing: ", 0), 0u);
     EXPECT_EQ(message(json{{"gradientless_step", 0}}).rfind("options.gradientless_step: ", 0), 0u);
+    EXPECT_EQ(message(json{{"gradientless_scale", "x"}}).rfind("options.gradientless_scale: ", 0), 0u);
     EXPECT_EQ(message(json{{"order", "front-to-back"}}).rfind("options.order: unknown option", 0), 0u);
 }
 
@@ -321,7 +323,8 @@ ShadeError shadeError(const Image4f& image, const Image4d& reference)
 TEST(Iso3d, GradientlessShadingOnDistanceField)
 {
     for (const Camera& camera : {perspectiveCamera(), parallelCamera()}) {
-        Scene s = makeScene(camera, 0.5, {{"slices", 256}});
+        // k = 1 / Delta, the paper's (unit gradient); Delta defaults to the grid spacing 2/32.
+        Scene s = makeScene(camera, 0.5, {{"slices", 256}, {"gradientless_scale", 16.0}});
         s.iso["shading"] = "gradientless";
         const HitComparison hits = compareHits(s, sphere33());
         Scene g = s;
@@ -333,13 +336,14 @@ TEST(Iso3d, GradientlessShadingOnDistanceField)
         ASSERT_GT(e.pixels, 500u);  // hit depths are judged above; these are the same slices
         for (int c = 0; c < 3; ++c) {
             EXPECT_LE(e.maxAbs[c], 0.1) << "channel " << c;
-            EXPECT_LE(e.meanAbs[c], 0.03) << "channel " << c;
+            EXPECT_LE(e.meanAbs[c], 0.04) << "channel " << c;
         }
     }
 }
 
-// Where |grad| is not 1 the difference is scaled by it: on Marschner-Lobb (|grad| from ~0 to ~20 per world
-// unit) the gradientless shade is wrong by far more than the gradient-shaded one. Stated, not hidden.
+// Where |grad| varies over the surface the difference is scaled by it: on Marschner-Lobb (|grad| from ~0 to
+// ~20 per world unit) no one scale fits (default: the median at the surface), and the gradientless shade is
+// wrong by far more than the gradient-shaded one. Stated, not hidden.
 TEST(Iso3d, GradientlessShadingFailsWhereGradientIsNotUnit)
 {
     Scene s = makeScene(perspectiveCamera(), 0.5, {{"slices", 256}});
@@ -355,6 +359,12 @@ TEST(Iso3d, GradientlessShadingFailsWhereGradientIsNotUnit)
     // Measured 0.196 against 0.104 (the gradient-shaded error here is itself large: unit normals of a
     // 41^3 Marschner-Lobb vary fast between grid points, so interpolation shortens them a lot).
     EXPECT_GT(less.meanAbs.x, 1.5 * grad.meanAbs.x);
+}
+
+TEST(Iso3d, MedianGradientAtIsoOfDistanceFieldIsAboutOne)
+{
+    // 1 - |p| has |grad| = 1; the Sobel smoothing across the axes shortens it a little on a curved shell.
+    EXPECT_NEAR(medianGradientAtIso(sphere33(), 0.5), 1.0, 0.05);
 }
 
 TEST(Iso3d, BackgroundWhereNoHitAndIdenticalBits)

@@ -59,7 +59,7 @@ private:
     // Gradientless shading: the scalar volume as a 3D texture (texel centers at the grid points) and
     // the shift Delta L in texture coordinates.
     std::unique_ptr<raster::Texture> scalarTexture_;
-    double gradientlessStep_ = 0.0;
+    double gradientlessStep_ = 0.0, gradientlessScale_ = 0.0;
     glm::vec4 textureShift_{0.0f};
 };
 
@@ -122,6 +122,11 @@ Iso3dRendererImpl::Iso3dRendererImpl(Device& device, const Scene& scene, const V
         gradientlessStep_ = options_.gradientlessStep > 0.0
                                 ? options_.gradientlessStep
                                 : std::min({volume.spacing.x, volume.spacing.y, volume.spacing.z});
+        // X(p0) - X(p0 + Delta L) ~ Delta |grad X| <L, N>: the paper's condition is |grad X| = 1 (then
+        // k = 1 / Delta); clvr divides by the median gradient length at the surface instead, unless given.
+        gradientlessScale_ = options_.gradientlessScale > 0.0
+                                 ? options_.gradientlessScale
+                                 : 1.0 / (gradientlessStep_ * medianGradientAtIso(volume, iso_.value));
         // Delta L in world units -> grid units (/ spacing) -> texture coordinates (/ n).
         textureShift_ = glm::vec4(glm::vec3(gradientlessStep_ * iso_.light / (volume.spacing * glm::dvec3(volume.dims))), 0.0f);
     }
@@ -184,8 +189,8 @@ Image4f Iso3dRendererImpl::render(FrameStats& stats)
         // Gradientless shading (§3): the frame buffer holds the surface points' texture coordinates;
         // read back and drawn twice through the pixel texture: X(p0), then X(p0 + Delta L) (the shift as
         // the pixel bias) subtracted from it by blending. X(p0) - X(p0 + Delta L) ~ -Delta dX/dL =
-        // Delta |grad X| <L, N>, so scale 1 / Delta turns it into <L, N> where |grad X| = 1 (a distance
-        // field); elsewhere the shade is off by the factor |grad X| (the paper's condition, docs/iso3d.md).
+        // Delta |grad X| <L, N>; times k = 1 / (Delta |grad|~) it is <L, N> where |grad X| = |grad|~
+        // (docs/iso3d.md: off by the factor |grad X| / |grad|~ elsewhere, the paper's condition).
         const Image4f positions = framebuffer_->readColor(device_);
         raster::drawPixels(device_, *framebuffer_, positions, {0, 0}, raster::PixelTransfer{},
                            raster::DrawPixelsBlend::Replace, scalarTexture_.get());
@@ -194,7 +199,7 @@ Image4f Iso3dRendererImpl::render(FrameStats& stats)
         raster::drawPixels(device_, *framebuffer_, positions, {0, 0}, shift, raster::DrawPixelsBlend::ReverseSubtract,
                            scalarTexture_.get());
         raster::PixelTransfer light;
-        light.scale = glm::vec4(glm::vec3(iso_.diffuse / gradientlessStep_ * iso_.color), 1.0f);
+        light.scale = glm::vec4(glm::vec3(iso_.diffuse * gradientlessScale_ * iso_.color), 1.0f);
         light.bias = glm::vec4(glm::vec3(iso_.ambient * iso_.color), 0.0f);
         raster::applyPixelTransfer(device_, *framebuffer_, light);
     }
@@ -264,8 +269,12 @@ Iso3dOptions parseIso3dOptions(const nlohmann::json& options)
             if (!value.is_number() || !(value.get<double>() > 0.0) || !std::isfinite(value.get<double>()))
                 badOption(key, "must be a positive number (world units), got " + value.dump());
             o.gradientlessStep = value.get<double>();
+        } else if (key == "gradientless_scale") {
+            if (!value.is_number() || !(value.get<double>() > 0.0) || !std::isfinite(value.get<double>()))
+                badOption(key, "must be a positive number (per data unit), got " + value.dump());
+            o.gradientlessScale = value.get<double>();
         } else {
-            badOption(key, "unknown option for iso3d (known: slices, slice_spacing, gradientless_step)");
+            badOption(key, "unknown option for iso3d (known: slices, slice_spacing, gradientless_step, gradientless_scale)");
         }
     }
     if (options.contains("slices") && options.contains("slice_spacing"))
@@ -315,6 +324,28 @@ std::vector<glm::vec4> encodedNormalVolume(const Volume& volume)
         p = glm::vec4(glm::vec3(0.5 * n + 0.5), p.w);
     }
     return rgba;
+}
+
+double medianGradientAtIso(const Volume& volume, double iso)
+{
+    const std::vector<glm::vec4> gradients = sobelGradientVolume(volume);
+    const glm::ivec3 n = volume.dims;
+    std::vector<float> lengths;
+    for (int k = 0; k < n.z; ++k)
+        for (int j = 0; j < n.y; ++j)
+            for (int i = 0; i < n.x; ++i) {
+                const double f = volume.at(i, j, k) - iso;
+                const bool crossing = (i + 1 < n.x && f * (volume.at(i + 1, j, k) - iso) <= 0.0) ||
+                                      (j + 1 < n.y && f * (volume.at(i, j + 1, k) - iso) <= 0.0) ||
+                                      (k + 1 < n.z && f * (volume.at(i, j, k + 1) - iso) <= 0.0);
+                if (crossing)
+                    lengths.push_back(glm::length(glm::vec3(gradients[(static_cast<std::size_t>(k) * n.y + j) * n.x + i])));
+            }
+    if (lengths.empty())
+        return 1.0;
+    std::nth_element(lengths.begin(), lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2), lengths.end());
+    const double median = lengths[lengths.size() / 2];
+    return median > 0.0 ? median : 1.0;
 }
 
 glm::dmat4 isoColorMatrix(const glm::dvec3& light, const glm::dmat3& rotation)

@@ -21,9 +21,10 @@ struct Iso3dOptions {
     int slices = 256;           // slices across the box's eye-depth range ...
     double sliceSpacing = 0.0;  // ... or, when > 0, this spacing in world units
     double gradientlessStep = 0.0;  // Delta of gradientless shading, world units; 0: the smallest grid spacing
+    double gradientlessScale = 0.0;  // k: shade I_a + k_d k (X(p0) - X(p0 + Delta L)); 0: 1 / (Delta |grad|~)
 };
 
-// Reads the scene's "options" for iso3d (slices, slice_spacing, gradientless_step). Throws InputError naming the key.
+// Reads the scene's "options" for iso3d (slices, slice_spacing, gradientless_step, gradientless_scale). Throws InputError naming the key.
 Iso3dOptions parseIso3dOptions(const nlohmann::json& options);
 
 // The scene's "iso" as iso3d uses it (scene-format.md, iso), with iso3d's defaults.
@@ -43,6 +44,11 @@ IsoSurface parseIsoSurface(const Scene& scene);
 // the unit normal pointing out of the region at or above any iso-value (towards lower values); (0.5, 0.5,
 // 0.5) where the gradient is 0. The paper's "gradient components scaled and translated by 0.5", in float32.
 std::vector<glm::vec4> encodedNormalVolume(const Volume& volume);
+
+// The median Sobel gradient length (data units per world unit) over the grid points next to a crossing of
+// `iso` (the point or its +x, +y or +z neighbour on the other side): gradientless shading's default
+// normalization, |grad|~ in 1 / (Delta |grad|~). 1 when no edge crosses.
+double medianGradientAtIso(const Volume& volume, double iso);
 
 // The paper's color matrix for gradient shading, as printed in §3:
 //   CM = (rows L^T, L^T, L^T, e_4^T) * M_rot * (2 I_3 | -1; 0 | 1),
