@@ -21,6 +21,9 @@ namespace clvr {
 namespace {
 
 constexpr int kMaxSlices = 65536;
+// Figure 7: how far behind the box entry (in slices) the depth buffer is put. The first slice inside the box
+// lies within one slice of the entry; 1.5 keeps it in front on faces seen obliquely by a perspective camera.
+constexpr double kEntryDepthSlices = 1.5;
 
 [[noreturn]] void badOption(const std::string& key, const std::string& what)
 {
@@ -103,6 +106,9 @@ Iso3dRendererImpl::Iso3dRendererImpl(Device& device, const Scene& scene, const V
     fragmentProgram_.source = "#define CLVR_ISO3D_FRAGMENT 1\n" + std::string(source);
     fragmentProgram_.buffers[0] = volume_;
     const bool gradientless = iso_.shading == IsoSurface::Shading::Gradientless;
+    if (options_.interior && gradientless)
+        badOption("interior", "works with \"gradient\" or \"none\" shading (the gradientless difference would need its "
+                              "sign turned per pixel), and iso.shading is \"gradientless\"");
     fragmentProgram_.uniforms = {
         glm::vec4(glm::vec3(volume.origin), 0.0f),
         glm::vec4(glm::vec3(1.0 / volume.spacing), 0.0f),
@@ -177,8 +183,64 @@ Image4f Iso3dRendererImpl::render(FrameStats& stats)
     framebuffer_->clearColor(device_, glm::vec4(0.0f));
     framebuffer_->clearDepth(device_, 1.0f);
     raster::DrawStats drawStats;
-    if (!vertices.empty())
+    if (vertices.empty()) {
+        // the box is behind the camera: nothing to draw
+    } else if (!options_.interior) {
         drawStats = raster::draw(device_, *framebuffer_, state, raster::Topology::Triangles, vertices, fragmentProgram_);
+    } else {
+        // Figure 7 (§3): 1. the depth buffer right behind the first intersection with the box: its 12
+        // triangles moved back by kEntryDepthSlices slices along forward, nearest kept, no color.
+        raster::DrawState box;
+        box.fragment.colorMask = {false, false, false, false};
+        box.fragment.depth.test = true;
+        box.fragment.depth.func = raster::CompareFunc::Less;
+        const glm::dvec3 shift = kEntryDepthSlices * plan_.deltaS * forward;
+        std::vector<raster::Vertex> boxVertices;
+        auto corner = [&](int c) {
+            return glm::dvec3((c & 1) ? hi_.x : lo_.x, (c & 2) ? hi_.y : lo_.y, (c & 4) ? hi_.z : lo_.z) + shift;
+        };
+        for (int axis = 0; axis < 3; ++axis)
+            for (int side = 0; side < 2; ++side) {
+                // The face's 4 corners: bit `axis` fixed to `side`, the other two bits in a cycle.
+                const int a = 1 << ((axis + 1) % 3), b = 1 << ((axis + 2) % 3), base = side ? (1 << axis) : 0;
+                const int quad[4] = {base, base | a, base | a | b, base | b};
+                for (int t : {0, 1, 2, 0, 2, 3}) {
+                    raster::Vertex v;
+                    v.position = glm::vec4(viewProjection * glm::dvec4(corner(quad[t]), 1.0));
+                    boxVertices.push_back(v);
+                }
+            }
+        framebuffer_->clearStencil(device_, 0);
+        raster::draw(device_, *framebuffer_, box, raster::Topology::Triangles, boxVertices);
+        // 2. Samples at or above iso in front of it fail the depth test (GREATER): there the stencil is set.
+        raster::DrawState mark = state;
+        mark.fragment.colorMask = {false, false, false, false};
+        mark.fragment.depth.func = raster::CompareFunc::Greater;
+        mark.fragment.depth.write = false;
+        mark.fragment.stencil.test = true;
+        mark.fragment.stencil.func = raster::CompareFunc::Always;
+        mark.fragment.stencil.ref = 1;
+        mark.fragment.stencil.dpfail = raster::StencilOp::Replace;
+        raster::draw(device_, *framebuffer_, mark, raster::Topology::Triangles, vertices, fragmentProgram_);
+        // 3. The usual alpha test where the stencil is unchanged ...
+        framebuffer_->clearDepth(device_, 1.0f);
+        raster::DrawState exterior = state;
+        exterior.fragment.stencil.test = true;
+        exterior.fragment.stencil.func = raster::CompareFunc::Equal;
+        exterior.fragment.stencil.ref = 0;
+        drawStats = raster::draw(device_, *framebuffer_, exterior, raster::Topology::Triangles, vertices, fragmentProgram_);
+        // 4. ... and reversed (LESS: the first sample below iso) where it is set; the fragment program
+        // turns the normal round there (it points into the material, away from this viewer).
+        raster::DrawState interior = exterior;
+        interior.fragment.alpha.func = raster::CompareFunc::Less;
+        interior.fragment.stencil.ref = 1;
+        raster::FragmentProgram flipped = fragmentProgram_;
+        flipped.uniforms[3].w = 1.0f;
+        const raster::DrawStats d =
+            raster::draw(device_, *framebuffer_, interior, raster::Topology::Triangles, vertices, flipped);
+        drawStats.fragments += d.fragments;
+        drawStats.triangles += d.triangles;
+    }
 
     const bool shaded = iso_.shading != IsoSurface::Shading::None;
     if (iso_.shading == IsoSurface::Shading::Gradient) {
@@ -225,6 +287,7 @@ Image4f Iso3dRendererImpl::render(FrameStats& stats)
                              : iso_.shading == IsoSurface::Shading::Gradientless ? "gradientless"
                                                                                  : "none";
     stats.extra["resident_bytes"] = residentBytes_;
+    stats.extra["interior"] = options_.interior;
     return image;
 }
 
@@ -273,8 +336,13 @@ Iso3dOptions parseIso3dOptions(const nlohmann::json& options)
             if (!value.is_number() || !(value.get<double>() > 0.0) || !std::isfinite(value.get<double>()))
                 badOption(key, "must be a positive number (per data unit), got " + value.dump());
             o.gradientlessScale = value.get<double>();
+        } else if (key == "interior") {
+            if (!value.is_boolean())
+                badOption(key, "must be true or false, got " + value.dump());
+            o.interior = value.get<bool>();
         } else {
-            badOption(key, "unknown option for iso3d (known: slices, slice_spacing, gradientless_step, gradientless_scale)");
+            badOption(key, "unknown option for iso3d (known: slices, slice_spacing, gradientless_step, gradientless_scale, "
+                           "interior)");
         }
     }
     if (options.contains("slices") && options.contains("slice_spacing"))

@@ -22,9 +22,13 @@ struct Iso3dOptions {
     double sliceSpacing = 0.0;  // ... or, when > 0, this spacing in world units
     double gradientlessStep = 0.0;  // Delta of gradientless shading, world units; 0: the smallest grid spacing
     double gradientlessScale = 0.0;  // k: shade I_a + k_d k (X(p0) - X(p0 + Delta L)); 0: 1 / (Delta |grad|~)
+    // Figure 7's multi-pass: where the values right behind the box entry are already at or above the
+    // iso-value (stencil set), show the first sample below it (the interior surface) instead of the entry.
+    bool interior = false;
 };
 
-// Reads the scene's "options" for iso3d (slices, slice_spacing, gradientless_step, gradientless_scale). Throws InputError naming the key.
+// Reads the scene's "options" for iso3d (slices, slice_spacing, gradientless_step, gradientless_scale,
+// interior). Throws InputError naming the key.
 Iso3dOptions parseIso3dOptions(const nlohmann::json& options);
 
 // The scene's "iso" as iso3d uses it (scene-format.md, iso), with iso3d's defaults.
