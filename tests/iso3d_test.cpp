@@ -434,7 +434,7 @@ TEST(Iso3d, InteriorMultiPassFigure7)
                     "mean %.4g (red)\n",
                     both, maxErr / renderer->sliceSpacing(), over, differ, e.maxAbs.x, e.meanAbs.x);
         EXPECT_GT(both, 500u);
-        EXPECT_LE(over, 5u);  // measured 2 (perspective, at 1.03 deltaS): grazing rays, as HitDepth... above
+        EXPECT_LE(over, 5u);  // measured 2 (perspective, 1.03 deltaS): grazing rays, where float sample positions move the crossing
         EXPECT_LE(differ, 40u);  // silhouette pixels of the inner sphere (measured 0)
         EXPECT_LE(e.maxAbs.x, 0.05);
         EXPECT_LE(e.meanAbs.x, 0.01);
