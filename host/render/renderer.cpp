@@ -1,38 +1,59 @@
-// host/render/renderer.cpp — technique names and the factory makeRenderer.
+// host/render/renderer.cpp — technique names and the factories makeRenderer and makeMeshRenderer.
 #include "host/render/renderer.h"
 
 #include "host/errors.h"
 #include "host/render/blend.h"
 #include "host/render/harc.h"
+#include "host/render/iso3d.h"
 #include "host/render/planes.h"
 #include "host/render/slice3d.h"
 #include "host/render/stack2d.h"
 
-namespace clvr {
+#include <functional>
 
-std::vector<std::string> techniqueNames() { return {"slice3d", "stack2d", "planes", "blend", "harc"}; }
+namespace clvr {
+namespace {
+
+// The regular-grid techniques, in the order `clvr info` and error messages list them.
+struct VolumeTechnique {
+    const char* name;
+    std::function<std::unique_ptr<Renderer>(Device&, const Scene&, const Volume&)> make;
+};
+
+const std::vector<VolumeTechnique>& volumeTechniques()
+{
+    static const std::vector<VolumeTechnique> techniques = {
+        {"slice3d", makeSlice3dRenderer}, {"stack2d", makeStack2dRenderer}, {"iso3d", makeIso3dRenderer},
+        {"planes", makePlanesRenderer},   {"blend", makeBlendRenderer},
+    };
+    return techniques;
+}
+
+const VolumeTechnique* findVolumeTechnique(const std::string& name)
+{
+    for (const VolumeTechnique& t : volumeTechniques())
+        if (name == t.name)
+            return &t;
+    return nullptr;
+}
+
+}  // namespace
+
+std::vector<std::string> techniqueNames()
+{
+    std::vector<std::string> names;
+    for (const VolumeTechnique& t : volumeTechniques())
+        names.emplace_back(t.name);
+    names.emplace_back("harc");
+    return names;
+}
 
 std::unique_ptr<Renderer> makeRenderer(Device& device, const Scene& scene, const Volume& volume)
 {
-    if (scene.technique == "slice3d") {
+    if (const VolumeTechnique* t = findVolumeTechnique(scene.technique)) {
         if (volume.values.empty())
-            throw InputError("technique slice3d needs a regular-grid \"volume\", and the scene has none");
-        return makeSlice3dRenderer(device, scene, volume);
-    }
-    if (scene.technique == "stack2d") {
-        if (volume.values.empty())
-            throw InputError("technique stack2d needs a regular-grid \"volume\", and the scene has none");
-        return makeStack2dRenderer(device, scene, volume);
-    }
-    if (scene.technique == "planes") {
-        if (volume.values.empty())
-            throw InputError("technique planes needs a regular-grid \"volume\", and the scene has none");
-        return makePlanesRenderer(device, scene, volume);
-    }
-    if (scene.technique == "blend") {
-        if (volume.values.empty())
-            throw InputError("technique blend needs a regular-grid \"volume\", and the scene has none");
-        return makeBlendRenderer(device, scene, volume);
+            throw InputError("technique " + scene.technique + " needs a regular-grid \"volume\", and the scene has none");
+        return t->make(device, scene, volume);
     }
     if (scene.technique == "harc")
         throw InputError("technique harc needs a tetrahedral \"mesh\", and the scene has none");
@@ -46,9 +67,10 @@ std::unique_ptr<Renderer> makeMeshRenderer(Device& device, const Scene& scene, c
 {
     if (scene.technique == "harc")
         return makeHarcRenderer(device, scene, mesh, buildTopology(mesh));
-    if (scene.technique != "slice3d" && scene.technique != "stack2d" && scene.technique != "planes" && scene.technique != "blend")
+    if (!findVolumeTechnique(scene.technique))
         throw InputError("technique: unknown technique \"" + scene.technique + "\" (mesh techniques: harc)");
-    throw InputError("technique \"" + scene.technique + "\" renders regular-grid volumes, and the scene has a \"mesh\" (mesh techniques: harc)");
+    throw InputError("technique \"" + scene.technique +
+                     "\" renders regular-grid volumes, and the scene has a \"mesh\" (mesh techniques: harc)");
 }
 
 }  // namespace clvr

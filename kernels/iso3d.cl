@@ -1,0 +1,73 @@
+// kernels/iso3d.cl — shaded iso-surfaces by the alpha test (§3 of seeds/000_354856c7f65dc3f9.txt).
+// Two uses of this file (host/render/iso3d.cpp):
+//  - with CLVR_ISO3D_FRAGMENT defined, it is appended after kernels/raster.cl as the fragment program
+//    of the slices: it samples the RGBA volume (encoded normal, value) trilinearly and puts the value,
+//    normalized to [0,1], in alpha, where the alpha test (GEQUAL iso) keeps the samples at or above
+//    the iso-value and the depth test (LESS) the nearest of them;
+//  - without it: iso3d_finish, the last pass, which puts the background where no slice passed.
+// The host has validated everything; this file only does arithmetic.
+#include "clvr_common.h"
+#include "volume_sampling.h"
+
+#ifndef CLVR_ISO3D_FRAGMENT
+
+/* Last pass, per pixel: a pixel is on the surface iff some fragment passed both tests there, i.e.
+ * its depth is below the cleared 1.0. On the surface: (color, 1), the color clamped to [0,1] as a
+ * fixed-point frame buffer would after the color-matrix copy (shaded != 0), or the flat surface
+ * color (shaded == 0). Elsewhere: (background, 0), so the image is I + (1 - A) background. */
+kernel void iso3d_finish(global float4* color, global const float* depth, const uint n, const int shaded,
+                         const float4 surface, const float4 background)
+{
+    CLVR_GUARD_1D(n);
+    const size_t i = get_global_id(0);
+    if (depth[i] < 1.0f)
+        color[i] = (float4)(shaded ? clamp(color[i].xyz, 0.0f, 1.0f) : surface.xyz, 1.0f);
+    else
+        color[i] = (float4)(background.xyz, 0.0f);
+}
+
+#else
+
+/* Trilinear RGBA at grid coordinates g (checked inside by the caller), the four channels of each
+ * grid point interleaved: the 3D texture of the paper's gradient shading, filtered as one texture. */
+float4 iso3d_trilinear4(global const float* v, const int4 dims, const float3 g)
+{
+    const int i = min((int)g.x, dims.x - 2);
+    const int j = min((int)g.y, dims.y - 2);
+    const int k = min((int)g.z, dims.z - 2);
+    const float fx = g.x - (float)i, fy = g.y - (float)j, fz = g.z - (float)k;
+    const uint nx = (uint)dims.x;
+    const uint nxy = nx * (uint)dims.y;
+    const uint p = (uint)k * nxy + (uint)j * nx + (uint)i;
+    const float4 c000 = vload4(p, v), c100 = vload4(p + 1u, v);
+    const float4 c010 = vload4(p + nx, v), c110 = vload4(p + nx + 1u, v);
+    const float4 c001 = vload4(p + nxy, v), c101 = vload4(p + nxy + 1u, v);
+    const float4 c011 = vload4(p + nxy + nx, v), c111 = vload4(p + nxy + nx + 1u, v);
+    const float4 c00 = c000 + fx * (c100 - c000), c10 = c010 + fx * (c110 - c010);
+    const float4 c01 = c001 + fx * (c101 - c001), c11 = c011 + fx * (c111 - c011);
+    const float4 c0 = c00 + fy * (c10 - c00), c1 = c01 + fy * (c11 - c01);
+    return c0 + fz * (c1 - c0);
+}
+
+/* attr[0] = world position on the slice (perspective-correct). uniforms: 0 grid origin, 1 1 / spacing,
+ * 2 dims, 3 (value_lo, 1 / (value_hi - value_lo), positions, flip): the value range mapped onto alpha's [0,1],
+ * positions != 0 for gradientless shading, and flip != 0 for Figure 7's interior pass (the normal turned
+ * round: encoded 1 - rgb). buffer[0]: RGBA volume, per grid point (0.5 N + 0.5, value)
+ * with N the unit normal (iso3d.h). Output: (0.5 N + 0.5 interpolated, normalized value), or with
+ * positions the point's 3D texture coordinates (g + 0.5) / n in RGB (the paper: "the computed texture
+ * coordinate (u, v, w) is assigned as RGB color value"); discarded outside the grid (empty there). */
+int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* color)
+{
+    constant float4* u = r->uniforms;
+    const int4 dims = convert_int4(u[2]);
+    const float3 g = (f->attr[0].xyz - u[0].xyz) * u[1].xyz;
+    if (!clvr_grid_inside(g, dims))
+        return 0;
+    const float4 t = iso3d_trilinear4(r->buffer[0], dims, g);
+    const float3 n = u[3].w != 0.0f ? 1.0f - t.xyz : t.xyz;
+    const float3 rgb = u[3].z != 0.0f ? (g + 0.5f) / convert_float3(dims.xyz) : n;
+    *color = (float4)(rgb, (t.w - u[3].x) * u[3].y);
+    return 1;
+}
+
+#endif
