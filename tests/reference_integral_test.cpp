@@ -195,7 +195,8 @@ TEST(ReferenceIntegral, IntervalsIntegrateOnlyTheirPieces)
     EXPECT_GT(hits, spec.width * spec.height / 8);
     EXPECT_LT(worst, 1e-6);
     options.intervals = [](const Ray&, double, double) { return std::vector<glm::dvec2>{}; };
-    for (const glm::dvec4& p : referenceIntegral(v, constantTf(color, tau), camera, spec, options).pixels())
+    const Image4d none = referenceIntegral(v, constantTf(color, tau), camera, spec, options);  // kept alive
+    for (const glm::dvec4& p : none.pixels())
         ASSERT_EQ(p, glm::dvec4(spec.background, 0.0));
 }
 
