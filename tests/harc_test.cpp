@@ -820,8 +820,9 @@ void checkShippedScene(const char* name, const Camera& through)
         FrameStats rasterStats;
         const Image4f raster = renderWithEntry(scene, mesh, topology, "raster", rasterStats);
         expectRasterEntryNear(what, raster, expected, rasterStats);
-        if (label != cameras[0].first)
+        if (label != cameras[0].first) {
             EXPECT_GE(rasterStats.extra["entry_layers"].get<int>(), 2) << what;  // peeled behind the gap
+        }
         if (label != cameras[0].first) {
             // Non-convex for real: at least 20% more boundary front-face crossings than rays that hit.
             std::uint64_t hit = 0;

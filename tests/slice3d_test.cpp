@@ -543,9 +543,11 @@ TEST(Slice3dFused, EarlyTerminationChangesPixelsByAtMostOneMinusThreshold)
     EXPECT_TRUE(test::imagesNear(ert, toDouble(full), {.maxAbs = 1.0 - threshold + 1e-5, .meanAbs = 1.0 - threshold}));
     EXPECT_GT(maxChannel(e.maxAbs), 1e-4);           // it did something ...
     EXPECT_LT(ertStats.samples, fullStats.samples);  // ... by taking fewer samples
-    for (std::size_t i = 0; i < ert.pixelCount(); ++i)
-        if (full.pixels()[i].a < threshold - 1e-4)
+    for (std::size_t i = 0; i < ert.pixelCount(); ++i) {
+        if (full.pixels()[i].a < threshold - 1e-4) {
             ASSERT_EQ(ert.pixels()[i], full.pixels()[i]) << "pixel " << i << " never reached the threshold";
+        }
+    }
 }
 
 // The pass-by-pass path (slice polygons through raster::draw, fragment program, GL blending) is the
@@ -642,8 +644,9 @@ TEST(Slice3dRenderer, TransferFunctionChangeBetweenFramesEqualsAFreshRenderer)
             const Image4f fresh = renderScene(makeScene(perspectiveCamera(), *tf, 40, options), sphere);
             EXPECT_EQ(std::memcmp(edited.pixels().data(), fresh.pixels().data(), edited.pixelCount() * sizeof(glm::vec4)), 0)
                 << path << ", " << tf->points().size() << " control points";
-            if (tf == &lower)  // the edit shows: the shell adds to the image
+            if (tf == &lower) {  // the edit shows: the shell adds to the image
                 EXPECT_NE(std::memcmp(edited.pixels().data(), first.pixels().data(), edited.pixelCount() * sizeof(glm::vec4)), 0);
+            }
         }
     }
 }
