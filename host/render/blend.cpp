@@ -3,6 +3,7 @@
 #include "host/render/blend.h"
 
 #include "host/errors.h"
+#include "host/render/options_util.h"
 #include "host/gradient_volume.h"
 #include "host/reflectance_map.h"
 #include "host/render/slice3d.h"  // planSlices, packTransferFunction
@@ -17,16 +18,6 @@ namespace {
 constexpr int kMaxSlices = 65536;
 constexpr int kMaxMapSize = 1024;
 constexpr const char* kKnownOptions = "slices, slice_spacing, opacity_threshold, reflectance_map_size";
-
-[[noreturn]] void badOption(const std::string& key, const std::string& what)
-{
-    throw InputError("options." + key + ": " + what);
-}
-
-cl_float4 toCl4(const glm::dvec3& v)
-{
-    return {{static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z), 0.0f}};
-}
 
 class BlendRenderer final : public Renderer {
 public:

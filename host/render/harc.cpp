@@ -3,6 +3,7 @@
 #include "host/render/harc.h"
 
 #include "host/errors.h"
+#include "host/render/options_util.h"
 #include "host/parallel.h"
 #include "host/preintegration_table.h"
 #include "host/psi_table.h"
@@ -23,16 +24,6 @@ namespace clvr {
 namespace {
 
 constexpr const char* kKnownOptions = "integration, full_table, max_steps, early_termination, entry, max_layers";
-
-[[noreturn]] void badOption(const std::string& key, const std::string& what)
-{
-    throw InputError("options." + key + ": " + what);
-}
-
-cl_float4 toCl4(const glm::dvec3& v, double w = 0.0)
-{
-    return {{static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z), static_cast<float>(w)}};
-}
 
 void meshBounds(const TetMesh& mesh, glm::dvec3& lo, glm::dvec3& hi)
 {

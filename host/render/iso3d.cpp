@@ -5,6 +5,7 @@
 
 #include "host/embedded_kernels.h"
 #include "host/errors.h"
+#include "host/render/options_util.h"
 #include "host/gradient_volume.h"
 #include "host/render/slice3d.h"  // planSlices, slicePolygon: the same slices as slice3d
 #include "raster/framebuffer.h"
@@ -24,16 +25,6 @@ constexpr int kMaxSlices = 65536;
 // Figure 7: how far behind the box entry (in slices) the depth buffer is put. The first slice inside the box
 // lies within one slice of the entry; 1.5 keeps it in front on faces seen obliquely by a perspective camera.
 constexpr double kEntryDepthSlices = 1.5;
-
-[[noreturn]] void badOption(const std::string& key, const std::string& what)
-{
-    throw InputError("options." + key + ": " + what);
-}
-
-cl_float4 toCl4(const glm::dvec3& v, double w = 0.0)
-{
-    return {{static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z), static_cast<float>(w)}};
-}
 
 class Iso3dRendererImpl final : public Iso3dRenderer {
 public:

@@ -3,6 +3,7 @@
 #include "host/render/planes.h"
 
 #include "host/errors.h"
+#include "host/render/options_util.h"
 #include "host/gradient_volume.h"
 #include "host/reflectance_map.h"
 #include "host/render/slice3d.h"  // packTransferFunction: the layout kernels/transfer_function.h reads
@@ -18,16 +19,6 @@ namespace {
 constexpr int kMaxMapSize = 1024;        // 6 * 1024^2 entries * 16 bytes = 96 MiB
 constexpr double kMaxSamplesPerRay = 1 << 20;
 constexpr const char* kKnownOptions = "sample_spacing, early_termination, opacity_threshold, reflectance_map_size";
-
-[[noreturn]] void badOption(const std::string& key, const std::string& what)
-{
-    throw InputError("options." + key + ": " + what);
-}
-
-cl_float4 toCl4(const glm::dvec3& v, double w = 0.0)
-{
-    return {{static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z), static_cast<float>(w)}};
-}
 
 class PlanesRenderer final : public Renderer {
 public:

@@ -5,6 +5,7 @@
 
 #include "host/embedded_kernels.h"
 #include "host/errors.h"
+#include "host/render/options_util.h"
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
 
@@ -20,16 +21,6 @@ namespace {
 constexpr int kMaxSlices = 65536;
 constexpr const char* kKnownOptions =
     "slices, slice_spacing, order, early_termination, path, empty_space_skipping, voxel_type, clip";
-
-[[noreturn]] void badOption(const std::string& key, const std::string& what)
-{
-    throw InputError("options." + key + ": " + what);
-}
-
-cl_float4 toCl4(const glm::dvec3& v, double w = 0.0)
-{
-    return {{static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z), static_cast<float>(w)}};
-}
 
 class Slice3dRenderer final : public Renderer {
 public:

@@ -5,6 +5,7 @@
 
 #include "host/embedded_kernels.h"
 #include "host/errors.h"
+#include "host/render/options_util.h"
 #include "host/gradient_volume.h"
 #include "host/reflectance_map.h"
 #include "host/render/slice3d.h"  // packTransferFunction
@@ -28,11 +29,6 @@ constexpr int kMaxIntermediate = 64;
 constexpr int kMaxMapSize = 1024;
 constexpr const char* kKnownOptions = "intermediate, reflectance_map_size";
 constexpr const char* kAxisNames[3] = {"x", "y", "z"};
-
-[[noreturn]] void badOption(const std::string& key, const std::string& what)
-{
-    throw InputError("options." + key + ": " + what);
-}
 
 // The stack along `axis`: slice i (grid index i on that axis) is a 2D texture over the other two
 // axes (b, c) = ((axis + 1) % 3, (axis + 2) % 3) ordered as x < y < z, i.e. (y, z), (x, z), (x, y);
