@@ -4,6 +4,7 @@
 // TetGen mesh cache and the peer's files. tools/*.cpp are not in the test binary, so their files are
 // compiled in here.
 #include "tools/bench_mesh.cpp"
+#include "tools/bench_suites.cpp"
 #include "tools/ceiling.cpp"
 
 #include "host/errors.h"
@@ -241,11 +242,11 @@ TEST(BenchMesh, BluntfinScenesRenderAndMoreSegmentsSplitMore)
 
 namespace {
 
-std::vector<std::filesystem::path> rtsBenchScenes()
+std::vector<std::filesystem::path> benchScenesStartingWith(const std::string& prefix)
 {
     std::vector<std::filesystem::path> out;
     for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::path(CLVR_SOURCE_DIR) / "data/scenes/bench"))
-        if (entry.path().filename().string().starts_with("rts-"))
+        if (entry.path().filename().string().starts_with(prefix))
             out.push_back(entry.path());
     std::sort(out.begin(), out.end());
     return out;
@@ -258,7 +259,7 @@ std::vector<std::filesystem::path> rtsBenchScenes()
 // "no-ert" and "no-skip" scenes differ from their base scene in that one option only.
 TEST(BenchRts, ScenesAreValidAndDifferOnlyWhereTheyShould)
 {
-    const std::vector<std::filesystem::path> files = rtsBenchScenes();
+    const std::vector<std::filesystem::path> files = benchScenesStartingWith("rts-");
     ASSERT_EQ(files.size(), 16u);  // 3 volumes x 2 transfer functions x 2 techniques + 4 planes on/off
     for (const auto& file : files) {
         const clvr::Scene scene = clvr::loadScene(file);
@@ -290,5 +291,43 @@ TEST(BenchRts, ScenesAreValidAndDifferOnlyWhereTheyShould)
             EXPECT_EQ(diff[0]["path"], std::string(off) == "-no-ert" ? "/early_termination" : "/opacity_threshold")
                 << name;
         }
+    }
+}
+
+// ---- the other regular-grid bench scenes (tools/make_regular_bench.py, `clvr bench --suite regular`) -----
+
+// The suite lists exactly the reg-* files there are; every scene loads, is 512x512 and names the technique
+// its file name says; each clip scene is its raster-path baseline plus the clip mesh and nothing else, and
+// each k1 stack is its plain stack with one intermediate slice.
+TEST(BenchRegular, ScenesAreValidAndPairsDifferOnlyWhereTheyShould)
+{
+    const std::vector<std::filesystem::path> files = benchScenesStartingWith("reg-");
+    std::vector<std::string> listed = clvr::tools::benchSuiteScenes("regular");
+    std::vector<std::string> present;
+    for (const auto& file : files)
+        present.push_back(file.filename().string());
+    std::sort(listed.begin(), listed.end());
+    EXPECT_EQ(listed, present);
+    ASSERT_EQ(files.size(), 16u);  // 3 volumes x (iso3d, 2 stacks, raster baseline, clip) + the gradientless engine
+    for (const auto& file : files) {
+        const clvr::Scene scene = clvr::loadScene(file);
+        const std::string name = file.filename().string();
+        EXPECT_EQ(scene.image.width, 512) << name;
+        EXPECT_EQ(scene.image.height, 512) << name;
+        const std::string expected = name.starts_with("reg-iso3d")     ? "iso3d"
+                                     : name.starts_with("reg-stack2d") ? "stack2d"
+                                                                       : "slice3d";
+        EXPECT_EQ(scene.technique, expected) << name;
+        auto differsOnlyIn = [&](const std::string& baseName, const std::string& path) {
+            const clvr::Scene base = clvr::loadScene(file.parent_path() / baseName);
+            const nlohmann::json diff = nlohmann::json::diff(base.options, scene.options);
+            ASSERT_EQ(diff.size(), 1u) << name << ": " << diff.dump();
+            EXPECT_EQ(diff[0]["path"], path) << name;
+            EXPECT_EQ(base.volume, scene.volume) << name;
+        };
+        if (name.starts_with("reg-clip-"))
+            differsOnlyIn("reg-slice3d-raster-" + name.substr(9), "/clip");
+        if (name.ends_with("-k1.json"))
+            differsOnlyIn(name.substr(0, name.size() - 8) + ".json", "/intermediate");
     }
 }

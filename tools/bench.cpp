@@ -444,37 +444,6 @@ nlohmann::json rasterBench(Device& device)
 
 }  // namespace
 
-std::vector<std::string> benchSuiteScenes(const std::string& suite)
-{
-    const std::vector<std::string> slice3d = {"slice3d-ml256.json", "slice3d-engine.json"};
-    const std::vector<std::string> harc = {"harc-bluntfin-10.json", "harc-bluntfin-255.json",
-                                           "harc-bluntfin-10-full.json", "harc-tetgen-1m.json"};
-    // Resample-then-shade (seeds/004 Tables 1-2), as tools/make_rts_bench.py writes them: planes and blend
-    // on each volume with a translucent and an opaque transfer function, then planes on the engine with
-    // early termination, and with the skipping of low-opacity samples, turned off.
-    std::vector<std::string> rts;
-    for (const char* volume : {"engine", "lobster", "ml256"})
-        for (const char* kind : {"translucent", "opaque"})
-            for (const char* technique : {"planes", "blend"})
-                rts.push_back(std::string("rts-") + technique + "-" + volume + "-" + kind + ".json");
-    for (const char* kind : {"translucent", "opaque"})
-        for (const char* off : {"no-ert", "no-skip"})
-            rts.push_back(std::string("rts-planes-engine-") + kind + "-" + off + ".json");
-    if (suite == "slice3d")
-        return slice3d;
-    if (suite == "harc")
-        return harc;
-    if (suite == "rts")
-        return rts;
-    if (suite == "all") {
-        std::vector<std::string> all = slice3d;
-        all.insert(all.end(), harc.begin(), harc.end());
-        all.insert(all.end(), rts.begin(), rts.end());
-        return all;
-    }
-    throw InputError("--suite: unknown suite \"" + suite + "\" (known: slice3d, harc, rts, all)");
-}
-
 int bench(const BenchOptions& options)
 {
     std::vector<fs::path> scenes(options.scenes.begin(), options.scenes.end());

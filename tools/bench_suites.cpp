@@ -1,0 +1,57 @@
+// tools/bench_suites.cpp — the scene files of each `clvr bench --suite` (docs/benchmarks.md). Apart from
+// tools/bench.cpp so that tests/bench_test.cpp can compile it in and check the lists against the files.
+#include "tools/bench.h"
+
+#include "host/errors.h"
+
+#include <string>
+#include <vector>
+
+namespace clvr::tools {
+
+std::vector<std::string> benchSuiteScenes(const std::string& suite)
+{
+    const std::vector<std::string> slice3d = {"slice3d-ml256.json", "slice3d-engine.json"};
+    const std::vector<std::string> harc = {"harc-bluntfin-10.json", "harc-bluntfin-255.json",
+                                           "harc-bluntfin-10-full.json", "harc-tetgen-1m.json"};
+    // Resample-then-shade (seeds/004 Tables 1-2), as tools/make_rts_bench.py writes them: planes and blend
+    // on each volume with a translucent and an opaque transfer function, then planes on the engine with
+    // early termination, and with the skipping of low-opacity samples, turned off.
+    std::vector<std::string> rts;
+    for (const char* volume : {"engine", "lobster", "ml256"})
+        for (const char* kind : {"translucent", "opaque"})
+            for (const char* technique : {"planes", "blend"})
+                rts.push_back(std::string("rts-") + technique + "-" + volume + "-" + kind + ".json");
+    for (const char* kind : {"translucent", "opaque"})
+        for (const char* off : {"no-ert", "no-skip"})
+            rts.push_back(std::string("rts-planes-engine-") + kind + "-" + off + ".json");
+    // The other regular-grid techniques (tools/make_regular_bench.py writes them; its docstring lists them).
+    std::vector<std::string> regular;
+    for (const char* volume : {"engine", "lobster", "ml256"}) {
+        regular.push_back(std::string("reg-iso3d-") + volume + ".json");
+        if (std::string(volume) == "engine")
+            regular.push_back("reg-iso3d-engine-gradientless.json");
+        for (const char* suffix : {"", "-k1"})
+            regular.push_back(std::string("reg-stack2d-") + volume + suffix + ".json");
+        regular.push_back(std::string("reg-slice3d-raster-") + volume + ".json");
+        regular.push_back(std::string("reg-clip-") + volume + ".json");
+    }
+    if (suite == "slice3d")
+        return slice3d;
+    if (suite == "harc")
+        return harc;
+    if (suite == "rts")
+        return rts;
+    if (suite == "regular")
+        return regular;
+    if (suite == "all") {
+        std::vector<std::string> all = slice3d;
+        all.insert(all.end(), harc.begin(), harc.end());
+        all.insert(all.end(), rts.begin(), rts.end());
+        all.insert(all.end(), regular.begin(), regular.end());
+        return all;
+    }
+    throw InputError("--suite: unknown suite \"" + suite + "\" (known: slice3d, harc, rts, regular, all)");
+}
+
+}  // namespace clvr::tools

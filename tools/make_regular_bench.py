@@ -1,0 +1,108 @@
+#!/usr/bin/python3
+"""tools/make_regular_bench.py — writes the regular-grid bench scenes data/scenes/bench/reg-*.json for
+`clvr bench --suite regular` (issue 4 part 8: every regular-grid technique on engine, lobster and
+Marschner-Lobb 256^3 at 512x512).
+
+    /usr/bin/python3 tools/make_regular_bench.py            # rewrites the scene files
+    /usr/bin/python3 tools/make_regular_bench.py --check    # exit 1 if a file differs from what it would write
+    /usr/bin/python3 tools/make_regular_bench.py --list     # the file names, in the suite's order
+
+Volumes, cameras and the translucent transfer function are those of tools/make_rts_bench.py, so a row
+here and a resample-then-shade row of the same volume see the same data from the same place.
+Per volume:
+  reg-iso3d-V            iso3d, gradient shading, 512 slices (seeds/000 §3)
+  reg-stack2d-V          stack2d, plain bilinear slices of the stack (seeds/003)
+  reg-stack2d-V-k1       stack2d, one lerped intermediate slice between stack slices (trilinear again)
+  reg-slice3d-raster-V   slice3d through the raster stage, 256 slices: the baseline of the clip rows
+  reg-clip-V             the same with a sphere clip mesh, two-pass stencil (seeds/000 §2.1)
+and on the engine also reg-iso3d-engine-gradientless (the pixel-texture shading of §3).
+"""
+import argparse
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from make_rts_bench import VOLUMES, scene_text, transfer_function  # noqa: E402
+
+LIGHT = [1, -0.6, 0.8]
+
+# name: (iso-value, clip sphere (center, radius) in world units)
+PER_VOLUME = {
+    "engine": (100.0, ([150, 90, 100], 75)),
+    "lobster": (60.0, ([150, 120, 40], 70)),
+    "ml256": (0.5, ([0.35, 0.25, 0.45], 0.6)),
+}
+
+
+def base(volume, technique):
+    spec, camera, _, _ = VOLUMES[volume]
+    return {
+        "technique": technique,
+        "volume": spec,
+        "camera": camera,
+        "image": {"width": 512, "height": 512, "background": [0, 0, 0]},
+    }
+
+
+def iso_scene(volume, shading):
+    scene = base(volume, "iso3d")
+    scene["transfer_function"] = {"points": [[VOLUMES[volume][2][0], 0.95, 0.8, 0.6, 0.0],
+                                             [VOLUMES[volume][2][1], 0.95, 0.8, 0.6, 1.0]]}
+    scene["iso"] = {"value": PER_VOLUME[volume][0], "shading": shading, "light": LIGHT, "ambient": 0.2,
+                    "diffuse": 0.8}
+    scene["options"] = {"slices": 512}
+    return scene
+
+
+def translucent_scene(volume, technique, options):
+    scene = base(volume, technique)
+    scene["transfer_function"] = {"points": transfer_function(volume, "translucent")}
+    scene["options"] = options
+    return scene
+
+
+def scenes():
+    """(file name, scene) for every bench scene, in the suite's order."""
+    out = []
+    for volume in VOLUMES:
+        center, radius = PER_VOLUME[volume][1]
+        clip = {"mesh": {"generator": "sphere", "center": center, "radius": radius, "segments": 64},
+                "inverse": True, "method": "two-pass"}
+        out.append(("reg-iso3d-%s.json" % volume, iso_scene(volume, "gradient")))
+        if volume == "engine":
+            out.append(("reg-iso3d-engine-gradientless.json", iso_scene(volume, "gradientless")))
+        out.append(("reg-stack2d-%s.json" % volume, translucent_scene(volume, "stack2d", {"intermediate": 0})))
+        out.append(("reg-stack2d-%s-k1.json" % volume, translucent_scene(volume, "stack2d", {"intermediate": 1})))
+        out.append(("reg-slice3d-raster-%s.json" % volume,
+                    translucent_scene(volume, "slice3d", {"slices": 256, "path": "raster"})))
+        out.append(("reg-clip-%s.json" % volume,
+                    translucent_scene(volume, "slice3d", {"slices": 256, "path": "raster", "clip": clip})))
+    return out
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--check", action="store_true", help="compare instead of writing")
+    ap.add_argument("--list", action="store_true", help="print the file names in the suite's order")
+    args = ap.parse_args()
+    bench_dir = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data", "scenes", "bench"))
+    status = 0
+    for name, scene in scenes():
+        if args.list:
+            print(name)
+            continue
+        path = os.path.join(bench_dir, name)
+        text = scene_text(scene)
+        if args.check:
+            if not os.path.exists(path) or open(path).read() != text:
+                print("make_regular_bench.py: " + path + " differs from the generated scene")
+                status = 1
+        else:
+            with open(path, "w") as f:
+                f.write(text)
+            print("wrote " + path)
+    return status
+
+
+if __name__ == "__main__":
+    sys.exit(main())
