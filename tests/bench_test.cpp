@@ -297,8 +297,9 @@ TEST(BenchRts, ScenesAreValidAndDifferOnlyWhereTheyShould)
 // ---- the other regular-grid bench scenes (tools/make_regular_bench.py, `clvr bench --suite regular`) -----
 
 // The suite lists exactly the reg-* files there are; every scene loads, is 512x512 and names the technique
-// its file name says; each clip scene is its raster-path baseline plus the clip mesh and nothing else, and
-// each k1 stack is its plain stack with one intermediate slice.
+// its file name says; each clip scene is its raster-path baseline plus the clip mesh and nothing else,
+// each k1 stack is its plain stack with one intermediate slice, and each p4 stack its k1 stack with four
+// slices per polygon.
 TEST(BenchRegular, ScenesAreValidAndPairsDifferOnlyWhereTheyShould)
 {
     const std::vector<std::filesystem::path> files = benchScenesStartingWith("reg-");
@@ -308,7 +309,7 @@ TEST(BenchRegular, ScenesAreValidAndPairsDifferOnlyWhereTheyShould)
         present.push_back(file.filename().string());
     std::sort(listed.begin(), listed.end());
     EXPECT_EQ(listed, present);
-    ASSERT_EQ(files.size(), 16u);  // 3 volumes x (iso3d, 2 stacks, raster baseline, clip) + the gradientless engine
+    ASSERT_EQ(files.size(), 19u);  // 3 volumes x (iso3d, 3 stacks, raster baseline, clip) + the gradientless engine
     for (const auto& file : files) {
         const clvr::Scene scene = clvr::loadScene(file);
         const std::string name = file.filename().string();
@@ -329,5 +330,7 @@ TEST(BenchRegular, ScenesAreValidAndPairsDifferOnlyWhereTheyShould)
             differsOnlyIn("reg-slice3d-raster-" + name.substr(9), "/clip");
         if (name.ends_with("-k1.json"))
             differsOnlyIn(name.substr(0, name.size() - 8) + ".json", "/intermediate");
+        if (name.ends_with("-p4.json"))
+            differsOnlyIn(name.substr(0, name.size() - 8) + ".json", "/slices_per_polygon");
     }
 }

@@ -31,7 +31,7 @@ std::vector<std::string> benchSuiteScenes(const std::string& suite)
         regular.push_back(std::string("reg-iso3d-") + volume + ".json");
         if (std::string(volume) == "engine")
             regular.push_back("reg-iso3d-engine-gradientless.json");
-        for (const char* suffix : {"", "-k1"})
+        for (const char* suffix : {"", "-k1", "-k1-p4"})
             regular.push_back(std::string("reg-stack2d-") + volume + suffix + ".json");
         regular.push_back(std::string("reg-slice3d-raster-") + volume + ".json");
         regular.push_back(std::string("reg-clip-") + volume + ".json");

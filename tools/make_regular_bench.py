@@ -13,6 +13,7 @@ Per volume:
   reg-iso3d-V            iso3d, gradient shading, 512 slices (seeds/000 §3)
   reg-stack2d-V          stack2d, plain bilinear slices of the stack (seeds/003)
   reg-stack2d-V-k1       stack2d, one lerped intermediate slice between stack slices (trilinear again)
+  reg-stack2d-V-k1-p4    the same with four slices per polygon (seeds/003's multi-texture speed-up)
   reg-slice3d-raster-V   slice3d through the raster stage, 256 slices: the baseline of the clip rows
   reg-clip-V             the same with a sphere clip mesh, two-pass stencil (seeds/000 §2.1)
 and on the engine also reg-iso3d-engine-gradientless (the pixel-texture shading of §3).
@@ -73,6 +74,8 @@ def scenes():
             out.append(("reg-iso3d-engine-gradientless.json", iso_scene(volume, "gradientless")))
         out.append(("reg-stack2d-%s.json" % volume, translucent_scene(volume, "stack2d", {"intermediate": 0})))
         out.append(("reg-stack2d-%s-k1.json" % volume, translucent_scene(volume, "stack2d", {"intermediate": 1})))
+        out.append(("reg-stack2d-%s-k1-p4.json" % volume,
+                    translucent_scene(volume, "stack2d", {"intermediate": 1, "slices_per_polygon": 4})))
         out.append(("reg-slice3d-raster-%s.json" % volume,
                     translucent_scene(volume, "slice3d", {"slices": 256, "path": "raster"})))
         out.append(("reg-clip-%s.json" % volume,

@@ -27,7 +27,8 @@ namespace {
 // The most intermediate slices per stack interval; 64 already samples far finer than the data.
 constexpr int kMaxIntermediate = 64;
 constexpr int kMaxMapSize = 1024;
-constexpr const char* kKnownOptions = "intermediate, reflectance_map_size";
+constexpr int kMaxSlicesPerPolygon = 64;
+constexpr const char* kKnownOptions = "intermediate, reflectance_map_size, slices_per_polygon";
 constexpr const char* kAxisNames[3] = {"x", "y", "z"};
 
 // The stack along `axis`: slice i (grid index i on that axis) is a 2D texture over the other two
@@ -86,6 +87,8 @@ private:
     std::optional<Iso> iso_;
     int axis_ = 2;
     std::vector<StackSlice> slices_;
+    SliceGroups grouped_;  // slices_per_polygon > 1 only
+    cl::Buffer sliceTable_;
     std::vector<raster::Texture> stacks_;  // x, y, z: all three stay resident, as on the paper's boards
     cl::Buffer tf_, map_;
     std::size_t tfBytes_ = 0;
@@ -196,6 +199,29 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
         isoFinish_ = device_.kernel("stack2d.cl", "stack2d_iso_finish");
     }
     fragmentProgram_.buffers[2] = map_;
+    if (options_.slicesPerPolygon > 1) {
+        grouped_ = groupStackSlices(slices_, camera_, origin_, spacing_, axis_, options_.slicesPerPolygon);
+        std::vector<glm::vec4> table;
+        for (const StackSlice& slice : grouped_.slices)
+            table.emplace_back(static_cast<float>(origin_[axis_] + slice.position * spacing_[axis_]),
+                               static_cast<float>(slice.lower), slice.weight, static_cast<float>(slice.thickness));
+        sliceTable_ = device_.upload("stack2d slice table", table);
+        residentBytes_ += table.size() * sizeof(glm::vec4);
+        fragmentProgram_.buffers[3] = sliceTable_;
+        glm::vec4 eb(0.0f), ec(0.0f);
+        eb[s.b] = 1.0f;
+        ec[s.c] = 1.0f;
+        const double alphaRef =
+            iso_ ? std::clamp((iso_->value - iso_->dataMin) / (iso_->dataMax > iso_->dataMin ? iso_->dataMax - iso_->dataMin : 1.0),
+                              0.0, 1.0)
+                 : 0.0;
+        fragmentProgram_.uniforms.push_back(eb);  // 13
+        fragmentProgram_.uniforms.push_back(ec);  // 14
+        fragmentProgram_.uniforms.push_back(glm::vec4(lo_[s.b], lo_[s.c], hi_[s.b], hi_[s.c]));  // 15
+        fragmentProgram_.uniforms.push_back(glm::vec4(0.5f / dims_[s.b], 0.5f / dims_[s.c], (dims_[s.b] - 0.5f) / dims_[s.b],
+                                                      (dims_[s.c] - 0.5f) / dims_[s.c]));  // 16, as the quads' corners
+        fragmentProgram_.uniforms.push_back(glm::vec4(static_cast<float>(alphaRef), 0.0f, 0.0f, 0.0f));  // 17
+    }
     fragmentProgram_.uniforms[5].z = static_cast<float>(scene.transferFunction.points().size());
     fragmentProgram_.buffers[1] = tf_;
 }
@@ -241,22 +267,64 @@ Image4f Stack2dRenderer::render(FrameStats& stats)
     const glm::dvec2 uvLo(0.5 / dims_[s.b], 0.5 / dims_[s.c]);
     const glm::dvec2 uvHi((dims_[s.b] - 0.5) / dims_[s.b], (dims_[s.c] - 0.5) / dims_[s.c]);
     std::vector<raster::Vertex> vertices;
-    vertices.reserve(slices_.size() * 6);
-    for (const StackSlice& slice : slices_) {
-        auto vertex = [&](int cb, int cc) {
+    auto quad = [&](double axisWorld, glm::dvec2 rectLo, glm::dvec2 rectHi, float lower, float weight,
+                    glm::vec4 attribute1) {
+        for (const auto& [cb, cc] : std::array<std::pair<int, int>, 6>{{{0, 0}, {1, 0}, {1, 1}, {0, 0}, {1, 1}, {0, 1}}}) {
             glm::dvec3 p;
-            p[axis_] = origin_[axis_] + slice.position * spacing_[axis_];
-            p[s.b] = cb ? hi_[s.b] : lo_[s.b];
-            p[s.c] = cc ? hi_[s.c] : lo_[s.c];
+            p[axis_] = axisWorld;
+            p[s.b] = cb ? rectHi.x : rectLo.x;
+            p[s.c] = cc ? rectHi.y : rectLo.y;
+            // Texture coordinates linear in (b, c): the box corners get uvLo and uvHi exactly.
+            glm::dvec2 uv;
+            for (int k = 0; k < 2; ++k) {
+                const int a = k == 0 ? s.b : s.c;
+                const double extent = hi_[a] - lo_[a];
+                uv[k] = extent > 0.0 ? uvLo[k] + (p[a] - lo_[a]) / extent * (uvHi[k] - uvLo[k]) : uvLo[k];
+                if (p[a] == hi_[a])
+                    uv[k] = uvHi[k];
+            }
             raster::Vertex v;
             v.position = glm::vec4(viewProjection * glm::dvec4(p, 1.0));
-            v.attributes[0] = glm::vec4(static_cast<float>(cb ? uvHi.x : uvLo.x), static_cast<float>(cc ? uvHi.y : uvLo.y),
-                                        static_cast<float>(slice.lower), slice.weight);
-            v.attributes[1] = glm::vec4(static_cast<float>(slice.thickness), 0.0f, 0.0f, 0.0f);
-            return v;
-        };
-        for (const auto& [cb, cc] : std::array<std::pair<int, int>, 6>{{{0, 0}, {1, 0}, {1, 1}, {0, 0}, {1, 1}, {0, 1}}})
-            vertices.push_back(vertex(cb, cc));
+            v.attributes[0] = glm::vec4(static_cast<float>(uv.x), static_cast<float>(uv.y), lower, weight);
+            v.attributes[1] = attribute1;
+            vertices.push_back(v);
+        }
+    };
+    const glm::dvec2 boxLo(lo_[s.b], lo_[s.c]), boxHi(hi_[s.b], hi_[s.c]);
+    if (options_.slicesPerPolygon == 1) {
+        vertices.reserve(slices_.size() * 6);
+        for (const StackSlice& slice : slices_)
+            quad(origin_[axis_] + slice.position * spacing_[axis_], boxLo, boxHi, static_cast<float>(slice.lower),
+                 slice.weight, glm::vec4(static_cast<float>(slice.thickness), 0.0f, 0.0f, 0.0f));
+    } else {
+        // One quad per group, in the plane of its front-most slice, covering the box's cross-section
+        // of every slice of the group as seen from the camera: the bounding rectangle of their
+        // corners projected onto that plane along the rays (through the camera, or along forward).
+        vertices.reserve(grouped_.groups.size() * 6);
+        for (const auto& [first, count] : grouped_.groups) {
+            const double drawn = origin_[axis_] + grouped_.slices[first + count - 1].position * spacing_[axis_];
+            glm::dvec2 rectLo(std::numeric_limits<double>::infinity()), rectHi(-std::numeric_limits<double>::infinity());
+            for (int j = first; j < first + count; ++j) {
+                const double x = origin_[axis_] + grouped_.slices[j].position * spacing_[axis_];
+                for (int corner = 0; corner < 4; ++corner) {
+                    glm::dvec3 p;
+                    p[axis_] = x;
+                    p[s.b] = (corner & 1) ? hi_[s.b] : lo_[s.b];
+                    p[s.c] = (corner & 2) ? hi_[s.c] : lo_[s.c];
+                    const glm::dvec3 q = camera_.parallel
+                                             ? p + camera_.forward() * ((drawn - x) / camera_.forward()[axis_])
+                                             : camera_.position + (p - camera_.position) *
+                                                                      ((drawn - camera_.position[axis_]) / (x - camera_.position[axis_]));
+                    rectLo = glm::min(rectLo, glm::dvec2(q[s.b], q[s.c]));
+                    rectHi = glm::max(rectHi, glm::dvec2(q[s.b], q[s.c]));
+                }
+            }
+            // Widen by a hair so that pixels whose rays graze a box edge are covered; the fragment
+            // program tests each slice against the box itself.
+            const glm::dvec2 pad = 1e-6 * (rectHi - rectLo) + 1e-12;
+            quad(drawn, rectLo - pad, rectHi + pad, 0.0f, 0.0f,
+                 glm::vec4(0.0f, static_cast<float>(first), static_cast<float>(count), 0.0f));
+        }
     }
     raster::DrawState state;
     if (!iso_) {  // "over" on premultiplied color: dst = src + (1 - src.a) dst
@@ -297,10 +365,19 @@ Image4f Stack2dRenderer::render(FrameStats& stats)
     Image4f image = framebuffer_->readColor(device_);
     stats.passes = device_.takePassTimes();
     stats.frameMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    stats.samples = drawStats.fragments;  // one sample per fragment of a quad
+    // One sample per fragment of a quad; with several slices per polygon at most `count` per fragment
+    // (fewer where the enlarged quad covers pixels outside some of its slices): an upper bound.
+    std::uint64_t samples = drawStats.fragments;
+    if (options_.slicesPerPolygon > 1)
+        samples = static_cast<std::uint64_t>(static_cast<double>(drawStats.fragments) * grouped_.slices.size() /
+                                             std::max<std::size_t>(grouped_.groups.size(), 1));
+    stats.samples = samples;
     stats.extra["axis"] = kAxisNames[axis_];
     stats.extra["slices"] = slices_.size();
     stats.extra["intermediate"] = options_.intermediate;
+    stats.extra["slices_per_polygon"] = options_.slicesPerPolygon;
+    stats.extra["polygons"] = options_.slicesPerPolygon > 1 ? grouped_.groups.size() : slices_.size();
+    stats.extra["fragments"] = drawStats.fragments;
     stats.extra["shaded"] = lighting_.shaded();
     stats.extra["iso"] = iso_.has_value();
     stats.extra["reflectance_map_size"] = options_.reflectanceMapSize;
@@ -328,6 +405,10 @@ Stack2dOptions parseStack2dOptions(const nlohmann::json& options)
             if (!value.is_number_integer() || value.get<long long>() < 1 || value.get<long long>() > kMaxMapSize)
                 badOption(key, "must be an integer in [1, " + std::to_string(kMaxMapSize) + "], got " + value.dump());
             o.reflectanceMapSize = static_cast<int>(value.get<long long>());
+        } else if (key == "slices_per_polygon") {
+            if (!value.is_number_integer() || value.get<long long>() < 1 || value.get<long long>() > kMaxSlicesPerPolygon)
+                badOption(key, "must be an integer in [1, " + std::to_string(kMaxSlicesPerPolygon) + "], got " + value.dump());
+            o.slicesPerPolygon = static_cast<int>(value.get<long long>());
         } else {
             badOption(key, std::string("unknown option for stack2d (known: ") + kKnownOptions + ")");
         }
@@ -369,6 +450,27 @@ std::vector<StackSlice> planStack(const Camera& camera, const glm::dvec3& origin
     std::stable_sort(slices.begin(), slices.end(),
                      [&](const StackSlice& a, const StackSlice& b) { return farness(a) > farness(b); });
     return slices;
+}
+
+SliceGroups groupStackSlices(const std::vector<StackSlice>& drawOrder, const Camera& camera, const glm::dvec3& origin,
+                             const glm::dvec3& spacing, int axis, int perPolygon)
+{
+    SliceGroups out;
+    std::vector<StackSlice> sides[2];
+    for (const StackSlice& slice : drawOrder) {
+        const double x = origin[axis] + slice.position * spacing[axis];
+        if (camera.parallel)
+            sides[0].push_back(slice);
+        else if (x != camera.position[axis])
+            sides[x > camera.position[axis] ? 0 : 1].push_back(slice);
+    }
+    for (const std::vector<StackSlice>& side : sides)
+        for (std::size_t first = 0; first < side.size(); first += perPolygon) {
+            const std::size_t count = std::min<std::size_t>(perPolygon, side.size() - first);
+            out.groups.emplace_back(static_cast<int>(out.slices.size()), static_cast<int>(count));
+            out.slices.insert(out.slices.end(), side.begin() + first, side.begin() + first + count);
+        }
+    return out;
 }
 
 std::unique_ptr<Renderer> makeStack2dRenderer(Device& device, const Scene& scene, const Volume& volume)

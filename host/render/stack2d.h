@@ -22,6 +22,7 @@ namespace clvr {
 struct Stack2dOptions {
     int intermediate = 0;  // slices interpolated between two neighbouring stack slices (0: the stack itself)
     int reflectanceMapSize = 128;  // shaded ("lights" in the scene): n, 6 n^2 shades (host/reflectance_map.h)
+    int slicesPerPolygon = 1;      // slices one quad stands for (seeds/003's multi-texture speed-up)
 };
 
 // Reads the scene's "options" for stack2d. Throws InputError naming the key ("options.intermediate: ...").
@@ -49,6 +50,19 @@ struct StackSlice {
 // plane from the camera position along the axis; parallel: decreasing depth along forward).
 std::vector<StackSlice> planStack(const Camera& camera, const glm::dvec3& origin, const glm::dvec3& spacing,
                                   const glm::ivec3& dims, int axis, int intermediate);
+
+// Several slices per polygon: the slices of `drawOrder` (planStack's order) grouped into runs of at
+// most `perPolygon` consecutive slices, each drawn as one quad whose fragment program samples all of
+// them. A ray meets the planes on one side of a perspective camera only (along the axis), so the
+// slices are first split by side — each side keeps its back-to-front order, and groups never mix
+// sides; a plane through the camera (seen edge-on, no fragments) is dropped. `slices` is the new
+// order, `groups` (first, count) index into it, farthest slice of a group first.
+struct SliceGroups {
+    std::vector<StackSlice> slices;
+    std::vector<std::pair<int, int>> groups;
+};
+SliceGroups groupStackSlices(const std::vector<StackSlice>& drawOrder, const Camera& camera, const glm::dvec3& origin,
+                             const glm::dvec3& spacing, int axis, int perPolygon);
 
 // Renderer for "stack2d". Uploads three float32 stacks (3 x 4 bytes per grid point; shaded, with the
 // Sobel gradient: 3 x 16 bytes) and the packed transfer function (and the reflectance map); throws InputError for bad options, DeviceError when the stacks do not fit.
