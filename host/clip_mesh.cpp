@@ -3,6 +3,7 @@
 #include "host/clip_mesh.h"
 
 #include "host/errors.h"
+#include "host/file_io.h"
 
 #include <tetgen.h>
 
@@ -166,7 +167,11 @@ ClipMesh readWithTetgen(const fs::path& path, const std::string& ext)
 {
     tetgenio in;
     auto name = cString(path.string());
-    const bool loaded = ext == ".off" ? in.load_off(name.data()) : in.load_stl(name.data());
+    bool loaded = false;
+    {
+        const QuietStdout quiet;  // TetGen prints "Opening FILE."
+        loaded = ext == ".off" ? in.load_off(name.data()) : in.load_stl(name.data());
+    }
     if (!loaded || in.numberofpoints == 0 || in.numberoffacets == 0)
         throw InputError(path.string() + ": TetGen's reader could not read a surface from it");
     ClipMesh mesh;

@@ -3,6 +3,7 @@
 #include "host/tetgen_mesher.h"
 
 #include "host/errors.h"
+#include "host/file_io.h"
 #include "host/generators.h"
 #include "host/volume_io.h"
 
@@ -11,6 +12,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <memory>
 #include <sstream>
 #include <vector>
 
@@ -98,6 +100,7 @@ TetMesh meshSurface(const fs::path& surface, const MesherOptions& options)
     const std::string ext = lower(surface.extension().string());
     tetgenio in, out;
     bool loaded = false;
+    auto quiet = std::make_unique<QuietStdout>();  // TetGen's readers print "Opening FILE."
     if (ext == ".poly" || ext == ".smesh") {
         fs::path base = surface;
         base.replace_extension();
@@ -112,6 +115,7 @@ TetMesh meshSurface(const fs::path& surface, const MesherOptions& options)
     } else {
         throw InputError(surface.string() + ": unknown surface format \"" + ext + "\" (.poly, .smesh, .off, .stl)");
     }
+    quiet.reset();
     if (!loaded || in.numberofpoints == 0 || in.numberoffacets == 0)
         throw InputError(surface.string() + ": TetGen could not read a surface from it");
 

@@ -181,3 +181,15 @@ expect_error(3 ${out} "out of device memory: .*volume.*needs 8 MiB"
 # A malformed limit is bad input.
 expect_error(2 ${out} "CLVR_DEVICE_MEMORY_LIMIT"
   ${CMAKE_COMMAND} -E env CLVR_DEVICE_MEMORY_LIMIT=lots ${CLVR} render -o ${out} ${SMALL})
+
+# A clip mesh and a mesh surface read through TetGen's readers (which print "Opening FILE." on stdout):
+# clvr's stdout is its own one line.
+function(expect_one_stdout_line scene)
+  execute_process(COMMAND ${CLVR} render ${SRC}/data/scenes/${scene}.json -o ${WORK}/${scene}.png ${SMALL} ${ARGN}
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 300)
+  if(NOT rc EQUAL 0 OR NOT out MATCHES "^wrote [^\n]*\n$")
+    message(FATAL_ERROR "clvr render ${scene}: exit ${rc}, want 0 and one line 'wrote ...' on stdout\n  stdout: ${out}\n  stderr: ${err}")
+  endif()
+endfunction()
+expect_one_stdout_line(engine-clip-torus --set options.slices=16)
+expect_one_stdout_line(torus)
