@@ -18,12 +18,11 @@ Per volume:
   reg-clip-V             the same with a sphere clip mesh, two-pass stencil (seeds/000 §2.1)
 and on the engine also reg-iso3d-engine-gradientless (the pixel-texture shading of §3).
 """
-import argparse
 import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from make_rts_bench import VOLUMES, scene_text, transfer_function  # noqa: E402
+from make_rts_bench import VOLUMES, transfer_function, write_scenes  # noqa: E402
 
 LIGHT = [1, -0.6, 0.8]
 
@@ -84,27 +83,7 @@ def scenes():
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--check", action="store_true", help="compare instead of writing")
-    ap.add_argument("--list", action="store_true", help="print the file names in the suite's order")
-    args = ap.parse_args()
-    bench_dir = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data", "scenes", "bench"))
-    status = 0
-    for name, scene in scenes():
-        if args.list:
-            print(name)
-            continue
-        path = os.path.join(bench_dir, name)
-        text = scene_text(scene)
-        if args.check:
-            if not os.path.exists(path) or open(path).read() != text:
-                print("make_regular_bench.py: " + path + " differs from the generated scene")
-                status = 1
-        else:
-            with open(path, "w") as f:
-                f.write(text)
-            print("wrote " + path)
-    return status
+    return write_scenes(scenes(), "make_regular_bench.py", __doc__.split("\n")[0])
 
 
 if __name__ == "__main__":

@@ -87,14 +87,16 @@ def scene_text(scene):
     return "{\n" + ",\n".join(keys) + "\n}\n"
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+def write_scenes(scene_list, tool, description):
+    """The command line shared by the bench-scene writers: write, --check or --list `scene_list`
+    ((file name, scene) pairs) in data/scenes/bench/; returns the exit status."""
+    ap = argparse.ArgumentParser(description=description)
     ap.add_argument("--check", action="store_true", help="compare instead of writing")
     ap.add_argument("--list", action="store_true", help="print the file names in the suite's order")
     args = ap.parse_args()
     bench_dir = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data", "scenes", "bench"))
     status = 0
-    for name, scene in scenes():
+    for name, scene in scene_list:
         if args.list:
             print(name)
             continue
@@ -102,13 +104,17 @@ def main():
         text = scene_text(scene)
         if args.check:
             if not os.path.exists(path) or open(path).read() != text:
-                print("make_rts_bench.py: " + path + " differs from the generated scene")
+                print(tool + ": " + path + " differs from the generated scene")
                 status = 1
         else:
             with open(path, "w") as f:
                 f.write(text)
             print("wrote " + path)
     return status
+
+
+def main():
+    return write_scenes(scenes(), "make_rts_bench.py", __doc__.split("\n")[0])
 
 
 if __name__ == "__main__":
