@@ -3,6 +3,7 @@
 #include "host/render/harc.h"
 
 #include "host/errors.h"
+#include "host/render/camera_args.h"
 #include "host/render/options_util.h"
 #include "host/parallel.h"
 #include "host/preintegration_table.h"
@@ -171,9 +172,6 @@ Image4f HarcRenderer::render(FrameStats& stats)
         entries.push_back(cl_int2{{0, 0}});  // no zero-size buffers
     const cl::Buffer entryBuffer = device_.upload("harc entry crossings", entries);
 
-    const double aspect = static_cast<double>(image_.width) / image_.height;
-    const double scale = camera_.parallel ? camera_.parallelScale : std::tan(glm::radians(camera_.viewAngle) * 0.5);
-    const cl_float4 params{{static_cast<float>(scale), static_cast<float>(aspect), camera_.parallel ? 1.0f : 0.0f, 0.0f}};
     const float ert = options_.earlyTermination < 1.0 ? static_cast<float>(options_.earlyTermination) : 2.0f;
     const cl_uint maxSteps = static_cast<cl_uint>(std::min<std::uint64_t>(maxSteps_, 0xffffffffu));
     int a = 0;
@@ -188,11 +186,7 @@ Image4f HarcRenderer::render(FrameStats& stats)
     kernel_.setArg(a++, static_cast<cl_int>(tfCount_));
     kernel_.setArg(a++, psi_);
     kernel_.setArg(a++, static_cast<cl_int>(psiTable().size));
-    kernel_.setArg(a++, toCl4(camera_.position - shift_));
-    kernel_.setArg(a++, toCl4(camera_.forward()));
-    kernel_.setArg(a++, toCl4(camera_.right()));
-    kernel_.setArg(a++, toCl4(camera_.up()));
-    kernel_.setArg(a++, params);
+    a = setCameraArgs(kernel_, a, camera_, image_.width, image_.height, shift_);
     kernel_.setArg(a++, maxSteps);
     const cl_int integration = options_.integration == HarcOptions::Integration::Average ? 1
                                : options_.integration == HarcOptions::Integration::Full  ? 2

@@ -4,6 +4,7 @@
 
 #include "host/embedded_kernels.h"
 #include "host/errors.h"
+#include "host/render/camera_args.h"
 
 #include <algorithm>
 #include <chrono>
@@ -93,14 +94,9 @@ HarcEntryLists HarcRasterEntries::build(const Camera& worldCamera, HarcRasterEnt
         vertices[i].attributes[0] = glm::vec4(corners_[i], 0.0f);
         vertices[i].attributes[1] = glm::vec4(static_cast<float>(code & 0xffff), static_cast<float>(code >> 16), 0.0f, 0.0f);
     }
-    const double aspect = static_cast<double>(width_) / height_;
-    const double scale = camera.parallel ? camera.parallelScale : std::tan(glm::radians(camera.viewAngle) * 0.5);
-    program_.uniforms = {glm::vec4(glm::vec3(camera.position), 0.0f),
-                         glm::vec4(glm::vec3(forward), 0.0f),
-                         glm::vec4(glm::vec3(camera.right()), 0.0f),
-                         glm::vec4(glm::vec3(camera.up()), 0.0f),
-                         glm::vec4(static_cast<float>(scale), static_cast<float>(aspect), camera.parallel ? 1.0f : 0.0f, 0.0f),
-                         glm::vec4(static_cast<float>(width_), static_cast<float>(height_), 0.0f, 0.0f)};
+    const std::array<glm::vec4, 5> cameraUniforms = cameraVectors(camera, width_, height_);
+    program_.uniforms.assign(cameraUniforms.begin(), cameraUniforms.end());
+    program_.uniforms.push_back(glm::vec4(static_cast<float>(width_), static_cast<float>(height_), 0.0f, 0.0f));
     raster::DrawState state;
     state.fragment.depth.test = true;
     state.fragment.depth.func = raster::CompareFunc::Less;

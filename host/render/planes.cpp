@@ -3,6 +3,7 @@
 #include "host/render/planes.h"
 
 #include "host/errors.h"
+#include "host/render/camera_args.h"
 #include "host/render/options_util.h"
 #include "host/gradient_volume.h"
 #include "host/reflectance_map.h"
@@ -105,8 +106,6 @@ void PlanesRenderer::setTransferFunction(const TransferFunction& tf)
 Image4f PlanesRenderer::render(FrameStats& stats)
 {
     const auto start = std::chrono::steady_clock::now();
-    const double aspect = static_cast<double>(image_.width) / image_.height;
-    const double scale = camera_.parallel ? camera_.parallelScale : std::tan(glm::radians(camera_.viewAngle) * 0.5);
     int a = 0;
     kernel_.setArg(a++, out_);
     kernel_.setArg(a++, samples_);
@@ -126,11 +125,7 @@ Image4f PlanesRenderer::render(FrameStats& stats)
     kernel_.setArg(a++, static_cast<cl_int>(options_.reflectanceMapSize));
     kernel_.setArg(a++, static_cast<cl_int>(lighting_.shaded() ? 1 : 0));
     kernel_.setArg(a++, toCl4(toEye_));
-    kernel_.setArg(a++, toCl4(camera_.position));
-    kernel_.setArg(a++, toCl4(camera_.forward()));
-    kernel_.setArg(a++, toCl4(camera_.right()));
-    kernel_.setArg(a++, toCl4(camera_.up()));
-    kernel_.setArg(a++, cl_float4{{static_cast<float>(scale), static_cast<float>(aspect), camera_.parallel ? 1.0f : 0.0f, 0.0f}});
+    a = setCameraArgs(kernel_, a, camera_, image_.width, image_.height);
     kernel_.setArg(a++, static_cast<cl_float>(options_.sampleSpacing));
     kernel_.setArg(a++, static_cast<cl_float>(options_.earlyTermination));
     kernel_.setArg(a++, static_cast<cl_float>(options_.opacityThreshold));

@@ -5,6 +5,7 @@
 
 #include "host/embedded_kernels.h"
 #include "host/errors.h"
+#include "host/render/camera_args.h"
 #include "host/render/options_util.h"
 #include "host/gradient_volume.h"
 #include "host/reflectance_map.h"
@@ -170,17 +171,12 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
             source = k.source;
     fragmentProgram_.source = "#define CLVR_STACK2D_FRAGMENT 1\n" + std::string(source);
     fragmentProgram_.buffers[0] = stacks_[axis_].buffer();
-    const double aspect = static_cast<double>(image_.width) / image_.height;
-    const double scale = camera_.parallel ? camera_.parallelScale : std::tan(glm::radians(camera_.viewAngle) * 0.5);
     glm::vec4 axisVector(0.0f);
     axisVector[axis_] = 1.0f;
     const StackShape s = stackShape(axis_);
+    const std::array<glm::vec4, 5> cameraUniforms = cameraVectors(camera_, image_.width, image_.height);
     fragmentProgram_.uniforms = {
-        glm::vec4(glm::vec3(camera_.position), 0.0f),
-        glm::vec4(glm::vec3(camera_.forward()), 0.0f),
-        glm::vec4(glm::vec3(camera_.right()), 0.0f),
-        glm::vec4(glm::vec3(camera_.up()), 0.0f),
-        glm::vec4(static_cast<float>(scale), static_cast<float>(aspect), camera_.parallel ? 1.0f : 0.0f, 0.0f),
+        cameraUniforms[0], cameraUniforms[1], cameraUniforms[2], cameraUniforms[3], cameraUniforms[4],
         glm::vec4(image_.width, image_.height, 0.0f, 0.0f),  // z: tf_count, set with the transfer function
         axisVector,
         glm::vec4(dims_[s.b], dims_[s.c], channels, 0.0f),
