@@ -139,32 +139,19 @@ Image4f BlendRenderer::render(FrameStats& stats)
 BlendOptions parseBlendOptions(const nlohmann::json& options)
 {
     BlendOptions o;
-    if (options.is_null())
-        return o;
-    if (!options.is_object())
-        throw InputError("options: must be an object");
-    for (const auto& [key, value] : options.items()) {
-        const bool number = value.is_number() && std::isfinite(value.get<double>());
-        if (key == "slices") {
-            if (!value.is_number_integer() || value.get<long long>() < 1 || value.get<long long>() > kMaxSlices)
-                badOption(key, "must be an integer in [1, " + std::to_string(kMaxSlices) + "], got " + value.dump());
-            o.slices = static_cast<int>(value.get<long long>());
-        } else if (key == "slice_spacing") {
-            if (!number || !(value.get<double>() > 0.0))
-                badOption(key, "must be a positive number (world units), got " + value.dump());
-            o.sliceSpacing = value.get<double>();
-        } else if (key == "opacity_threshold") {
-            if (!number || !(value.get<double>() >= 0.0 && value.get<double>() < 1.0))
-                badOption(key, "must be an opacity in [0, 1) (0 = skip only transparent samples), got " + value.dump());
-            o.opacityThreshold = value.get<double>();
-        } else if (key == "reflectance_map_size") {
-            if (!value.is_number_integer() || value.get<long long>() < 1 || value.get<long long>() > kMaxMapSize)
-                badOption(key, "must be an integer in [1, " + std::to_string(kMaxMapSize) + "], got " + value.dump());
-            o.reflectanceMapSize = static_cast<int>(value.get<long long>());
-        } else {
+    forEachOption(options, [&](const std::string& key, const nlohmann::json& value) {
+        if (key == "slices")
+            o.slices = integerOption(key, value, 1, kMaxSlices);
+        else if (key == "slice_spacing")
+            o.sliceSpacing = numberOption(key, value, [](double x) { return x > 0.0; }, "a positive number (world units)");
+        else if (key == "opacity_threshold")
+            o.opacityThreshold = numberOption(key, value, [](double x) { return x >= 0.0 && x < 1.0; },
+                                              "an opacity in [0, 1) (0 = skip only transparent samples)");
+        else if (key == "reflectance_map_size")
+            o.reflectanceMapSize = integerOption(key, value, 1, kMaxMapSize);
+        else
             badOption(key, std::string("unknown option for blend (known: ") + kKnownOptions + ")");
-        }
-    }
+    });
     if (options.contains("slices") && options.contains("slice_spacing"))
         badOption("slice_spacing", "give either slices or slice_spacing, not both");
     return o;

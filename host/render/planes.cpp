@@ -164,32 +164,20 @@ Image4f PlanesRenderer::render(FrameStats& stats)
 PlanesOptions parsePlanesOptions(const nlohmann::json& options)
 {
     PlanesOptions o;
-    if (options.is_null())
-        return o;
-    if (!options.is_object())
-        throw InputError("options: must be an object");
-    for (const auto& [key, value] : options.items()) {
-        const bool number = value.is_number() && std::isfinite(value.get<double>());
-        if (key == "sample_spacing") {
-            if (!number || !(value.get<double>() > 0.0))
-                badOption(key, "must be a positive number (world units), got " + value.dump());
-            o.sampleSpacing = value.get<double>();
-        } else if (key == "early_termination") {
-            if (!number || !(value.get<double>() > 0.0 && value.get<double>() <= 1.0))
-                badOption(key, "must be an opacity in (0, 1] (1 = off), got " + value.dump());
-            o.earlyTermination = value.get<double>();
-        } else if (key == "opacity_threshold") {
-            if (!number || !(value.get<double>() >= 0.0 && value.get<double>() < 1.0))
-                badOption(key, "must be an opacity in [0, 1) (0 = skip only transparent samples), got " + value.dump());
-            o.opacityThreshold = value.get<double>();
-        } else if (key == "reflectance_map_size") {
-            if (!value.is_number_integer() || value.get<long long>() < 1 || value.get<long long>() > kMaxMapSize)
-                badOption(key, "must be an integer in [1, " + std::to_string(kMaxMapSize) + "], got " + value.dump());
-            o.reflectanceMapSize = static_cast<int>(value.get<long long>());
-        } else {
+    forEachOption(options, [&](const std::string& key, const nlohmann::json& value) {
+        if (key == "sample_spacing")
+            o.sampleSpacing = numberOption(key, value, [](double x) { return x > 0.0; }, "a positive number (world units)");
+        else if (key == "early_termination")
+            o.earlyTermination =
+                numberOption(key, value, [](double x) { return x > 0.0 && x <= 1.0; }, "an opacity in (0, 1] (1 = off)");
+        else if (key == "opacity_threshold")
+            o.opacityThreshold = numberOption(key, value, [](double x) { return x >= 0.0 && x < 1.0; },
+                                              "an opacity in [0, 1) (0 = skip only transparent samples)");
+        else if (key == "reflectance_map_size")
+            o.reflectanceMapSize = integerOption(key, value, 1, kMaxMapSize);
+        else
             badOption(key, std::string("unknown option for planes (known: ") + kKnownOptions + ")");
-        }
-    }
+    });
     return o;
 }
 

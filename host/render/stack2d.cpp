@@ -388,27 +388,16 @@ Image4f Stack2dRenderer::render(FrameStats& stats)
 Stack2dOptions parseStack2dOptions(const nlohmann::json& options)
 {
     Stack2dOptions o;
-    if (options.is_null())
-        return o;
-    if (!options.is_object())
-        throw InputError("options: must be an object");
-    for (const auto& [key, value] : options.items()) {
-        if (key == "intermediate") {
-            if (!value.is_number_integer() || value.get<long long>() < 0 || value.get<long long>() > kMaxIntermediate)
-                badOption(key, "must be an integer in [0, " + std::to_string(kMaxIntermediate) + "], got " + value.dump());
-            o.intermediate = static_cast<int>(value.get<long long>());
-        } else if (key == "reflectance_map_size") {
-            if (!value.is_number_integer() || value.get<long long>() < 1 || value.get<long long>() > kMaxMapSize)
-                badOption(key, "must be an integer in [1, " + std::to_string(kMaxMapSize) + "], got " + value.dump());
-            o.reflectanceMapSize = static_cast<int>(value.get<long long>());
-        } else if (key == "slices_per_polygon") {
-            if (!value.is_number_integer() || value.get<long long>() < 1 || value.get<long long>() > kMaxSlicesPerPolygon)
-                badOption(key, "must be an integer in [1, " + std::to_string(kMaxSlicesPerPolygon) + "], got " + value.dump());
-            o.slicesPerPolygon = static_cast<int>(value.get<long long>());
-        } else {
+    forEachOption(options, [&](const std::string& key, const nlohmann::json& value) {
+        if (key == "intermediate")
+            o.intermediate = integerOption(key, value, 0, kMaxIntermediate);
+        else if (key == "reflectance_map_size")
+            o.reflectanceMapSize = integerOption(key, value, 1, kMaxMapSize);
+        else if (key == "slices_per_polygon")
+            o.slicesPerPolygon = integerOption(key, value, 1, kMaxSlicesPerPolygon);
+        else
             badOption(key, std::string("unknown option for stack2d (known: ") + kKnownOptions + ")");
-        }
-    }
+    });
     return o;
 }
 
