@@ -263,7 +263,12 @@ ClipTexture makeClipTexture(const ClipTextureSpec& spec, const fs::path& baseDir
         const fs::path path = fs::path(spec.maskFile).is_absolute() ? fs::path(spec.maskFile) : baseDir / spec.maskFile;
         if (!fs::is_regular_file(path))
             throw InputError(path.string() + ": no such file (clip texture mask)");
-        Volume mask = loadVolume(json::parse(spec.maskSpec), baseDir);  // validated: NaN is an InputError
+        Volume mask;
+        try {
+            mask = loadVolume(json::parse(spec.maskSpec), baseDir);  // validated: NaN is an InputError
+        } catch (const InputError& e) {
+            throw InputError(std::string("options.clip_texture.mask: ") + e.what());  // "volume: ..." would mislead
+        }
         t.source = mask.source;
         t.desc.width = mask.dims.x;
         t.desc.height = mask.dims.y;
@@ -356,7 +361,7 @@ std::vector<glm::dvec2> shapeClipIntervals(const ClipTextureSpec& s, const Ray& 
         const glm::dvec3 ax = glm::normalize(s.axis), w = r.origin - s.center;
         const double wa = glm::dot(w, ax), da = glm::dot(r.direction, ax);
         const glm::dvec3 wp = w - wa * ax, dp = r.direction - da * ax;
-        double ra, rb;
+        double ra = 0.0, rb = 0.0;
         const double A = glm::dot(dp, dp), C = glm::dot(wp, wp) - s.radius * s.radius;
         bool radial;
         if (A <= 1e-24 * glm::dot(r.direction, r.direction)) {  // along the axis: inside the tube or never
