@@ -407,6 +407,27 @@ TEST(ClipTexture, VoxelMasksMatchTheirReferences)
     EXPECT_TRUE(test::imagesNear(image, want, tolerance));
 }
 
+// The mask of data/scenes/engine-clip-texture-mask.json (an ASCII NRRD, given as a file name): read in
+// its own placement (9x9x5 points 32 apart), inside on the plus-shaped bars from z = 16 (the 0.5 level
+// between the rows k = 0 and 1) up, and moved by an offset as the texture coordinates say.
+TEST(ClipTexture, MaskFileFromTheEngineSceneIsReadAndPlaced)
+{
+    const ClipTextureSpec spec = parseClipTextureSpec({{"mask", "../masks/engine-plus.nrrd"}}, "clip_texture");
+    const ClipTexture texture = makeClipTexture(spec, test::repoData("scenes"));
+    EXPECT_EQ(texture.dims(), glm::ivec3(9, 9, 5));
+    EXPECT_EQ(texture.spacing, glm::dvec3(32.0));
+    const glm::dmat4 still = clipTextureCoordinates(texture, glm::dvec3(0.0), glm::dmat3(1.0));
+    EXPECT_TRUE(insideClipTexture(texture, still, {128, 128, 64}));   // where the bars cross
+    EXPECT_TRUE(insideClipTexture(texture, still, {20, 128, 100}));   // one bar, near its end
+    EXPECT_FALSE(insideClipTexture(texture, still, {20, 20, 64}));    // a corner between the bars
+    EXPECT_FALSE(insideClipTexture(texture, still, {128, 128, 15}));  // below z = 16
+    EXPECT_TRUE(insideClipTexture(texture, still, {128, 128, 17}));
+    EXPECT_FALSE(insideClipTexture(texture, still, {128, 128, 129}));  // above the mask's box
+    const glm::dmat4 moved = clipTextureCoordinates(texture, glm::dvec3(0.0, 0.0, 40.0), glm::dmat3(1.0));
+    EXPECT_FALSE(insideClipTexture(texture, moved, {128, 128, 55}));  // the bottom moved to z = 56
+    EXPECT_TRUE(insideClipTexture(texture, moved, {128, 128, 57}));
+}
+
 void expectInputError(const json& options, const std::string& fragment)
 {
     try {
