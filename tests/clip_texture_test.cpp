@@ -342,6 +342,33 @@ TEST(ClipTexture, MovingBetweenFramesEqualsAFreshRenderer)
     EXPECT_THROW(setSlice3dClipPlacement(*renderer, glm::dvec3(0.0), glm::dmat3(0.0)), InputError);  // singular
 }
 
+// The clip test sits inside the fused kernel's loops: empty-space skipping must still give the same
+// bits (a clipped sample and a stepped-over one both leave the pixel unchanged), and front to back
+// the same sum as back to front up to float rounding (tests/slice3d_test.cpp's 5e-5 / 5e-6).
+TEST(ClipTexture, SkippingAndOrderAreUnchangedByClipping)
+{
+    json inverse = kSphere;
+    inverse["inverse"] = true;
+    for (const json& clip : {kSphere, inverse}) {
+        Scene scene = makeScene(perspectiveCamera(), clip, "fused");
+        scene.transferFunction = TransferFunction({{0.0, {0, 0, 0}, 0.0}, {0.45, {0, 0, 0}, 0.0}, {0.5, {1, 0.5, 0}, 4.0},
+                                                   {1.0, {1, 1, 1}, kTauMax}});  // tau 0 below 0.45: empty bricks
+        FrameStats withSkip, without;
+        const Image4f a = render(scene, &withSkip);
+        scene.options["empty_space_skipping"] = false;
+        const Image4f b = render(scene, &without);
+        EXPECT_GT(withSkip.extra["samples_skipped"].get<std::uint64_t>(), 0u);
+        EXPECT_EQ(std::memcmp(a.pixels().data(), b.pixels().data(), a.pixels().size() * sizeof(glm::vec4)), 0);
+        scene.options["order"] = "front-to-back";
+        const Image4f c = render(scene);
+        Image4d want(a.width(), a.height());
+        for (std::size_t i = 0; i < a.pixelCount(); ++i)
+            want.pixels()[i] = glm::dvec4(a.pixels()[i]);
+        report("front-to-back vs back-to-front " + clip.dump(), test::imageError(c, want), {5e-5, 5e-6});
+        EXPECT_TRUE(test::imagesNear(c, want, {.maxAbs = 5e-5, .meanAbs = 5e-6}));
+    }
+}
+
 // A voxel mask as a raw float32 file in `dir`, on a 33^3 grid over the volume box (spacing 1/16): binary
 // (1 inside the sphere of radius r about c, else 0) or soft (0.5 - f / (4 h), clamped to [0, 1]).
 std::filesystem::path writeMask(const test::TempDir& dir, const glm::dvec3& c, double r, bool soft, double& spacing)
