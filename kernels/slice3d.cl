@@ -7,6 +7,7 @@
 //    program of the pass-by-pass path (the specification): one fragment per slice and pixel.
 // The host has validated everything; this file only does arithmetic.
 #include "clvr_common.h"
+#include "texture.h"
 #include "transfer_function.h"
 #include "volume_sampling.h"
 
@@ -41,6 +42,20 @@ float slice3d_stretch(const float2 ndc, const float4 params)
         return 1.0f;
     const float sx = ndc.x * params.x * params.y, sy = ndc.y * params.x;
     return sqrt(1.0f + sx * sx + sy * sy);
+}
+
+/* Clip texture (seeds/003, "Clipping with arbitrary clipping geometry"; host/clip_texture.h): a second,
+ * one-channel texture, negative inside (a signed distance, or 0.5 - mask value), sampled with linear
+ * filtering at the sample's clip-texture coordinates u (normalized, GL's: texel i centered at
+ * (i + 0.5) / n). Inside: u within the box of texel centers and the filtered value < 0. Returns 1 when
+ * the sample is drawn: inside, or outside when inverse is 1 (the alpha test on the mask). */
+int slice3d_clip_keep(global const float* texels, const ClTexture t, const float3 u, const int inverse)
+{
+    const float3 n = (float3)((float)t.width, (float)t.height, (float)t.depth);
+    const float3 x = u * n;
+    const int in_box = all(x >= 0.5f) && all(x <= n - 0.5f);
+    const int inside = in_box && clvr_tex3d(texels, t, (float4)(u, 0.0f)).x < 0.0f;
+    return inside != inverse;
 }
 
 #ifndef CLVR_SLICE3D_FRAGMENT
@@ -141,7 +156,12 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
                           const float4 cam_position, const float4 cam_forward, const float4 cam_right,
                           const float4 cam_up, const float4 cam_params, const float depth0,
                           const float delta_s, const int slice_count, const int front_to_back,
-                          const float ert_alpha, const float4 background)
+                          const float ert_alpha, const float4 background
+#ifdef SLICE3D_CLIP_TEXTURE
+                          , global const float* clip_texels, const ClTexture clip_tex, const float4 clip_row0,
+                          const float4 clip_row1, const float4 clip_row2, const int clip_inverse
+#endif
+                          )
 {
     CLVR_GUARD_2D(width, height);
     const int x = (int)get_global_id(0), y = (int)get_global_id(1);
@@ -153,6 +173,12 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
     const float3 go = (o - grid_origin.xyz) * inv_spacing.xyz;     /* grid coordinates */
     const float3 gd = d * inv_spacing.xyz;
     const float3 inv_gd = 1.0f / gd;  /* for empty-space runs only (inf where gd is 0, not used there) */
+#ifdef SLICE3D_CLIP_TEXTURE
+    /* Clip-texture coordinates are affine in the world position, so along the ray u = uo + z ud. */
+    const float3 uo = (float3)(dot(clip_row0.xyz, o) + clip_row0.w, dot(clip_row1.xyz, o) + clip_row1.w,
+                               dot(clip_row2.xyz, o) + clip_row2.w);
+    const float3 ud = (float3)(dot(clip_row0.xyz, d), dot(clip_row1.xyz, d), dot(clip_row2.xyz, d));
+#endif
 
     /* Depth interval of the ray inside the grid bounds (slab test), widened by one slice each way;
      * each sample is still checked, so this only limits the loop. */
@@ -199,6 +225,10 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
                 }
             }
             ++taken;
+#ifdef SLICE3D_CLIP_TEXTURE
+            if (!slice3d_clip_keep(clip_texels, clip_tex, uo + (depth0 + (float)k * delta_s) * ud, clip_inverse))
+                continue;
+#endif
             const float4 ct = clvr_tf_eval(tf, tf_count, SLICE3D_TRILINEAR(volume, dims, g));
             const float alpha = 1.0f - exp2(ct.w * neg_delta_log2e);
             c += (transmittance * alpha) * ct.xyz;
@@ -224,6 +254,10 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
                 }
             }
             ++taken;
+#ifdef SLICE3D_CLIP_TEXTURE
+            if (!slice3d_clip_keep(clip_texels, clip_tex, uo + (depth0 + (float)k * delta_s) * ud, clip_inverse))
+                continue;
+#endif
             const float4 ct = clvr_tf_eval(tf, tf_count, SLICE3D_TRILINEAR(volume, dims, g));
             const float alpha = 1.0f - exp2(ct.w * neg_delta_log2e);
             c = ct.xyz * alpha + (1.0f - alpha) * c;
@@ -251,6 +285,7 @@ kernel void slice3d_over_background(global float4* color, const int count, const
  * slice (perspective-correct). uniforms: 0..3 camera position, forward, right, up; 4 camera params
  * (see slice3d_ray); 5 (width, height, delta_s, tf_count); 6 grid origin; 7 1 / spacing;
  * 8 dims. buffer[0] volume values, buffer[1] transfer function (transfer_function.h layout).
+ * With CLVR_SLICE3D_CLIP_TEXTURE: attr[1] clip-texture coordinates, uniform 9, buffer[2] its texels.
  * Output: premultiplied (C alpha, alpha), blended by the draw state. */
 int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* color)
 {
@@ -259,6 +294,21 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
     const float3 g = (f->attr[0].xyz - u[6].xyz) * u[7].xyz;
     if (!clvr_grid_inside(g, dims))
         return 0;
+#ifdef CLVR_SLICE3D_CLIP_TEXTURE
+    /* The second texture (multitexturing): attr[1] = clip-texture coordinates of the slice point;
+     * uniform 9 = (width, height, depth, inverse) of buffer[2], one channel, linear, clamp to edge. */
+    ClTexture clip;
+    clip.width = (uint)u[9].x;
+    clip.height = (uint)u[9].y;
+    clip.depth = (uint)u[9].z;
+    clip.channels = 1u;
+    clip.filter = CLVR_FILTER_LINEAR;
+    clip.wrap = CLVR_WRAP_CLAMP_TO_EDGE;
+    clip.pad0 = clip.pad1 = 0u;
+    clip.border = (float4)(0.0f);
+    if (!slice3d_clip_keep(r->buffer[2], clip, f->attr[1].xyz, (int)u[9].w))
+        return 0;
+#endif
     const float2 ndc = slice3d_ndc(f->window, (int)u[5].x, (int)u[5].y);
     const float delta = u[5].z * slice3d_stretch(ndc, u[4]);
     const float4 ct = clvr_tf_eval(r->buffer[1], (int)u[5].w, clvr_trilinear(r->buffer[0], dims, g));

@@ -139,6 +139,16 @@ expect_error(2 ${out} "no-such-mesh.off: no such file \\(clip mesh\\)"
 file(WRITE "${WORK}/open.obj" "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\n")
 expect_error(2 ${out} "open.obj: the clip mesh is not a closed, consistently oriented surface"
   ${CLVR} render -o ${out} ${SMALL} --set "options.clip={\"mesh\": \"${WORK}/open.obj\"}")
+# slice3d clip textures (docs/slice3d.md): a bad shape, a negative radius, a missing mask; one renders.
+expect_error(2 ${out} "options.clip_texture.shape: must be \"sphere\", \"box\" or \"cylinder\", got \"torus\""
+  ${CLVR} render -o ${out} ${SMALL} --set "options.clip_texture={\"shape\": \"torus\"}")
+expect_error(2 ${out} "options.clip_texture.radius: must be a positive number, got -1"
+  ${CLVR} render -o ${out} ${SMALL} --set "options.clip_texture={\"shape\": \"sphere\", \"radius\": -1}")
+expect_error(2 ${out} "no-such-mask.nrrd: no such file \\(clip texture mask\\)"
+  ${CLVR} render -o ${out} ${SMALL} --set "options.clip_texture={\"mask\": \"${WORK}/no-such-mask.nrrd\"}")
+expect_run(0 "wrote .*clipped.png \\(64x64, slice3d," ${CLVR} render -o ${WORK}/clipped.png ${SMALL}
+  --set "options.clip_texture={\"shape\": \"box\", \"inverse\": true}")
+expect_png(${WORK}/clipped.png 64 64)
 expect_error(2 ${out} "default scene: technique: unknown technique \"no-such-technique\"" ${CLVR} render -o ${out} ${SMALL} --set technique=no-such-technique)
 file(WRITE "${WORK}/nodata.json" [=[{
   "volume": {"file": "data/not-there.nrrd"},

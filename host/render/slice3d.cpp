@@ -8,6 +8,7 @@
 #include "host/render/options_util.h"
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
+#include "raster/texture.h"
 
 #include <algorithm>
 #include <chrono>
@@ -20,7 +21,7 @@ namespace {
 
 constexpr int kMaxSlices = 65536;
 constexpr const char* kKnownOptions =
-    "slices, slice_spacing, order, early_termination, path, empty_space_skipping, voxel_type, clip";
+    "slices, slice_spacing, order, early_termination, path, empty_space_skipping, voxel_type, clip, clip_texture";
 
 class Slice3dRenderer final : public Renderer {
 public:
@@ -28,6 +29,7 @@ public:
     Image4f render(FrameStats& stats) override;
     std::uint64_t residentBytes() const override { return residentBytes_; }
     void setTransferFunction(const TransferFunction& tf) override;
+    void setClipPlacement(const glm::dvec3& offset, const glm::dmat3& matrix);
 
 private:
     Image4f renderFused(FrameStats& stats);
@@ -63,6 +65,10 @@ private:
     // Clipping (raster path): the closed mesh and its farthest eye depth.
     std::optional<ClipMesh> clipMesh_;
     double clipDepthMax_ = 0.0;
+    // Clip texture (both paths): the texture, its device copy, and world -> texture coordinates.
+    std::optional<ClipTexture> clipTexture_;
+    std::unique_ptr<raster::Texture> clipTexels_;
+    glm::dmat4 clipCoordinates_{1.0};
 };
 
 Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volume& volume)
@@ -86,6 +92,12 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
         clipDepthMax_ = -std::numeric_limits<double>::infinity();
         for (const glm::dvec3& p : clipMesh_->points)
             clipDepthMax_ = std::max(clipDepthMax_, glm::dot(camera_.forward(), p - camera_.position));
+    }
+
+    if (options_.clipTexture) {
+        clipTexture_ = makeClipTexture(*options_.clipTexture, scene.baseDir);
+        clipCoordinates_ =
+            clipTextureCoordinates(*clipTexture_, options_.clipTexture->offset, options_.clipTexture->matrix);
     }
 
     // On the fused path with voxel_type auto, uint8 or uint16 when every value is an integer in that
@@ -118,6 +130,12 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
     tf_ = device_.upload("slice3d transfer function", tf);
     residentBytes_ += tf.size() * sizeof(float);
 
+    if (clipTexture_) {
+        clipTexels_ = std::make_unique<raster::Texture>(device_, clipTexture_->desc, clipTexture_->texels);
+        residentBytes_ += clipTexels_->bytes();
+        trilinearOptions += " -DSLICE3D_CLIP_TEXTURE=1";
+    }
+
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
     if (options_.path == Slice3dOptions::Path::Fused) {
         fused_ = device_.kernel("slice3d.cl", "slice3d_fused", {}, trilinearOptions);
@@ -141,7 +159,8 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
         for (const EmbeddedKernel& k : embeddedKernels())
             if (k.name == "slice3d.cl")
                 source = k.source;
-        fragmentProgram_.source = "#define CLVR_SLICE3D_FRAGMENT 1\n" + std::string(source);
+        fragmentProgram_.source = std::string("#define CLVR_SLICE3D_FRAGMENT 1\n") +
+                                  (clipTexture_ ? "#define CLVR_SLICE3D_CLIP_TEXTURE 1\n" : "") + std::string(source);
         fragmentProgram_.buffers[0] = volume_;
         fragmentProgram_.buffers[1] = tf_;
         const glm::dvec3 invSpacing = 1.0 / spacing_;
@@ -156,7 +175,24 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
             glm::vec4(glm::vec3(invSpacing), 0.0f),
             glm::vec4(dims_.x, dims_.y, dims_.z, 0.0f),
         };
+        if (clipTexture_) {  // the second texture: buffer 2, uniform 9, coordinates in attribute 1
+            fragmentProgram_.buffers[2] = clipTexels_->buffer();
+            const glm::ivec3 n = clipTexture_->dims();
+            fragmentProgram_.uniforms.push_back(
+                glm::vec4(n.x, n.y, n.z, options_.clipTexture->inverse ? 1.0f : 0.0f));
+        }
     }
+}
+
+void Slice3dRenderer::setClipPlacement(const glm::dvec3& offset, const glm::dmat3& matrix)
+{
+    if (!clipTexture_)
+        throw InputError("slice3d: no clip texture to move (options.clip_texture is not given)");
+    if (!(std::abs(glm::determinant(matrix)) > 0.0))
+        throw InputError("slice3d: the clip texture's matrix must be invertible");
+    options_.clipTexture->offset = offset;
+    options_.clipTexture->matrix = matrix;
+    clipCoordinates_ = clipTextureCoordinates(*clipTexture_, offset, matrix);
 }
 
 cl_float4 Slice3dRenderer::cameraParams() const
@@ -180,6 +216,12 @@ Image4f Slice3dRenderer::render(FrameStats& stats)
     stats.extra["voxels"] = static_cast<std::uint64_t>(dims_.x) * dims_.y * dims_.z;
     stats.extra["resident_bytes"] = residentBytes_;
     stats.extra["voxel_type"] = voxelType_;
+    if (clipTexture_) {
+        const glm::ivec3 n = clipTexture_->dims();
+        stats.extra["clip_texture"] = clipTexture_->source;
+        stats.extra["clip_texture_dims"] = {n.x, n.y, n.z};
+        stats.extra["clip_texture_inverse"] = options_.clipTexture->inverse;
+    }
     return image;
 }
 
@@ -238,6 +280,14 @@ Image4f Slice3dRenderer::renderFused(FrameStats& stats)
     fused_.setArg(a++, static_cast<cl_int>(frontToBack ? 1 : 0));
     fused_.setArg(a++, static_cast<cl_float>(ert));
     fused_.setArg(a++, toCl4(image_.background, 0.0));
+    if (clipTexture_) {
+        fused_.setArg(a++, clipTexels_->buffer());
+        fused_.setArg(a++, clipTexels_->toCl());
+        for (int r = 0; r < 3; ++r)  // rows of the affine world -> texture coordinates map
+            fused_.setArg(a++, toCl4(glm::dvec3(clipCoordinates_[0][r], clipCoordinates_[1][r], clipCoordinates_[2][r]),
+                                     clipCoordinates_[3][r]));
+        fused_.setArg(a++, static_cast<cl_int>(options_.clipTexture->inverse ? 1 : 0));
+    }
     device_.launch("slice3d: fused", fused_, image_.width, image_.height);
 
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
@@ -280,6 +330,8 @@ Image4f Slice3dRenderer::renderRaster(FrameStats& stats)
             raster::Vertex v;
             v.position = glm::vec4(viewProjection * glm::dvec4(p, 1.0));
             v.attributes[0] = glm::vec4(glm::vec3(p), 1.0f);
+            if (clipTexture_)  // the second texture's coordinates: moving the clip texture changes only these
+                v.attributes[1] = glm::vec4(glm::vec3(clipCoordinates_ * glm::dvec4(p, 1.0)), 1.0f);
             return v;
         };
         firsts.push_back(vertices.size());
@@ -492,6 +544,8 @@ Slice3dOptions parseSlice3dOptions(const nlohmann::json& options)
             o.emptySpaceSkipping = value.get<bool>();
         } else if (key == "clip") {
             o.clip = parseClip(value);
+        } else if (key == "clip_texture") {
+            o.clipTexture = parseClipTextureSpec(value, "options.clip_texture");
         } else {
             badOption(key, std::string("unknown option for slice3d (known: ") + kKnownOptions + ")");
         }
@@ -708,6 +762,14 @@ std::vector<float> packTransferFunction(const TransferFunction& tf)
 std::unique_ptr<Renderer> makeSlice3dRenderer(Device& device, const Scene& scene, const Volume& volume)
 {
     return std::make_unique<Slice3dRenderer>(device, scene, volume);
+}
+
+void setSlice3dClipPlacement(Renderer& renderer, const glm::dvec3& offset, const glm::dmat3& matrix)
+{
+    auto* slice3d = dynamic_cast<Slice3dRenderer*>(&renderer);
+    if (!slice3d)
+        throw InputError("setSlice3dClipPlacement: the renderer is not slice3d");
+    slice3d->setClipPlacement(offset, matrix);
 }
 
 }  // namespace clvr

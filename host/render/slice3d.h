@@ -6,6 +6,7 @@
 #pragma once
 
 #include "host/clip_mesh.h"
+#include "host/clip_texture.h"
 #include "host/render/renderer.h"
 
 #include <glm/glm.hpp>
@@ -38,6 +39,8 @@ struct Slice3dOptions {
     bool emptySpaceSkipping = true;  // fused path: step over bricks where tau is 0 (bit-identical image)
     bool nativeVoxels = true;  // fused path: uint8/uint16 on the device when every value fits (same bits)
     std::optional<Slice3dClip> clip;  // needs the raster path (chosen by default when clip is given)
+    // Clipping with a second "stencil" texture (seeds/003; host/clip_texture.h): both paths.
+    std::optional<ClipTextureSpec> clipTexture;
 };
 
 // Reads the scene's "options" for slice3d. Throws InputError naming the key ("options.slices: ...")
@@ -95,5 +98,12 @@ std::vector<float> packTransferFunction(const TransferFunction& tf);
 // Renderer for "slice3d". Uploads the volume as float32 (4 bytes per grid point) and the packed
 // transfer function; throws InputError for bad options and DeviceError when the volume does not fit.
 std::unique_ptr<Renderer> makeSlice3dRenderer(Device& device, const Scene& scene, const Volume& volume);
+
+// Moves the clip texture of a slice3d renderer made with options.clip_texture for the following
+// frames, as the scene's "offset" and "matrix" would (seeds/003: "the clipping volume can be
+// interactively moved by adapting texture coordinates"): only the texture coordinates change, the
+// texture on the device stays. The next frame is bit-identical to a new renderer's with that
+// placement. InputError for another renderer, one without a clip texture, or a singular matrix.
+void setSlice3dClipPlacement(Renderer& renderer, const glm::dvec3& offset, const glm::dmat3& matrix = glm::dmat3(1.0));
 
 }  // namespace clvr
