@@ -12,7 +12,9 @@
 
 /* The length of the camera ray through pixel (px, py) inside the slab r_lo <= |x - center| <= r_hi
  * on one side of the ray's closest approach to the center (side +1: beyond it, where the sphere's
- * back faces are; -1: before it, the front faces), counting only t >= 0. cam: 0..3 position,
+ * back faces are; -1: before it, the front faces), counting only t >= 0. A ray that does not reach
+ * the next inner sphere, radius center.w (its closest distance p >= center.w), never meets that
+ * sphere, so this one takes its whole path below r_hi: the slab then starts at p (r_lo ignored). cam: 0..3 position,
  * forward, right, up; cam[4] = (scale, aspect, parallel, 0) with scale tan(view_angle / 2) or the
  * parallel scale; size = (width, height). The ray is host/camera.cpp's PixelRays::at. */
 float clvr_spherical_slab_length(const float px, const float py, const float4 cam0, const float4 cam1,
@@ -34,7 +36,7 @@ float clvr_spherical_slab_length(const float px, const float py, const float4 ca
     const float3 off = oc - tc * dir; /* center minus its closest ray point: p = |off|, no cancellation */
     const float p2 = dot(off, off);
     const float h_hi = sqrt(fmax(r_hi * r_hi - p2, 0.0f));
-    const float h_lo = sqrt(fmax(r_lo * r_lo - p2, 0.0f));
+    const float h_lo = p2 >= center.w * center.w ? 0.0f : sqrt(fmax(r_lo * r_lo - p2, 0.0f));
     const float t0 = side > 0.0f ? tc + h_lo : tc - h_hi;
     const float t1 = side > 0.0f ? tc + h_hi : tc - h_lo;
     return fmax(t1 - fmax(t0, 0.0f), 0.0f);

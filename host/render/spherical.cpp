@@ -288,7 +288,8 @@ void SphericalRenderer::renderPass(std::size_t shellIndex, bool back)
     k.setArg(a++, f4(camera_.right()));
     k.setArg(a++, f4(camera_.up()));
     k.setArg(a++, cl_float4{{static_cast<float>(scale), static_cast<float>(aspect), camera_.parallel ? 1.0f : 0.0f, 0.0f}});
-    k.setArg(a++, f4(d.center));
+    // center.w: the next inner sphere's radius (-1: none), see clvr_spherical_slab_length.
+    k.setArg(a++, f4(d.center, shellIndex > 0 ? shells_[shellIndex - 1].radius : -1.0));
     k.setArg(a++, cl_float4{{static_cast<float>(shell.rLo), static_cast<float>(shell.rHi), back ? 1.0f : -1.0f,
                              radial ? 1.0f : 0.0f}});
     device_.launch("spherical: pixel texture, classify, blend", k, static_cast<std::size_t>(imageSpec_.width),
