@@ -191,6 +191,10 @@ raster::PixelTransfer composeTextureMap(const raster::PixelTransfer& user, const
 SphericalRenderer::SphericalRenderer(Device& device, const Scene& scene, const Volume& volume)
     : device_(device), options_(parseSphericalOptions(scene.options)), imageSpec_(scene.image)
 {
+    if (!scene.lights.is_null())
+        throw InputError("lights: technique spherical renders unshaded (no \"lights\")");
+    if (!scene.iso.is_null())
+        throw InputError("iso: technique spherical renders no iso-surfaces (no \"iso\")");
     volume.validate();
     dims_ = volume.dims;
     const SphericalDomain& d = options_.domain;

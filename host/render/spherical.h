@@ -21,7 +21,7 @@
 
 namespace clvr {
 
-// The world domain of the data: the shell center <= |x - center| ... r_min <= |x - center| <= r_max.
+// The world domain of the data: the points x with r_min <= |x - center| <= r_max.
 // Grid point (i, j, k) of an (nx, ny, nz) grid sits at u = i / (nx - 1) (so φ = 2π u; i = 0 and
 // i = nx - 1 are the same meridian, and φ interpolation wraps), v = j / (ny - 1), w = k / (nz - 1);
 // the volume's origin and spacing are not used.
@@ -105,7 +105,8 @@ private:
 };
 
 // Renderer for "spherical": uploads the volume as a one-channel float 3D texture and the packed
-// transfer function; InputError for bad options.
+// transfer function; InputError for bad options, and for a scene with "lights" or "iso" (unshaded
+// direct volume rendering only).
 std::unique_ptr<Renderer> makeSphericalRenderer(Device& device, const Scene& scene, const Volume& volume);
 
 }  // namespace clvr
