@@ -419,6 +419,22 @@ TEST(SphericalRender, TwoRendersGiveIdenticalBits)
     EXPECT_EQ(stats.extra["shells"].get<int>(), 8);
 }
 
+// An edited transfer function gives the image a new renderer gives (Renderer::setTransferFunction).
+TEST(SphericalRender, SetTransferFunctionEqualsNewRenderer)
+{
+    Scene scene = makeScene(obliqueCamera(), 32, {{"shells", 8}, {"segments", 16}});
+    auto renderer = makeRenderer(test::device(), scene, atmosphere());
+    FrameStats stats;
+    const Image4f before = renderer->render(stats);
+    const TransferFunction edited({{0.0, {1, 0, 0}, 0.5}, {1.0, {0, 1, 0}, 3.0}});
+    renderer->setTransferFunction(edited);
+    const Image4f after = renderer->render(stats);
+    scene.transferFunction = edited;
+    const Image4f fresh = renderScene(scene, atmosphere());
+    EXPECT_EQ(std::memcmp(after.pixels().data(), fresh.pixels().data(), after.pixelCount() * sizeof(glm::vec4)), 0);
+    EXPECT_NE(std::memcmp(after.pixels().data(), before.pixels().data(), after.pixelCount() * sizeof(glm::vec4)), 0);
+}
+
 TEST(SphericalRender, SceneFileSelectsTheTechnique)
 {
     const std::string text = R"({
