@@ -25,7 +25,7 @@ const std::vector<VolumeTechnique>& volumeTechniques()
 {
     static const std::vector<VolumeTechnique> techniques = {
         {"slice3d", makeSlice3dRenderer}, {"stack2d", makeStack2dRenderer}, {"iso3d", makeIso3dRenderer},
-        {"planes", makePlanesRenderer},   {"blend", makeBlendRenderer},       {"spherical", makeSphericalRenderer},
+        {"planes", makePlanesRenderer},   {"blend", makeBlendRenderer},   {"spherical", makeSphericalRenderer},
     };
     return techniques;
 }

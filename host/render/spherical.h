@@ -38,8 +38,10 @@ struct SphericalOptions {
     // (φ is periodic), q.y, q.z are clamped to [0, 1] by the texture's clamp-to-edge; q.w is unused.
     raster::PixelTransfer transfer;
     // How a shell's opacity counts the shell's slab [r_lo, r_hi] (radii halfway to the neighbours):
-    // Path: the length of the pixel's ray inside the slab (exact per pixel); Radial: r_hi - r_lo
-    // for every pixel (the paper's plain blending; too transparent wherever rays are oblique).
+    // Path: the length of the pixel's ray inside the slab on the drawn hemisphere's side (exact per
+    // pixel; a ray that misses the next inner sphere gives this shell its path down to its closest
+    // approach, so no path is lost at silhouettes); Radial: r_hi - r_lo for every pixel (the paper's
+    // plain blending; too transparent wherever rays are oblique).
     enum class Opacity { Path, Radial } opacity = Opacity::Path;
 };
 
