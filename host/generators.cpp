@@ -56,6 +56,16 @@ double blobsField(const glm::dvec3& p)
     return std::min(sum, 1.0);
 }
 
+double atmosphereField(const glm::dvec3& p)
+{
+    // p in [-1,1]^3 read as normalized spherical coordinates (u, v, w) = (p + 1) / 2 (the
+    // spherical technique's grid axes, host/render/spherical.h): phi = 2 pi u, theta = pi v.
+    const double phi = kPi * (p.x + 1.0), theta = 0.5 * kPi * (p.y + 1.0), w = 0.5 * (p.z + 1.0);
+    const double layer = std::exp(-std::pow((w - 0.55) / 0.22, 2.0));
+    const double bands = 0.5 + 0.5 * std::cos(6.0 * theta + 1.2 * std::sin(theta) * std::cos(3.0 * phi));
+    return std::clamp(layer * bands, 0.0, 1.0);
+}
+
 Volume generateVolume(const std::string& name, glm::ivec3 dims)
 {
     double (*field)(const glm::dvec3&) = nullptr;
@@ -65,8 +75,10 @@ Volume generateVolume(const std::string& name, glm::ivec3 dims)
         field = sphereField;
     else if (name == "blobs")
         field = blobsField;
+    else if (name == "atmosphere")
+        field = atmosphereField;
     else
-        throw InputError("generator \"" + name + "\": unknown (marschner-lobb, sphere and blobs exist)");
+        throw InputError("generator \"" + name + "\": unknown (marschner-lobb, sphere, blobs and atmosphere exist)");
 
     const std::string source = "generator " + name;
     std::uint64_t count = 1;

@@ -11,7 +11,7 @@
 
 namespace clvr {
 
-// "marschner-lobb", "sphere" or "blobs" sampled on a dims grid over [-1,1]^3.
+// "marschner-lobb", "sphere", "blobs" or "atmosphere" sampled on a dims grid over [-1,1]^3.
 // Throws InputError for an unknown name, a dimension < 2, or more than 2^34 grid points.
 Volume generateVolume(const std::string& name, glm::ivec3 dims);
 
@@ -28,5 +28,12 @@ double sphereField(const glm::dvec3& p);
 // "blobs": min(1, sum over four fixed Gaussians a_k exp(-|p - c_k|^2 / (2 sigma_k^2))), amplitudes a_k
 // 1, 0.75, 0.5 and 0.25; values in [0,1]. Centers and widths are in generators.cpp and docs/data-formats.md.
 double blobsField(const glm::dvec3& p);
+
+// "atmosphere": a field meant as (phi, theta, r) data for the spherical technique (host/render/spherical.h):
+// with (u, v, w) = (p + 1) / 2, phi = 2 pi u, theta = pi v, a cloud layer around w = 0.55 (Gaussian, width
+// 0.22) times latitude bands that meander with longitude:
+//   exp(-((w - 0.55) / 0.22)^2) * (1 + cos(6 theta + 1.2 sin(theta) cos(3 phi))) / 2, in [0,1].
+// Periodic in phi (u = 0 and u = 1 agree) and independent of phi at the poles (sin(theta) = 0).
+double atmosphereField(const glm::dvec3& p);
 
 }  // namespace clvr

@@ -40,7 +40,7 @@ struct RawLayout {
 //   {"file": "x.nrrd"} or "x.nhdr" (NRRD), {"file": "x.vtk"} (VTK legacy STRUCTURED_POINTS),
 //   {"file": "x.raw", "dims": [nx,ny,nz], "type": "uint8|int8|int16|uint16|int32|uint32|float32|float64",
 //    "endian": "little|big", "spacing": [..] (opt), "origin": [..] (opt), "header_bytes": N (opt)},
-//   {"generator": "marschner-lobb"|"sphere"|"blobs", "dims": [nx,ny,nz]} (host/generators.h).
+//   {"generator": "marschner-lobb"|"sphere"|"blobs"|"atmosphere", "dims": [nx,ny,nz]} (host/generators.h).
 // A file with "dims" is read as raw whatever its extension. Relative paths are relative to baseDir.
 // Unknown keys and wrongly typed values throw InputError naming the key.
 Volume loadVolume(const nlohmann::json& spec, const std::filesystem::path& baseDir);

@@ -7,6 +7,7 @@
 #include "host/render/iso3d.h"
 #include "host/render/planes.h"
 #include "host/render/slice3d.h"
+#include "host/render/spherical.h"
 #include "host/render/stack2d.h"
 
 #include <functional>
@@ -24,7 +25,7 @@ const std::vector<VolumeTechnique>& volumeTechniques()
 {
     static const std::vector<VolumeTechnique> techniques = {
         {"slice3d", makeSlice3dRenderer}, {"stack2d", makeStack2dRenderer}, {"iso3d", makeIso3dRenderer},
-        {"planes", makePlanesRenderer},   {"blend", makeBlendRenderer},
+        {"planes", makePlanesRenderer},   {"blend", makeBlendRenderer},   {"spherical", makeSphericalRenderer},
     };
     return techniques;
 }
