@@ -297,7 +297,8 @@ TEST(BenchRts, ScenesAreValidAndDifferOnlyWhereTheyShould)
 // ---- the other regular-grid bench scenes (tools/make_regular_bench.py, `clvr bench --suite regular`) -----
 
 // The suite lists exactly the reg-* files there are; every scene loads, is 512x512 and names the technique
-// its file name says; each clip scene is its raster-path baseline plus the clip mesh and nothing else,
+// its file name says; each clip scene is its raster-path baseline plus the clip mesh and nothing else
+// (each clip-texture scene its fused baseline plus the clip texture),
 // each k1 stack is its plain stack with one intermediate slice, and each p4 stack its k1 stack with four
 // slices per polygon.
 TEST(BenchRegular, ScenesAreValidAndPairsDifferOnlyWhereTheyShould)
@@ -309,15 +310,18 @@ TEST(BenchRegular, ScenesAreValidAndPairsDifferOnlyWhereTheyShould)
         present.push_back(file.filename().string());
     std::sort(listed.begin(), listed.end());
     EXPECT_EQ(listed, present);
-    ASSERT_EQ(files.size(), 19u);  // 3 volumes x (iso3d, 3 stacks, raster baseline, clip) + the gradientless engine
+    // 3 volumes x (iso3d, 3 stacks, raster baseline, clip mesh, fused baseline, clip texture)
+    // + the gradientless engine + spherical
+    ASSERT_EQ(files.size(), 26u);
     for (const auto& file : files) {
         const clvr::Scene scene = clvr::loadScene(file);
         const std::string name = file.filename().string();
         EXPECT_EQ(scene.image.width, 512) << name;
         EXPECT_EQ(scene.image.height, 512) << name;
-        const std::string expected = name.starts_with("reg-iso3d")     ? "iso3d"
-                                     : name.starts_with("reg-stack2d") ? "stack2d"
-                                                                       : "slice3d";
+        const std::string expected = name.starts_with("reg-iso3d")       ? "iso3d"
+                                     : name.starts_with("reg-stack2d")   ? "stack2d"
+                                     : name.starts_with("reg-spherical") ? "spherical"
+                                                                         : "slice3d";
         EXPECT_EQ(scene.technique, expected) << name;
         auto differsOnlyIn = [&](const std::string& baseName, const std::string& path) {
             const clvr::Scene base = clvr::loadScene(file.parent_path() / baseName);
@@ -328,6 +332,8 @@ TEST(BenchRegular, ScenesAreValidAndPairsDifferOnlyWhereTheyShould)
         };
         if (name.starts_with("reg-clip-"))
             differsOnlyIn("reg-slice3d-raster-" + name.substr(9), "/clip");
+        if (name.starts_with("reg-cliptex-"))
+            differsOnlyIn("reg-slice3d-" + name.substr(12), "/clip_texture");
         if (name.ends_with("-k1.json"))
             differsOnlyIn(name.substr(0, name.size() - 8) + ".json", "/intermediate");
         if (name.ends_with("-p4.json"))

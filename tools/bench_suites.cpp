@@ -35,7 +35,10 @@ std::vector<std::string> benchSuiteScenes(const std::string& suite)
             regular.push_back(std::string("reg-stack2d-") + volume + suffix + ".json");
         regular.push_back(std::string("reg-slice3d-raster-") + volume + ".json");
         regular.push_back(std::string("reg-clip-") + volume + ".json");
+        regular.push_back(std::string("reg-slice3d-") + volume + ".json");
+        regular.push_back(std::string("reg-cliptex-") + volume + ".json");
     }
+    regular.push_back("reg-spherical-atmosphere.json");
     if (suite == "slice3d")
         return slice3d;
     if (suite == "harc")

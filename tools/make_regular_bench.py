@@ -16,7 +16,11 @@ Per volume:
   reg-stack2d-V-k1-p4    the same with four slices per polygon (seeds/003's multi-texture speed-up)
   reg-slice3d-raster-V   slice3d through the raster stage, 256 slices: the baseline of the clip rows
   reg-clip-V             the same with a sphere clip mesh, two-pass stencil (seeds/000 §2.1)
-and on the engine also reg-iso3d-engine-gradientless (the pixel-texture shading of §3).
+  reg-slice3d-V          slice3d's default fused path, 256 slices: the baseline of the next row
+  reg-cliptex-V          the same clipped by a clip texture of the same sphere (seeds/003's stencil texture)
+and on the engine also reg-iso3d-engine-gradientless (the pixel-texture shading of §3); and
+reg-spherical-atmosphere, the spherical technique on the generated atmosphere (seeds/000 §2.2; a
+spherical domain has no counterpart among the three volumes).
 """
 import os
 import sys
@@ -79,7 +83,26 @@ def scenes():
                     translucent_scene(volume, "slice3d", {"slices": 256, "path": "raster"})))
         out.append(("reg-clip-%s.json" % volume,
                     translucent_scene(volume, "slice3d", {"slices": 256, "path": "raster", "clip": clip})))
+        out.append(("reg-slice3d-%s.json" % volume, translucent_scene(volume, "slice3d", {"slices": 256})))
+        clip_texture = {"shape": "sphere", "center": center, "radius": radius, "inverse": True}
+        out.append(("reg-cliptex-%s.json" % volume,
+                    translucent_scene(volume, "slice3d", {"slices": 256, "clip_texture": clip_texture})))
+    out.append(("reg-spherical-atmosphere.json", spherical_scene()))
     return out
+
+
+def spherical_scene():
+    """data/scenes/atmosphere.json's scene."""
+    return {
+        "technique": "spherical",
+        "volume": {"generator": "atmosphere", "dims": [129, 65, 48]},
+        "camera": {"position": [2.9, -1.6, 1.5], "focal_point": [0, 0, 0], "view_up": [0, 0, 1], "view_angle": 36},
+        "image": {"width": 512, "height": 512, "background": [0, 0, 0]},
+        "transfer_function": {"points": [[0.00, 0.00, 0.00, 0.00, 0.0], [0.20, 0.05, 0.15, 0.45, 0.0],
+                                         [0.45, 0.20, 0.50, 0.95, 1.5], [0.70, 0.85, 0.90, 1.00, 6.0],
+                                         [1.00, 1.00, 0.95, 0.80, 14.0]]},
+        "options": {"shells": 96, "segments": 128, "r_min": 0.5, "r_max": 1.0},
+    }
 
 
 def main():
