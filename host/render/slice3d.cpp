@@ -5,6 +5,7 @@
 
 #include "host/embedded_kernels.h"
 #include "host/errors.h"
+#include "host/render/camera_args.h"
 #include "host/render/options_util.h"
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
@@ -36,7 +37,6 @@ private:
     Image4f renderRaster(FrameStats& stats);
     raster::DrawStats drawClipped(const std::vector<raster::Vertex>& slices, const std::vector<std::size_t>& firsts,
                                   const raster::DrawState& sliceState, const glm::dmat4& viewProjection);
-    cl_float4 cameraParams() const;
 
     Device& device_;
     Slice3dOptions options_;
@@ -164,12 +164,9 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
         fragmentProgram_.buffers[0] = volume_;
         fragmentProgram_.buffers[1] = tf_;
         const glm::dvec3 invSpacing = 1.0 / spacing_;
+        const std::array<glm::vec4, 5> cameraUniforms = cameraVectors(camera_, image_.width, image_.height);
         fragmentProgram_.uniforms = {
-            glm::vec4(glm::vec3(camera_.position), 0.0f),
-            glm::vec4(glm::vec3(camera_.forward()), 0.0f),
-            glm::vec4(glm::vec3(camera_.right()), 0.0f),
-            glm::vec4(glm::vec3(camera_.up()), 0.0f),
-            glm::vec4(cameraParams().s[0], cameraParams().s[1], cameraParams().s[2], 0.0f),
+            cameraUniforms[0], cameraUniforms[1], cameraUniforms[2], cameraUniforms[3], cameraUniforms[4],
             glm::vec4(image_.width, image_.height, static_cast<float>(plan_.deltaS), tfCount_),
             glm::vec4(glm::vec3(origin_), 0.0f),
             glm::vec4(glm::vec3(invSpacing), 0.0f),
@@ -193,13 +190,6 @@ void Slice3dRenderer::setClipPlacement(const glm::dvec3& offset, const glm::dmat
     options_.clipTexture->offset = offset;
     options_.clipTexture->matrix = matrix;
     clipCoordinates_ = clipTextureCoordinates(*clipTexture_, offset, matrix);
-}
-
-cl_float4 Slice3dRenderer::cameraParams() const
-{
-    const double aspect = static_cast<double>(image_.width) / image_.height;
-    const double scale = camera_.parallel ? camera_.parallelScale : std::tan(glm::radians(camera_.viewAngle) * 0.5);
-    return {{static_cast<float>(scale), static_cast<float>(aspect), camera_.parallel ? 1.0f : 0.0f, 0.0f}};
 }
 
 Image4f Slice3dRenderer::render(FrameStats& stats)
@@ -269,11 +259,7 @@ Image4f Slice3dRenderer::renderFused(FrameStats& stats)
     // Off when asked, or when no brick is empty (then the loop is the plain one).
     const bool skip = options_.emptySpaceSkipping && emptyBrickCount_ > 0;
     fused_.setArg(a++, static_cast<cl_int>(skip ? 1 : 0));
-    fused_.setArg(a++, toCl4(camera_.position));
-    fused_.setArg(a++, toCl4(camera_.forward()));
-    fused_.setArg(a++, toCl4(camera_.right()));
-    fused_.setArg(a++, toCl4(camera_.up()));
-    fused_.setArg(a++, cameraParams());
+    a = setCameraArgs(fused_, a, camera_, image_.width, image_.height);
     fused_.setArg(a++, static_cast<cl_float>(plan_.depth(0)));
     fused_.setArg(a++, static_cast<cl_float>(plan_.deltaS));
     fused_.setArg(a++, static_cast<cl_int>(plan_.count));
@@ -494,11 +480,7 @@ Slice3dClip parseClip(const nlohmann::json& value)
 Slice3dOptions parseSlice3dOptions(const nlohmann::json& options)
 {
     Slice3dOptions o;
-    if (options.is_null())
-        return o;
-    if (!options.is_object())
-        throw InputError("options: must be an object");
-    for (const auto& [key, value] : options.items()) {
+    forEachOption(options, [&](const std::string& key, const nlohmann::json& value) {
         if (key == "slices") {
             if (!value.is_number_integer())
                 badOption(key, "must be an integer, got " + value.dump());
@@ -507,9 +489,7 @@ Slice3dOptions parseSlice3dOptions(const nlohmann::json& options)
                 badOption(key, "must be in [1, " + std::to_string(kMaxSlices) + "], got " + std::to_string(n));
             o.slices = static_cast<int>(n);
         } else if (key == "slice_spacing") {
-            if (!value.is_number() || !(value.get<double>() > 0.0) || !std::isfinite(value.get<double>()))
-                badOption(key, "must be a positive number (world units), got " + value.dump());
-            o.sliceSpacing = value.get<double>();
+            o.sliceSpacing = numberOption(key, value, [](double x) { return x > 0.0; }, "a positive number (world units)");
         } else if (key == "order") {
             const std::string s = value.is_string() ? value.get<std::string>() : "";
             if (s == "back-to-front")
@@ -519,9 +499,8 @@ Slice3dOptions parseSlice3dOptions(const nlohmann::json& options)
             else
                 badOption(key, "must be \"back-to-front\" or \"front-to-back\", got " + value.dump());
         } else if (key == "early_termination") {
-            if (!value.is_number() || !(value.get<double>() > 0.0 && value.get<double>() <= 1.0))
-                badOption(key, "must be an opacity in (0, 1] (1 = off), got " + value.dump());
-            o.earlyTermination = value.get<double>();
+            o.earlyTermination =
+                numberOption(key, value, [](double x) { return x > 0.0 && x <= 1.0; }, "an opacity in (0, 1] (1 = off)");
         } else if (key == "path") {
             const std::string s = value.is_string() ? value.get<std::string>() : "";
             if (s == "fused")
@@ -549,7 +528,7 @@ Slice3dOptions parseSlice3dOptions(const nlohmann::json& options)
         } else {
             badOption(key, std::string("unknown option for slice3d (known: ") + kKnownOptions + ")");
         }
-    }
+    });
     if (o.clip) {
         // The stencil passes run per slice, between the slice polygons: only the raster path has them.
         if (options.contains("path") && o.path == Slice3dOptions::Path::Fused)
