@@ -145,7 +145,15 @@ DrawStats draw(Device& device, Framebuffer& fb, const DrawState& state, Topology
         throw InputError("draw: " + std::to_string(program.uniforms.size()) + " fragment program uniforms, at most " +
                          std::to_string(kMaxUniforms));
     const ResolvedViewport vp = resolveViewport(state.viewport, fb.width(), fb.height());
-    const Rect rect = vp.scissor;
+    Rect rect = vp.scissor;
+    if (state.scissor.test) {
+        const Scissor& sc = state.scissor;
+        if (sc.width < 0 || sc.height < 0)
+            throw InputError("draw: scissor of size " + std::to_string(sc.width) + "x" + std::to_string(sc.height));
+        const int x0 = std::max(rect.x, sc.x), y0 = std::max(rect.y, sc.y);
+        const int x1 = std::min(rect.x + rect.width, sc.x + sc.width), y1 = std::min(rect.y + rect.height, sc.y + sc.height);
+        rect = {x0, y0, std::max(0, x1 - x0), std::max(0, y1 - y0)};
+    }
     const std::vector<glm::dvec4> planes = clipPlanes(state, vp);
     const FragmentState& fs = state.fragment;
 
