@@ -1,6 +1,7 @@
 // tests/raster_test.cpp — the ordered triangle rasterizer (raster/rasterizer.h) against the CPU
 // reference (raster/reference/rasterizer.h) and against closed-form geometry: coverage and stencil
 // exact, color and depth within stated float tolerances, fill rule, clipping, perspective, order.
+#include "host/errors.h"
 #include "raster/rasterizer.h"
 #include "raster/reference/rasterizer.h"
 #include "raster/texture.h"
