@@ -234,6 +234,10 @@ Image4f Iso3dRendererImpl::render(FrameStats& stats)
     framebuffer_->clearColor(device_, glm::vec4(0.0f));
     framebuffer_->clearDepth(device_, 1.0f);
     raster::DrawStats drawStats;
+    // Uploads per frame: none unbricked (the volume stays resident between frames); drawBricks counts its own.
+    stats.extra["brick_uploads"] = 0;
+    stats.extra["brick_upload_bytes"] = 0;
+    stats.extra["brick_upload_ms"] = 0.0;
     if (vertices.empty()) {
         // the box is behind the camera: nothing to draw
     } else if (bricks_.count() > 1) {
@@ -344,10 +348,6 @@ Image4f Iso3dRendererImpl::render(FrameStats& stats)
     stats.extra["bricks"] = bricks_.count();
     stats.extra["brick_grid"] = {bricks_.counts.x, bricks_.counts.y, bricks_.counts.z};
     stats.extra["brick_bytes"] = bricks_.maxBytes();
-    if (bricks_.count() == 1) {
-        stats.extra["brick_uploads"] = 0;  // the volume stays resident between frames
-        stats.extra["brick_upload_bytes"] = 0;
-    }
     return image;
 }
 
