@@ -50,9 +50,10 @@ float4 iso3d_trilinear4(global const float* v, const int4 dims, const float3 g)
 }
 
 /* attr[0] = world position on the slice (perspective-correct). uniforms: 0 grid origin, 1 1 / spacing,
- * 2 dims, 3 (value_lo, 1 / (value_hi - value_lo), positions, flip): the value range mapped onto alpha's [0,1],
+ * 2 dims, 4 the brick's first grid point, 5 its box's exclusive upper end (grid units), 6 its dims,
+ * 3 (value_lo, 1 / (value_hi - value_lo), positions, flip): the value range mapped onto alpha's [0,1],
  * positions != 0 for gradientless shading, and flip != 0 for Figure 7's interior pass (the normal turned
- * round: encoded 1 - rgb). buffer[0]: RGBA volume, per grid point (0.5 N + 0.5, value)
+ * round: encoded 1 - rgb). buffer[0]: RGBA volume (or the brick's part of it), per grid point (0.5 N + 0.5, value)
  * with N the unit normal (iso3d.h). Output: (0.5 N + 0.5 interpolated, normalized value), or with
  * positions the point's 3D texture coordinates (g + 0.5) / n in RGB (the paper: "the computed texture
  * coordinate (u, v, w) is assigned as RGB color value"); discarded outside the grid (empty there). */
@@ -63,7 +64,14 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
     const float3 g = (f->attr[0].xyz - u[0].xyz) * u[1].xyz;
     if (!clvr_grid_inside(g, dims))
         return 0;
-    const float4 t = iso3d_trilinear4(r->buffer[0], dims, g);
+    /* Bricking (§3.1): the fragment belongs to the brick whose half-open box [lo, hi) holds g (hi = n for
+     * the last slab of an axis, so its far face is kept), which cuts every slice exactly between bricks.
+     * The brick's texture is sampled at g - lo: exact in float (0 <= lo <= g, lo an integer), so the
+     * cell and its weights are the unbricked ones, bit for bit. Unbricked: lo = 0, hi = n. */
+    const float3 lo = u[4].xyz;
+    if (g.x < lo.x || g.y < lo.y || g.z < lo.z || g.x >= u[5].x || g.y >= u[5].y || g.z >= u[5].z)
+        return 0;
+    const float4 t = iso3d_trilinear4(r->buffer[0], convert_int4(u[6]), g - lo);
     const float3 n = u[3].w != 0.0f ? 1.0f - t.xyz : t.xyz;
     const float3 rgb = u[3].z != 0.0f ? (g + 0.5f) / convert_float3(dims.xyz) : n;
     *color = (float4)(rgb, (t.w - u[3].x) * u[3].y);

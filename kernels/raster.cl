@@ -223,9 +223,10 @@ __attribute__((always_inline)) void clvr_shade(global const ClTriangle* t, long 
  * parallelism and share each triangle's loads. Tiles of CLVR_TILE_SIZE pixels start at the
  * rectangle's corner, so a work-item's pixels share a tile; tile t lists triangle indices
  * tile_tris[tile_start[t] .. tile_start[t+1]) in submission order. fragment_counts[row] receives
- * the covered-pixel count of that rectangle row. */
+ * the covered-pixel count of that rectangle row. Pixels outside scissor (x0, y0, x1, y1: GL's scissor
+ * rectangle, ends exclusive; the viewport rectangle when the test is off) are skipped. */
 kernel void raster_fragments(global float4* color, global float* depth, global uchar* stencil, const int fb_width,
-                             const int rect_x, const int rect_y, const int rect_w, const int rect_h,
+                             const int rect_x, const int rect_y, const int rect_w, const int rect_h, const int4 scissor,
                              const int tiles_x, global const ClTriangle* tris, global const uint* tile_start,
                              global const uint* tile_tris, const ClFragmentState fs, const ClBlendState bs,
                              constant float4* uniforms, global const float* buffer0, global const float* buffer1,
@@ -243,6 +244,8 @@ kernel void raster_fragments(global float4* color, global float* depth, global u
 
     const int px0 = rect_x + gx0;
     const int py = rect_y + gy;
+    if (py < scissor.y || py >= scissor.w)
+        return;
     const int count = min(CLVR_PIXELS_PER_ITEM, rect_w - gx0);
     const size_t pixel0 = (size_t)py * (size_t)fb_width + (size_t)px0;
     const int sx0 = px0 * CLVR_SUBPIXEL_SCALE + CLVR_SUBPIXEL_SCALE / 2;  /* first pixel center */
@@ -283,7 +286,8 @@ kernel void raster_fragments(global float4* color, global float* depth, global u
 #pragma unroll
         for (int p = 0; p < CLVR_PIXELS_PER_ITEM; ++p) {
             /* Top-left rule: a pixel center on an edge belongs to the triangle only for a top or left edge. */
-            if (p < count && e0 + t->bias[0] >= 0 && e1 + t->bias[1] >= 0 && e2 + t->bias[2] >= 0) {
+            if (p < count && px0 + p >= scissor.x && px0 + p < scissor.z && e0 + t->bias[0] >= 0 &&
+                e1 + t->bias[1] >= 0 && e2 + t->bias[2] >= 0) {
                 ++covered;
                 clvr_shade(t, e0, e1, e2, px0 + p, py, &fs, &bs, &blend, write_mask, &resources, &c[p], &d[p], &s[p]);
             }

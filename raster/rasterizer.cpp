@@ -146,6 +146,18 @@ DrawStats draw(Device& device, Framebuffer& fb, const DrawState& state, Topology
                          std::to_string(kMaxUniforms));
     const ResolvedViewport vp = resolveViewport(state.viewport, fb.width(), fb.height());
     const Rect rect = vp.scissor;
+    // GL's scissor test: the launch and the tiles stay those of the viewport rectangle (one launch shape for
+    // every scissor, so PoCL builds no new work-group variant per rectangle); triangles are binned only
+    // within `clip`, and the kernel skips pixels outside it.
+    Rect clip = rect;
+    if (state.scissor.test) {
+        const Scissor& sc = state.scissor;
+        if (sc.width < 0 || sc.height < 0)
+            throw InputError("draw: scissor of size " + std::to_string(sc.width) + "x" + std::to_string(sc.height));
+        const int x0 = std::max(rect.x, sc.x), y0 = std::max(rect.y, sc.y);
+        const int x1 = std::min(rect.x + rect.width, sc.x + sc.width), y1 = std::min(rect.y + rect.height, sc.y + sc.height);
+        clip = {x0, y0, std::max(0, x1 - x0), std::max(0, y1 - y0)};
+    }
     const std::vector<glm::dvec4> planes = clipPlanes(state, vp);
     const FragmentState& fs = state.fragment;
 
@@ -245,10 +257,10 @@ DrawStats draw(Device& device, Framebuffer& fb, const DrawState& state, Topology
             std::int64_t minX = std::min({v[0]->x, v[1]->x, v[2]->x}), maxX = std::max({v[0]->x, v[1]->x, v[2]->x});
             std::int64_t minY = std::min({v[0]->y, v[1]->y, v[2]->y}), maxY = std::max({v[0]->y, v[1]->y, v[2]->y});
             const double half = CLVR_SUBPIXEL_SCALE / 2;
-            const int px0 = std::max<int>(rect.x, int(std::ceil((double(minX) - half) / CLVR_SUBPIXEL_SCALE)));
-            const int px1 = std::min<int>(rect.x + rect.width - 1, int(std::floor((double(maxX) - half) / CLVR_SUBPIXEL_SCALE)));
-            const int py0 = std::max<int>(rect.y, int(std::ceil((double(minY) - half) / CLVR_SUBPIXEL_SCALE)));
-            const int py1 = std::min<int>(rect.y + rect.height - 1, int(std::floor((double(maxY) - half) / CLVR_SUBPIXEL_SCALE)));
+            const int px0 = std::max<int>(clip.x, int(std::ceil((double(minX) - half) / CLVR_SUBPIXEL_SCALE)));
+            const int px1 = std::min<int>(clip.x + clip.width - 1, int(std::floor((double(maxX) - half) / CLVR_SUBPIXEL_SCALE)));
+            const int py0 = std::max<int>(clip.y, int(std::ceil((double(minY) - half) / CLVR_SUBPIXEL_SCALE)));
+            const int py1 = std::min<int>(clip.y + clip.height - 1, int(std::floor((double(maxY) - half) / CLVR_SUBPIXEL_SCALE)));
             if (px0 > px1 || py0 > py1)
                 continue;
             binned.push_back({t, (px0 - rect.x) / CLVR_TILE_SIZE, (py0 - rect.y) / CLVR_TILE_SIZE,
@@ -332,6 +344,7 @@ DrawStats draw(Device& device, Framebuffer& fb, const DrawState& state, Topology
     k.setArg(arg++, static_cast<cl_int>(rect.y));
     k.setArg(arg++, static_cast<cl_int>(rect.width));
     k.setArg(arg++, static_cast<cl_int>(rect.height));
+    k.setArg(arg++, cl_int4{{clip.x, clip.y, clip.x + clip.width, clip.y + clip.height}});
     k.setArg(arg++, static_cast<cl_int>(tilesX));
     k.setArg(arg++, triangleBuffer);
     k.setArg(arg++, tileStartBuffer);

@@ -46,10 +46,16 @@ struct FragmentProgram {
     std::vector<glm::vec4> uniforms;    // r->uniforms[i], up to kMaxUniforms
 };
 
+// GL's scissor test (glScissor): with `test`, only pixels inside the rectangle (x, y its top-left pixel,
+// row 0 at the top) are visited. Coverage, depth and attributes of the pixels inside are unchanged:
+// edge functions and interpolation use absolute pixel positions.
+struct Scissor { bool test = false; int x = 0, y = 0, width = 0, height = 0; };
+
 struct DrawState {
     FragmentState fragment;
     std::vector<glm::vec4> clipPlanes;  // CLIP coordinates: keep dot(plane, clipPos) >= 0; up to 6
     Viewport viewport;
+    Scissor scissor;
 };
 
 // A world-space plane (keep dot(plane, (p,1)) >= 0) in clip coordinates: inverse-transpose of viewProjection.

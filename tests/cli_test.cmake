@@ -188,6 +188,21 @@ expect_error(3 ${out} "no OpenCL device"
 # scene's 128^3 float volume (8 MiB): the upload is refused with one line naming what did not fit.
 expect_error(3 ${out} "out of device memory: .*volume.*needs 8 MiB"
   ${CMAKE_COMMAND} -E env CLVR_DEVICE_MEMORY_LIMIT=1M ${CLVR} render -o ${out} ${SMALL})
+# Bricking (iso3d, §3.1 of seeds/000, docs/iso3d.md): on the same 1 MiB device the 64^3 volume's RGBA texture
+# (4 MiB) does not fit whole, but cut into bricks of at most 512 KiB it renders; a budget below the smallest
+# brick is bad input.
+set(ISO --set technique=iso3d --set "iso={\"value\":0.5}" --set "volume.dims=[64,64,64]")
+expect_error(3 ${out} "out of device memory: .*iso3d RGBA volume.*needs 4 MiB"
+  ${CMAKE_COMMAND} -E env CLVR_DEVICE_MEMORY_LIMIT=1M ${CLVR} render -o ${out} ${SMALL} ${ISO} --set options.slices=64)
+expect_run(0 "wrote" ${CMAKE_COMMAND} -E env CLVR_DEVICE_MEMORY_LIMIT=1M ${CLVR} render -o ${out} ${SMALL} ${ISO}
+  --set options.slices=64 --set options.brick_budget=524288 --stats ${WORK}/bricked-stats.json)
+expect_png(${out} 64 64)
+file(READ ${WORK}/bricked-stats.json bricked_stats)
+if(NOT bricked_stats MATCHES "\"bricks\": *(1[0-9]|[2-9][0-9])[^0-9]")
+  message(FATAL_ERROR "bricked render: want 10..99 bricks in --stats, got ${bricked_stats}")
+endif()
+expect_error(2 ${out} "default scene: options.brick_budget: 100 bytes is less than the smallest brick"
+  ${CLVR} render -o ${out} ${SMALL} ${ISO} --set options.brick_budget=100)
 # A malformed limit is bad input.
 expect_error(2 ${out} "CLVR_DEVICE_MEMORY_LIMIT"
   ${CMAKE_COMMAND} -E env CLVR_DEVICE_MEMORY_LIMIT=lots ${CLVR} render -o ${out} ${SMALL})

@@ -459,5 +459,214 @@ TEST(Iso3d, BackgroundWhereNoHitAndIdenticalBits)
         ASSERT_EQ(p.w, 0.0f);
 }
 
+
+// ---- Bricking (§3.1) ----
+
+TEST(Iso3dBricking, GridSharesFacePointsAndFitsTheBudget)
+{
+    const glm::ivec3 dims(33, 33, 33);
+    // 17^3 grid points x 16 bytes: exactly 2x2x2 bricks of 16 cells (+ the shared face).
+    const MemoryBricks g = planBricks(dims, 16, 17ull * 17 * 17 * 16);
+    EXPECT_EQ(g.counts, glm::ivec3(2, 2, 2));
+    EXPECT_EQ(g.maxBytes(), 17ull * 17 * 17 * 16);
+    EXPECT_EQ(g.lo({1, 0, 0}).x, 16);
+    EXPECT_EQ(g.hi({0, 0, 0}).x, 16) << "neighbours share the face's grid points";
+    EXPECT_EQ(g.hi({1, 1, 1}), glm::ivec3(32));
+    // One byte less: more bricks, each fitting.
+    const MemoryBricks h = planBricks(dims, 16, 17ull * 17 * 17 * 16 - 1);
+    EXPECT_GT(h.count(), 8);
+    EXPECT_LE(h.maxBytes(), 17ull * 17 * 17 * 16 - 1);
+    // The whole volume fits: one brick.
+    EXPECT_EQ(planBricks(dims, 16, 33ull * 33 * 33 * 16).count(), 1);
+    // The smallest brick: 2x2x2 points; everything split into single cells.
+    const MemoryBricks tiny = planBricks({5, 4, 3}, 16, 128);
+    EXPECT_EQ(tiny.counts, glm::ivec3(4, 3, 2));
+    EXPECT_EQ(tiny.maxBytes(), 128u);
+    // 3x2x5 on 41^3: slabs of 13 or 14 cells along x, every cell in exactly one slab.
+    const MemoryBricks f = splitBricks({41, 41, 41}, {3, 2, 5}, 16);
+    EXPECT_EQ(f.starts[0], (std::vector<int>{0, 13, 26, 40}));
+    EXPECT_EQ(f.starts[2], (std::vector<int>{0, 8, 16, 24, 32, 40}));
+    EXPECT_EQ(f.maxBytes(), 15ull * 21 * 9 * 16);
+}
+
+TEST(Iso3dBricking, BadBudgetsAndCombinationsNameTheOption)
+{
+    auto message = [](const json& options, const std::string& shading = "gradient") {
+        Scene s = makeScene(perspectiveCamera(), 0.5, options);
+        s.iso["shading"] = shading;
+        try {
+            makeIso3dRenderer(test::device(), s, sphere33());
+        } catch (const InputError& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    EXPECT_EQ(message({{"brick_budget", 100}}),
+              "options.brick_budget: 100 bytes is less than the smallest brick, 2x2x2 grid points x 16 bytes = 128 bytes");
+    EXPECT_EQ(message({{"brick_budget", 0}}).rfind("options.brick_budget: must be a positive integer", 0), 0u);
+    EXPECT_EQ(message({{"brick_budget", 1.5}}).rfind("options.brick_budget: must be a positive integer", 0), 0u);
+    EXPECT_EQ(message({{"bricks", {2, 2}}}).rfind("options.bricks: must be [nx, ny, nz]", 0), 0u);
+    EXPECT_EQ(message({{"bricks", {2, 33, 1}}}),
+              "options.bricks: axis 1 has 32 cells, so from 1 to 32 bricks, got 33");
+    EXPECT_EQ(message({{"bricks", {2, 2, 2}}, {"brick_budget", 100000}}),
+              "options.bricks: give either brick_budget or bricks, not both");
+    EXPECT_EQ(message({{"bricks", {2, 1, 1}}}, "gradientless").rfind("options.bricks: gives 2x1x1 bricks, and bricking "
+                                                                     "works with iso.shading \"gradient\" or \"none\" only",
+                                                                     0),
+              0u);
+    EXPECT_EQ(message({{"brick_budget", 100000}, {"interior", true}}).rfind("options.brick_budget: gives 2x2x2 bricks", 0), 0u);
+    // Budgets that hold the whole volume are no bricking at all, so those combinations work.
+    EXPECT_EQ(message({{"brick_budget", 33 * 33 * 33 * 20}}, "gradientless"), "no error");
+    EXPECT_EQ(message({{"bricks", {1, 1, 1}}, {"interior", true}}), "no error");
+}
+
+// Every pixel-center ray from the eye, stepped finely: the bricks it passes must come in brickOrder's order.
+std::size_t orderViolations(const MemoryBricks& grid, const Camera& camera, const Volume& v)
+{
+    const std::vector<glm::ivec3> order = brickOrder(grid, camera, v.origin, v.spacing);
+    std::vector<int> rank(static_cast<std::size_t>(grid.count()));
+    for (std::size_t i = 0; i < order.size(); ++i)
+        rank[static_cast<std::size_t>(order[i].x + grid.counts.x * (order[i].y + grid.counts.y * order[i].z))] =
+            static_cast<int>(i);
+    const PixelRays rays(camera, 24, 24);
+    std::size_t violations = 0;
+    for (int y = 0; y < 24; ++y)
+        for (int x = 0; x < 24; ++x) {
+            const Ray r = rays.at(x, y);
+            int last = -1;
+            for (double t = 0.0; t < 8.0; t += 1e-3) {
+                const glm::dvec3 g = (r.origin + t * r.direction - v.origin) / v.spacing;
+                glm::ivec3 b;
+                bool inside = true;
+                for (int a = 0; a < 3; ++a) {
+                    if (g[a] < 0.0 || g[a] > v.dims[a] - 1) {
+                        inside = false;
+                        break;
+                    }
+                    b[a] = 0;
+                    while (b[a] + 1 < grid.counts[a] && g[a] >= grid.starts[a][b[a] + 1])
+                        ++b[a];
+                }
+                if (!inside)
+                    continue;
+                const int k = rank[static_cast<std::size_t>(b.x + grid.counts.x * (b.y + grid.counts.y * b.z))];
+                if (k < last)
+                    ++violations;
+                last = std::max(last, k);
+            }
+        }
+    return violations;
+}
+
+Camera insideCamera()
+{
+    Camera c;  // in the box [-1, 1]^3, outside the sphere of radius 0.5, looking past its centre
+    c.position = {0.55, 0.7, 0.8};
+    c.focalPoint = {0.0, -0.1, 0.0};
+    c.viewAngle = 70.0;
+    return c;
+}
+
+TEST(Iso3dBricking, OrderIsFrontToBackForEveryRay)
+{
+    const Volume& v = marschnerLobb41();
+    const MemoryBricks grid = splitBricks(v.dims, {3, 2, 5}, 16);
+    EXPECT_EQ(orderViolations(grid, perspectiveCamera(), v), 0u);
+    EXPECT_EQ(orderViolations(grid, parallelCamera(), v), 0u);
+    EXPECT_EQ(orderViolations(grid, insideCamera(), v), 0u);
+    // A camera close above a flat grid of 8x1x8 bricks, looking across it.
+    Camera near;
+    near.position = {0.9, 0.95, 1.3};
+    near.focalPoint = {0.9, -1.0, -1.0};
+    near.viewAngle = 90.0;
+    EXPECT_EQ(orderViolations(splitBricks(v.dims, {8, 1, 8}, 16), near, v), 0u);
+}
+
+struct BrickedVsUnbricked {
+    std::size_t pixels = 0, colorDiffers = 0, depthDiffers = 0, coverageDiffers = 0, hits = 0;
+    nlohmann::json stats;
+};
+
+BrickedVsUnbricked compareBricked(const Camera& camera, const Volume& volume, const json& bricking,
+                                  const std::string& shading = "gradient", int slices = 96)
+{
+    json plain = {{"slices", slices}};
+    json bricked = plain;
+    bricked.update(bricking);
+    Scene a = makeScene(camera, 0.5, plain), b = makeScene(camera, 0.5, bricked);
+    a.iso["shading"] = shading;
+    b.iso["shading"] = shading;
+    auto ra = makeIso3dRenderer(test::device(), a, volume);
+    auto rb = makeIso3dRenderer(test::device(), b, volume);
+    FrameStats sa, sb;
+    const Image4f ia = ra->render(sa), ib = rb->render(sb);
+    const std::vector<double> za = ra->hitDepth(), zb = rb->hitDepth();
+    BrickedVsUnbricked r;
+    r.stats = sb.extra;
+    r.pixels = za.size();
+    for (std::size_t i = 0; i < za.size(); ++i) {
+        const bool ha = std::isfinite(za[i]), hb = std::isfinite(zb[i]);
+        r.hits += ha;
+        r.coverageDiffers += ha != hb;
+        r.depthDiffers += ha && hb && za[i] != zb[i];
+        r.colorDiffers += std::memcmp(&ia.pixels()[i], &ib.pixels()[i], sizeof(glm::vec4)) != 0;
+    }
+    std::printf("iso3d bricked %s vs unbricked: %d bricks, %zu hits, coverage differs %zu, depth differs %zu, "
+                "color differs %zu (of %zu)\n",
+                bricking.dump().c_str(), sb.extra["bricks"].get<int>(), r.hits, r.coverageDiffers, r.depthDiffers,
+                r.colorDiffers, r.pixels);
+    return r;
+}
+
+void expectIdentical(const BrickedVsUnbricked& r, std::size_t minHits = 300)
+{
+    EXPECT_GT(r.hits, minHits);
+    EXPECT_EQ(r.coverageDiffers, 0u);
+    EXPECT_EQ(r.depthDiffers, 0u);
+    EXPECT_EQ(r.colorDiffers, 0u);
+}
+
+TEST(Iso3dBricking, IdenticalToUnbrickedOnSpherePerspectiveAndParallel)
+{
+    for (const Camera& camera : {perspectiveCamera(), parallelCamera()}) {
+        const BrickedVsUnbricked r8 = compareBricked(camera, sphere33(), {{"brick_budget", 17 * 17 * 17 * 16}});
+        EXPECT_EQ(r8.stats["bricks"], 8);
+        EXPECT_EQ(r8.stats["brick_bytes"], 17 * 17 * 17 * 16);
+        EXPECT_EQ(r8.stats["resident_bytes"], 17 * 17 * 17 * 16);
+        EXPECT_EQ(r8.stats["brick_uploads"], 8);
+        expectIdentical(r8);
+        const BrickedVsUnbricked r30 = compareBricked(camera, sphere33(), {{"bricks", {3, 2, 5}}});
+        EXPECT_EQ(r30.stats["bricks"], 30);
+        expectIdentical(r30);
+        const BrickedVsUnbricked r1 = compareBricked(camera, sphere33(), {{"brick_budget", 1 << 30}});
+        EXPECT_EQ(r1.stats["bricks"], 1);
+        EXPECT_EQ(r1.stats["brick_uploads"], 0);
+        expectIdentical(r1);
+    }
+}
+
+TEST(Iso3dBricking, IdenticalToUnbrickedOnMarschnerLobb)
+{
+    expectIdentical(compareBricked(perspectiveCamera(), marschnerLobb41(), {{"bricks", {3, 2, 5}}}, "gradient", 128));
+    expectIdentical(compareBricked(parallelCamera(), marschnerLobb41(), {{"brick_budget", 21 * 21 * 21 * 16}}, "none", 128));
+}
+
+TEST(Iso3dBricking, IdenticalWithTheCameraInsideTheBrickGrid)
+{
+    expectIdentical(compareBricked(insideCamera(), sphere33(), {{"bricks", {3, 2, 5}}}));
+    expectIdentical(compareBricked(insideCamera(), marschnerLobb41(), {{"bricks", {2, 2, 2}}}, "gradient", 128));
+}
+
+TEST(Iso3dBricking, BrickedHitsWithinOneSliceOfTheExactFirstHit)
+{
+    // The bricked render against the exact reference directly (not only against the unbricked render).
+    const HitComparison r = compareHits(makeScene(perspectiveCamera(), 0.5, {{"slices", 128}, {"bricks", {2, 3, 2}}}),
+                                        sphere33());
+    ASSERT_GT(r.bothHit, 500u);
+    EXPECT_LE(r.maxDepthError, r.deltaS + kDepthSlack);
+    EXPECT_EQ(r.overOneSlice, 0u);
+    EXPECT_EQ(r.coverageDiffersInside, 0u);
+}
+
 }  // namespace
 }  // namespace clvr

@@ -1,6 +1,7 @@
 // tests/raster_test.cpp — the ordered triangle rasterizer (raster/rasterizer.h) against the CPU
 // reference (raster/reference/rasterizer.h) and against closed-form geometry: coverage and stencil
 // exact, color and depth within stated float tolerances, fill rule, clipping, perspective, order.
+#include "host/errors.h"
 #include "raster/rasterizer.h"
 #include "raster/reference/rasterizer.h"
 #include "raster/texture.h"
@@ -545,6 +546,53 @@ TEST(RasterClipping, UserPlaneHalvesAQuad)
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x)
             ASSERT_EQ(image.at(x, y).r, x >= 18 ? 1.0f : 0.0f) << x << "," << y;
+    device.takePassTimes();
+}
+
+TEST(RasterScissor, VisitsOnlyTheRectangleWithUnchangedValues)
+{
+    // A perspective-looking triangle with a varying attribute, drawn once whole and once scissored:
+    // inside the rectangle the bits are the same (absolute edge functions), outside nothing is written.
+    clvr::Device& device = clvr::test::device();
+    const int w = 37, h = 23;
+    std::vector<raster::Vertex> tri(3);
+    tri[0].position = glm::vec4(-0.9f, -0.8f, 0.1f, 1.0f);
+    tri[1].position = glm::vec4(1.7f, -1.2f, 0.5f, 2.0f);
+    tri[2].position = glm::vec4(0.1f, 0.9f, -0.3f, 1.0f);
+    for (int i = 0; i < 3; ++i)
+        tri[i].attributes[0] = glm::vec4(0.1f * i, 1.0f - 0.3f * i, 0.7f, 1.0f);
+    raster::DrawState s;
+    s.fragment.depth.test = true;
+    s.fragment.depth.func = raster::CompareFunc::Always;
+    raster::Framebuffer whole(device, w, h), part(device, w, h);
+    for (raster::Framebuffer* fb : {&whole, &part}) {
+        fb->clearColor(device, glm::vec4(-1.0f));
+        fb->clearDepth(device, 1.0f);
+    }
+    const raster::DrawStats all = raster::draw(device, whole, s, raster::Topology::Triangles, tri);
+    s.scissor = {true, 5, 3, 20, 11};  // columns 5..24, rows 3..13
+    const raster::DrawStats some = raster::draw(device, part, s, raster::Topology::Triangles, tri);
+    const clvr::Image4f a = whole.readColor(device), b = part.readColor(device);
+    const std::vector<float> da = whole.readDepth(device), db = part.readDepth(device);
+    std::uint64_t inside = 0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const bool in = x >= 5 && x < 25 && y >= 3 && y < 14;
+            const std::size_t i = static_cast<std::size_t>(y) * w + x;
+            if (in) {
+                inside += a.at(x, y).r >= 0.0f;
+                ASSERT_EQ(std::memcmp(&a.at(x, y), &b.at(x, y), sizeof(a.at(x, y))), 0) << x << "," << y;
+                ASSERT_EQ(da[i], db[i]) << x << "," << y;
+            } else {
+                ASSERT_EQ(b.at(x, y).r, -1.0f) << x << "," << y;
+                ASSERT_EQ(db[i], 1.0f) << x << "," << y;
+            }
+        }
+    EXPECT_GT(inside, 50u);
+    EXPECT_LT(some.fragments, all.fragments);
+    EXPECT_EQ(some.fragments, inside);
+    s.scissor = {true, 0, 0, -1, 4};
+    EXPECT_THROW(raster::draw(device, part, s, raster::Topology::Triangles, tri), clvr::InputError);
     device.takePassTimes();
 }
 

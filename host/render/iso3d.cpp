@@ -55,6 +55,16 @@ private:
     std::unique_ptr<raster::Texture> scalarTexture_;
     double gradientlessStep_ = 0.0, gradientlessScale_ = 0.0;
     glm::vec4 textureShift_{0.0f};
+    // Bricking (§3.1): with more than one brick, brickData_ holds each brick's part of the RGBA volume on
+    // the host (index x + counts.x (y + counts.y z)), uploaded in turn into the one device buffer volume_.
+    glm::dvec3 origin_{0.0}, spacing_{1.0};
+    glm::ivec3 dims_{0};
+    MemoryBricks bricks_;
+    std::vector<std::vector<glm::vec4>> brickData_;
+
+    raster::DrawStats drawBricks(const raster::DrawState& state, const std::vector<raster::Vertex>& vertices,
+                                 const std::vector<std::size_t>& sliceFirst, const glm::dmat4& viewProjection,
+                                 FrameStats& stats);
 };
 
 Iso3dRendererImpl::Iso3dRendererImpl(Device& device, const Scene& scene, const Volume& volume)
@@ -74,9 +84,53 @@ Iso3dRendererImpl::Iso3dRendererImpl(Device& device, const Scene& scene, const V
     sliceOptions.sliceSpacing = options_.sliceSpacing;
     plan_ = planSlices(camera_, lo_, hi_, sliceOptions);
 
+    origin_ = volume.origin;
+    spacing_ = volume.spacing;
+    dims_ = volume.dims;
+    const bool gradientless = iso_.shading == IsoSurface::Shading::Gradientless;
+    // Every byte of texture per grid point: the RGBA volume, and gradientless shading's scalar texture.
+    const std::uint64_t bytesPerPoint = sizeof(glm::vec4) + (gradientless ? sizeof(float) : 0);
+    if (options_.bricks.x > 0)
+        bricks_ = splitBricks(volume.dims, options_.bricks, bytesPerPoint);
+    else if (options_.brickBudget > 0)
+        bricks_ = planBricks(volume.dims, bytesPerPoint, options_.brickBudget);
+    else
+        bricks_ = splitBricks(volume.dims, glm::ivec3(1), bytesPerPoint);
+    const std::string brickKey = options_.bricks.x > 0 ? "bricks" : "brick_budget";
+    const std::string brickGrid = std::to_string(bricks_.counts.x) + "x" + std::to_string(bricks_.counts.y) + "x" +
+                                  std::to_string(bricks_.counts.z);
+    if (bricks_.count() > 1 && gradientless)
+        badOption(brickKey, "gives " + brickGrid + " bricks, and bricking works with iso.shading \"gradient\" or "
+                            "\"none\" only (gradientless shading's shifted lookup X(p0 + Delta L) leaves the brick)");
+    if (bricks_.count() > 1 && options_.interior)
+        badOption(brickKey, "gives " + brickGrid + " bricks, and bricking does not work with options.interior "
+                            "(Figure 7's passes use the stencil themselves)");
+
     const std::vector<glm::vec4> rgba = encodedNormalVolume(volume);
-    volume_ = device_.upload("iso3d RGBA volume (normal, value; float32)", rgba);
-    residentBytes_ = rgba.size() * sizeof(glm::vec4);
+    if (bricks_.count() == 1) {
+        volume_ = device_.upload("iso3d RGBA volume (normal, value; float32)", rgba);
+        residentBytes_ = rgba.size() * sizeof(glm::vec4);
+    } else {
+        // Each brick's grid points cut out of the globally computed RGBA volume (so its normals at the
+        // brick faces are the unbricked ones), and one device buffer as large as the largest brick.
+        for (int bz = 0; bz < bricks_.counts.z; ++bz)
+            for (int by = 0; by < bricks_.counts.y; ++by)
+                for (int bx = 0; bx < bricks_.counts.x; ++bx) {
+                    const glm::ivec3 b(bx, by, bz), lo = bricks_.lo(b), n = bricks_.dims(b);
+                    std::vector<glm::vec4> data;
+                    data.reserve(static_cast<std::size_t>(n.x) * n.y * n.z);
+                    for (int k = 0; k < n.z; ++k)
+                        for (int j = 0; j < n.y; ++j) {
+                            const std::size_t row =
+                                (static_cast<std::size_t>(lo.z + k) * volume.dims.y + (lo.y + j)) * volume.dims.x + lo.x;
+                            data.insert(data.end(), rgba.begin() + static_cast<std::ptrdiff_t>(row),
+                                        rgba.begin() + static_cast<std::ptrdiff_t>(row + n.x));
+                        }
+                    brickData_.push_back(std::move(data));
+                }
+        residentBytes_ = bricks_.maxBytes();
+        volume_ = device_.buffer("iso3d brick (RGBA: normal, value; float32)", residentBytes_, CL_MEM_READ_ONLY);
+    }
 
     // GL clamps the alpha reference to [0,1], as the paper's 8-bit textures hold values in [0,1]:
     // the value range, widened to hold the iso-value (so that an iso-value above every value keeps
@@ -96,7 +150,6 @@ Iso3dRendererImpl::Iso3dRendererImpl(Device& device, const Scene& scene, const V
             source = k.source;
     fragmentProgram_.source = "#define CLVR_ISO3D_FRAGMENT 1\n" + std::string(source);
     fragmentProgram_.buffers[0] = volume_;
-    const bool gradientless = iso_.shading == IsoSurface::Shading::Gradientless;
     if (options_.interior && gradientless)
         badOption("interior", "works with \"gradient\" or \"none\" shading (the gradientless difference would need its "
                               "sign turned per pixel), and iso.shading is \"gradientless\"");
@@ -105,6 +158,9 @@ Iso3dRendererImpl::Iso3dRendererImpl(Device& device, const Scene& scene, const V
         glm::vec4(glm::vec3(1.0 / volume.spacing), 0.0f),
         glm::vec4(volume.dims.x, volume.dims.y, volume.dims.z, 0.0f),
         glm::vec4(valueLo, scale, gradientless ? 1.0f : 0.0f, 0.0f),
+        glm::vec4(0.0f),                                                   // the brick's first grid point ...
+        glm::vec4(volume.dims.x, volume.dims.y, volume.dims.z, 0.0f),      // ... the end of its box ...
+        glm::vec4(volume.dims.x, volume.dims.y, volume.dims.z, 0.0f),      // ... its dims: unbricked, all
     };
     if (gradientless) {
         raster::TextureDesc desc;
@@ -146,7 +202,10 @@ Image4f Iso3dRendererImpl::render(FrameStats& stats)
         camera_.projectionMatrix(image_.width, image_.height, nearZ_, farZ_) * camera_.viewMatrix();
     std::vector<raster::Vertex> vertices;
     vertices.reserve(static_cast<std::size_t>(plan_.count) * 12);
+    std::vector<std::size_t> sliceFirst;  // slice k's triangles: vertices[sliceFirst[k] .. sliceFirst[k + 1])
+    sliceFirst.reserve(static_cast<std::size_t>(plan_.count) + 1);
     for (int k = 0; k < plan_.count; ++k) {
+        sliceFirst.push_back(vertices.size());
         const double offset = glm::dot(forward, camera_.position) + plan_.depth(k);
         const std::vector<glm::dvec3> polygon = slicePolygon(lo_, hi_, forward, offset);
         auto vertex = [&](const glm::dvec3& p) {
@@ -161,6 +220,7 @@ Image4f Iso3dRendererImpl::render(FrameStats& stats)
             vertices.push_back(vertex(polygon[j + 1]));
         }
     }
+    sliceFirst.push_back(vertices.size());
     // §3: "pixel values are only drawn if they pass the z-buffer test and if the alpha value is larger
     // than or equal to the selected iso-value". Front to back with LESS, the first slice that passes
     // the alpha test at a pixel locks it; back to front would give the same image with more writes.
@@ -174,8 +234,14 @@ Image4f Iso3dRendererImpl::render(FrameStats& stats)
     framebuffer_->clearColor(device_, glm::vec4(0.0f));
     framebuffer_->clearDepth(device_, 1.0f);
     raster::DrawStats drawStats;
+    // Uploads per frame: none unbricked (the volume stays resident between frames); drawBricks counts its own.
+    stats.extra["brick_uploads"] = 0;
+    stats.extra["brick_upload_bytes"] = 0;
+    stats.extra["brick_upload_ms"] = 0.0;
     if (vertices.empty()) {
         // the box is behind the camera: nothing to draw
+    } else if (bricks_.count() > 1) {
+        drawStats = drawBricks(state, vertices, sliceFirst, viewProjection, stats);
     } else if (!options_.interior) {
         drawStats = raster::draw(device_, *framebuffer_, state, raster::Topology::Triangles, vertices, fragmentProgram_);
     } else {
@@ -279,7 +345,99 @@ Image4f Iso3dRendererImpl::render(FrameStats& stats)
                                                                                  : "none";
     stats.extra["resident_bytes"] = residentBytes_;
     stats.extra["interior"] = options_.interior;
+    stats.extra["bricks"] = bricks_.count();
+    stats.extra["brick_grid"] = {bricks_.counts.x, bricks_.counts.y, bricks_.counts.z};
+    stats.extra["brick_bytes"] = bricks_.maxBytes();
     return image;
+}
+
+raster::DrawStats Iso3dRendererImpl::drawBricks(const raster::DrawState& unbricked,
+                                                const std::vector<raster::Vertex>& vertices,
+                                                const std::vector<std::size_t>& sliceFirst,
+                                                const glm::dmat4& viewProjection, FrameStats& stats)
+{
+    // §3.1: "Each brick is rendered separately from front to back starting with the one nearest to the
+    // image plane. Since the stencil buffer is immediately locked whenever a hit with the surface occurs,
+    // once a value has been set correctly it will never be changed." A fragment that passes the alpha test
+    // (and the depth test) sets the stencil to 1; the stencil test (NOTEQUAL 1) rejects every later
+    // fragment there, of this brick or of the bricks behind it.
+    raster::DrawState state = unbricked;
+    state.fragment.stencil.test = true;
+    state.fragment.stencil.func = raster::CompareFunc::NotEqual;
+    state.fragment.stencil.ref = 1;
+    state.fragment.stencil.dppass = raster::StencilOp::Replace;
+    framebuffer_->clearStencil(device_, 0);
+
+    const glm::dvec3 forward = camera_.forward();
+    raster::DrawStats total;
+    std::uint64_t uploads = 0, uploadBytes = 0;
+    double uploadMs = 0.0;
+    raster::FragmentProgram program = fragmentProgram_;
+    for (const glm::ivec3& b : brickOrder(bricks_, camera_, origin_, spacing_)) {
+        const glm::ivec3 lo = bricks_.lo(b), hi = bricks_.hi(b), n = bricks_.dims(b);
+        const glm::dvec3 boxLo = origin_ + glm::dvec3(lo) * spacing_, boxHi = origin_ + glm::dvec3(hi) * spacing_;
+        // The slices that can reach the brick: its corners' eye-depth range, one slice more on each side
+        // (a slice drawn for a brick it misses only costs discarded fragments; one missed would lose samples).
+        double dMin = std::numeric_limits<double>::infinity(), dMax = -dMin;
+        bool allInFront = true;
+        glm::dvec2 wMin(std::numeric_limits<double>::infinity()), wMax(-std::numeric_limits<double>::infinity());
+        for (int c = 0; c < 8; ++c) {
+            const glm::dvec3 p((c & 1) ? boxHi.x : boxLo.x, (c & 2) ? boxHi.y : boxLo.y, (c & 4) ? boxHi.z : boxLo.z);
+            const double d = glm::dot(forward, p - camera_.position);
+            dMin = std::min(dMin, d);
+            dMax = std::max(dMax, d);
+            const glm::dvec4 clip = viewProjection * glm::dvec4(p, 1.0);
+            if (!(clip.w > 0.0)) {
+                allInFront = false;
+                continue;
+            }
+            const glm::dvec2 window((clip.x / clip.w + 1.0) * 0.5 * image_.width,
+                                    (1.0 - clip.y / clip.w) * 0.5 * image_.height);
+            wMin = glm::min(wMin, window);
+            wMax = glm::max(wMax, window);
+        }
+        const int kLo = std::max(0, static_cast<int>(std::floor((dMin - plan_.depthMin) / plan_.deltaS - 0.5)) - 1);
+        const int kHi =
+            std::min(plan_.count - 1, static_cast<int>(std::ceil((dMax - plan_.depthMin) / plan_.deltaS - 0.5)) + 1);
+        if (kLo > kHi || sliceFirst[kLo] == sliceFirst[kHi + 1])
+            continue;
+        // The scissor: the brick's projected box (the hull of its corners when all are in front of the
+        // eye), one pixel wider on every side; the whole frame otherwise (the eye near or in the brick).
+        state.scissor = {};
+        if (allInFront) {
+            const int x0 = std::max(0, static_cast<int>(std::floor(wMin.x)) - 1);
+            const int y0 = std::max(0, static_cast<int>(std::floor(wMin.y)) - 1);
+            const int x1 = std::min(image_.width, static_cast<int>(std::ceil(wMax.x)) + 1);
+            const int y1 = std::min(image_.height, static_cast<int>(std::ceil(wMax.y)) + 1);
+            if (x0 >= x1 || y0 >= y1)
+                continue;  // off screen
+            state.scissor = {true, x0, y0, x1 - x0, y1 - y0};
+        }
+
+        const std::vector<glm::vec4>& data = brickData_[static_cast<std::size_t>(b.x + bricks_.counts.x * (b.y + bricks_.counts.y * b.z))];
+        const auto t0 = std::chrono::steady_clock::now();
+        device_.queue().enqueueWriteBuffer(volume_, CL_TRUE, 0, data.size() * sizeof(glm::vec4), data.data());
+        uploadMs += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        ++uploads;
+        uploadBytes += data.size() * sizeof(glm::vec4);
+
+        // Upper ends of the brick's half-open box in grid units; the last slab of an axis keeps its far face.
+        const glm::vec4 end(hi.x == dims_.x - 1 ? dims_.x : hi.x, hi.y == dims_.y - 1 ? dims_.y : hi.y,
+                            hi.z == dims_.z - 1 ? dims_.z : hi.z, 0.0f);
+        program.uniforms[4] = glm::vec4(lo.x, lo.y, lo.z, 0.0f);
+        program.uniforms[5] = end;
+        program.uniforms[6] = glm::vec4(n.x, n.y, n.z, 0.0f);
+        const std::vector<raster::Vertex> part(vertices.begin() + static_cast<std::ptrdiff_t>(sliceFirst[kLo]),
+                                               vertices.begin() + static_cast<std::ptrdiff_t>(sliceFirst[kHi + 1]));
+        const raster::DrawStats d =
+            raster::draw(device_, *framebuffer_, state, raster::Topology::Triangles, part, program);
+        total.fragments += d.fragments;
+        total.triangles += d.triangles;
+    }
+    stats.extra["brick_uploads"] = uploads;
+    stats.extra["brick_upload_bytes"] = uploadBytes;
+    stats.extra["brick_upload_ms"] = uploadMs;
+    return total;
 }
 
 std::vector<double> Iso3dRendererImpl::hitDepth()
@@ -327,17 +485,31 @@ Iso3dOptions parseIso3dOptions(const nlohmann::json& options)
             if (!value.is_number() || !(value.get<double>() > 0.0) || !std::isfinite(value.get<double>()))
                 badOption(key, "must be a positive number (per data unit), got " + value.dump());
             o.gradientlessScale = value.get<double>();
+        } else if (key == "brick_budget") {
+            if (!value.is_number_integer() || value.get<long long>() < 1)
+                badOption(key, "must be a positive integer (bytes of brick textures on the device), got " + value.dump());
+            o.brickBudget = value.get<std::uint64_t>();
+        } else if (key == "bricks") {
+            if (!value.is_array() || value.size() != 3)
+                badOption(key, "must be [nx, ny, nz], bricks per axis, got " + value.dump());
+            for (int a = 0; a < 3; ++a) {
+                if (!value[a].is_number_integer() || value[a].get<long long>() < 1 || value[a].get<long long>() > 65536)
+                    badOption(key, "must be [nx, ny, nz], integers in [1, 65536], got " + value.dump());
+                o.bricks[a] = value[a].get<int>();
+            }
         } else if (key == "interior") {
             if (!value.is_boolean())
                 badOption(key, "must be true or false, got " + value.dump());
             o.interior = value.get<bool>();
         } else {
             badOption(key, "unknown option for iso3d (known: slices, slice_spacing, gradientless_step, gradientless_scale, "
-                           "interior)");
+                           "interior, brick_budget, bricks)");
         }
     }
     if (options.contains("slices") && options.contains("slice_spacing"))
         badOption("slice_spacing", "give either slices or slice_spacing, not both");
+    if (options.contains("brick_budget") && options.contains("bricks"))
+        badOption("bricks", "give either brick_budget or bricks, not both");
     return o;
 }
 
@@ -431,6 +603,98 @@ raster::PixelTransfer isoShadingTransfer(const IsoSurface& iso, const glm::dmat3
     xf.scale = glm::vec4(glm::vec3(iso.diffuse * iso.color), 1.0f);
     xf.bias = glm::vec4(glm::vec3(iso.color * (iso.ambient - iso.diffuse * decodeBias)), 0.0f);
     return xf;
+}
+
+std::uint64_t MemoryBricks::bytes(const glm::ivec3& b) const
+{
+    const glm::ivec3 n = dims(b);
+    return static_cast<std::uint64_t>(n.x) * n.y * n.z * bytesPerPoint;
+}
+
+std::uint64_t MemoryBricks::maxBytes() const
+{
+    // Slabs differ by at most one cell per axis: the largest brick takes the largest slab of each.
+    glm::ivec3 n(0);
+    for (int a = 0; a < 3; ++a)
+        for (int s = 0; s < counts[a]; ++s)
+            n[a] = std::max(n[a], starts[a][s + 1] - starts[a][s] + 1);
+    return static_cast<std::uint64_t>(n.x) * n.y * n.z * bytesPerPoint;
+}
+
+MemoryBricks splitBricks(const glm::ivec3& dims, const glm::ivec3& counts, std::uint64_t bytesPerPoint)
+{
+    MemoryBricks grid;
+    grid.counts = counts;
+    grid.bytesPerPoint = bytesPerPoint;
+    for (int a = 0; a < 3; ++a) {
+        const int cells = dims[a] - 1;
+        if (counts[a] < 1 || counts[a] > cells)
+            badOption("bricks", "axis " + std::to_string(a) + " has " + std::to_string(cells) + " cells, so from 1 to " +
+                                    std::to_string(cells) + " bricks, got " + std::to_string(counts[a]));
+        grid.starts[a].resize(static_cast<std::size_t>(counts[a]) + 1);
+        for (int s = 0; s <= counts[a]; ++s)
+            grid.starts[a][s] = static_cast<int>(static_cast<long long>(s) * cells / counts[a]);
+    }
+    return grid;
+}
+
+MemoryBricks planBricks(const glm::ivec3& dims, std::uint64_t bytesPerPoint, std::uint64_t budget)
+{
+    const std::uint64_t smallest = 8 * bytesPerPoint;
+    if (budget < smallest)
+        badOption("brick_budget", std::to_string(budget) + " bytes is less than the smallest brick, 2x2x2 grid points x " +
+                                      std::to_string(bytesPerPoint) + " bytes = " + std::to_string(smallest) + " bytes");
+    glm::ivec3 counts(1);
+    for (;;) {
+        const MemoryBricks grid = splitBricks(dims, counts, bytesPerPoint);
+        if (grid.maxBytes() <= budget)
+            return grid;
+        // Cut the axis whose bricks have the most grid points (of those with more than one cell left).
+        int axis = -1, most = 0;
+        for (int a = 0; a < 3; ++a) {
+            const int cells = dims[a] - 1;
+            const int points = (cells + counts[a] - 1) / counts[a] + 1;
+            if (points > 2 && points > most) {
+                most = points;
+                axis = a;
+            }
+        }
+        ++counts[axis];  // axis >= 0: 2x2x2 points fit the budget
+    }
+}
+
+std::vector<glm::ivec3> brickOrder(const MemoryBricks& grid, const Camera& camera, const glm::dvec3& origin,
+                                   const glm::dvec3& spacing)
+{
+    // Per axis, the key of slab s: perspective, |s - the eye's slab| (the eye's coordinate clamped to the
+    // grid); parallel, s counted along the view direction. Along any ray from the eye each axis' key never
+    // decreases and one grows at every brick change, so the sum is a visibility order.
+    const glm::dvec3 forward = camera.forward();
+    std::array<std::vector<int>, 3> key;
+    for (int a = 0; a < 3; ++a) {
+        const int n = grid.counts[a];
+        key[a].resize(static_cast<std::size_t>(n));
+        if (camera.parallel) {
+            for (int s = 0; s < n; ++s)
+                key[a][s] = forward[a] > 0.0 ? s : forward[a] < 0.0 ? n - 1 - s : 0;
+        } else {
+            const double g = (camera.position[a] - origin[a]) / spacing[a];  // the eye in grid units
+            int eye = 0;
+            while (eye + 1 < n && g >= grid.starts[a][eye + 1])
+                ++eye;
+            for (int s = 0; s < n; ++s)
+                key[a][s] = std::abs(s - eye);
+        }
+    }
+    std::vector<glm::ivec3> order;
+    for (int z = 0; z < grid.counts.z; ++z)
+        for (int y = 0; y < grid.counts.y; ++y)
+            for (int x = 0; x < grid.counts.x; ++x)
+                order.emplace_back(x, y, z);
+    std::stable_sort(order.begin(), order.end(), [&](const glm::ivec3& p, const glm::ivec3& q) {
+        return key[0][p.x] + key[1][p.y] + key[2][p.z] < key[0][q.x] + key[1][q.y] + key[2][q.z];
+    });
+    return order;
 }
 
 std::unique_ptr<Iso3dRenderer> makeIso3dRenderer(Device& device, const Scene& scene, const Volume& volume)
