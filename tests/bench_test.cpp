@@ -298,7 +298,8 @@ TEST(BenchRts, ScenesAreValidAndDifferOnlyWhereTheyShould)
 
 // The suite lists exactly the reg-* files there are; every scene loads, is 512x512 and names the technique
 // its file name says; each clip scene is its raster-path baseline plus the clip mesh and nothing else
-// (each clip-texture scene its fused baseline plus the clip texture),
+// (each clip-texture scene its fused baseline plus the clip texture, each bricked iso-surface its
+// unbricked one plus the budget),
 // each k1 stack is its plain stack with one intermediate slice, and each p4 stack its k1 stack with four
 // slices per polygon.
 TEST(BenchRegular, ScenesAreValidAndPairsDifferOnlyWhereTheyShould)
@@ -310,9 +311,9 @@ TEST(BenchRegular, ScenesAreValidAndPairsDifferOnlyWhereTheyShould)
         present.push_back(file.filename().string());
     std::sort(listed.begin(), listed.end());
     EXPECT_EQ(listed, present);
-    // 3 volumes x (iso3d, 3 stacks, raster baseline, clip mesh, fused baseline, clip texture)
-    // + the gradientless engine + spherical
-    ASSERT_EQ(files.size(), 26u);
+    // 3 volumes x (iso3d, bricked iso3d, 3 stacks, raster baseline, clip mesh, fused baseline, clip
+    // texture) + the gradientless engine + spherical
+    ASSERT_EQ(files.size(), 29u);
     for (const auto& file : files) {
         const clvr::Scene scene = clvr::loadScene(file);
         const std::string name = file.filename().string();
@@ -332,6 +333,8 @@ TEST(BenchRegular, ScenesAreValidAndPairsDifferOnlyWhereTheyShould)
         };
         if (name.starts_with("reg-clip-"))
             differsOnlyIn("reg-slice3d-raster-" + name.substr(9), "/clip");
+        if (name.ends_with("-bricked.json"))
+            differsOnlyIn(name.substr(0, name.size() - 13) + ".json", "/brick_budget");
         if (name.starts_with("reg-cliptex-"))
             differsOnlyIn("reg-slice3d-" + name.substr(12), "/clip_texture");
         if (name.ends_with("-k1.json"))

@@ -11,6 +11,8 @@ Volumes, cameras and the translucent transfer function are those of tools/make_r
 here and a resample-then-shade row of the same volume see the same data from the same place.
 Per volume:
   reg-iso3d-V            iso3d, gradient shading, 512 slices (seeds/000 §3)
+  reg-iso3d-V-bricked    the same within a 16 MiB device-memory budget: bricks front to back, the
+                         stencil locking the first hit (seeds/000 §3.1)
   reg-stack2d-V          stack2d, plain bilinear slices of the stack (seeds/003)
   reg-stack2d-V-k1       stack2d, one lerped intermediate slice between stack slices (trilinear again)
   reg-stack2d-V-k1-p4    the same with four slices per polygon (seeds/003's multi-texture speed-up)
@@ -73,6 +75,9 @@ def scenes():
         clip = {"mesh": {"generator": "sphere", "center": center, "radius": radius, "segments": 64},
                 "inverse": True, "method": "two-pass"}
         out.append(("reg-iso3d-%s.json" % volume, iso_scene(volume, "gradient")))
+        bricked = iso_scene(volume, "gradient")
+        bricked["options"]["brick_budget"] = 16 * 2**20
+        out.append(("reg-iso3d-%s-bricked.json" % volume, bricked))
         if volume == "engine":
             out.append(("reg-iso3d-engine-gradientless.json", iso_scene(volume, "gradientless")))
         out.append(("reg-stack2d-%s.json" % volume, translucent_scene(volume, "stack2d", {"intermediate": 0})))
