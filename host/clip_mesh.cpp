@@ -3,6 +3,7 @@
 #include "host/clip_mesh.h"
 
 #include "host/errors.h"
+#include "host/json_values.h"
 #include "host/file_io.h"
 
 #include <tetgen.h>
@@ -31,28 +32,6 @@ std::string lower(std::string s)
     for (char& c : s)
         c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     return s;
-}
-
-[[noreturn]] void badKey(const std::string& key, const std::string& what)
-{
-    throw InputError(key + ": " + what);
-}
-
-glm::dvec3 vec3(const json& v, const std::string& key)
-{
-    if (!v.is_array() || v.size() != 3 || !std::all_of(v.begin(), v.end(), [](const json& x) { return x.is_number(); }))
-        badKey(key, "must be [x, y, z], got " + v.dump());
-    const glm::dvec3 p(v[0].get<double>(), v[1].get<double>(), v[2].get<double>());
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-        badKey(key, "must be finite, got " + v.dump());
-    return p;
-}
-
-double positive(const json& v, const std::string& key)
-{
-    if (!v.is_number() || !(v.get<double>() > 0.0) || !std::isfinite(v.get<double>()))
-        badKey(key, "must be a positive number, got " + v.dump());
-    return v.get<double>();
 }
 
 // tetgenio's readers take a writable char*.
@@ -247,13 +226,13 @@ ClipMeshSpec parseClipMeshSpec(const json& spec, const std::string& key)
         s.file = spec["file"].get<std::string>();
         if (spec.contains("scale")) {
             const json& v = spec["scale"];
-            s.scale = v.is_number() ? glm::dvec3(v.get<double>()) : vec3(v, key + ".scale");
+            s.scale = v.is_number() ? glm::dvec3(v.get<double>()) : jsonVec3(v, key + ".scale");
             // Zero would flatten the mesh; negative mirrors it (closeClipMesh then turns it outward again).
             if (!std::isfinite(s.scale.x) || s.scale.x == 0.0 || s.scale.y == 0.0 || s.scale.z == 0.0)
                 badKey(key + ".scale", "must be a finite non-zero number or [x, y, z] of them, got " + v.dump());
         }
         if (spec.contains("translate"))
-            s.translate = vec3(spec["translate"], key + ".translate");
+            s.translate = jsonVec3(spec["translate"], key + ".translate");
         return s;
     }
     const json& g = spec["generator"];
@@ -261,9 +240,9 @@ ClipMeshSpec parseClipMeshSpec(const json& spec, const std::string& key)
     if (s.generator == "box") {
         check({"generator", "min", "max"});
         if (spec.contains("min"))
-            s.min = vec3(spec["min"], key + ".min");
+            s.min = jsonVec3(spec["min"], key + ".min");
         if (spec.contains("max"))
-            s.max = vec3(spec["max"], key + ".max");
+            s.max = jsonVec3(spec["max"], key + ".max");
         if (!(s.min.x < s.max.x && s.min.y < s.max.y && s.min.z < s.max.z))
             badKey(key + ".max", "must be greater than min in x, y and z");
         return s;
@@ -275,13 +254,13 @@ ClipMeshSpec parseClipMeshSpec(const json& spec, const std::string& key)
     else
         check({"generator", "center", "axis", "radius", "height", "segments"});
     if (spec.contains("center"))
-        s.center = vec3(spec["center"], key + ".center");
+        s.center = jsonVec3(spec["center"], key + ".center");
     if (spec.contains("radius"))
-        s.radius = positive(spec["radius"], key + ".radius");
+        s.radius = jsonPositive(spec["radius"], key + ".radius");
     if (spec.contains("height"))
-        s.height = positive(spec["height"], key + ".height");
+        s.height = jsonPositive(spec["height"], key + ".height");
     if (spec.contains("axis")) {
-        s.axis = vec3(spec["axis"], key + ".axis");
+        s.axis = jsonVec3(spec["axis"], key + ".axis");
         if (glm::length(s.axis) == 0.0)
             badKey(key + ".axis", "must not be zero");
     }

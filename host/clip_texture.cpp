@@ -4,6 +4,7 @@
 #include "host/clip_texture.h"
 
 #include "host/errors.h"
+#include "host/json_values.h"
 #include "host/volume_io.h"
 
 #include <nlohmann/json.hpp>
@@ -22,28 +23,6 @@ namespace fs = std::filesystem;
 // shape never touches the box of texel centers and the zero level set is interpolated inside it.
 constexpr int kMarginTexels = 2;
 constexpr int kMinResolution = 8, kMaxResolution = 512;
-
-[[noreturn]] void badKey(const std::string& key, const std::string& what)
-{
-    throw InputError(key + ": " + what);
-}
-
-glm::dvec3 vec3(const json& v, const std::string& key)
-{
-    if (!v.is_array() || v.size() != 3 || !std::all_of(v.begin(), v.end(), [](const json& x) { return x.is_number(); }))
-        badKey(key, "must be [x, y, z], got " + v.dump());
-    const glm::dvec3 p(v[0].get<double>(), v[1].get<double>(), v[2].get<double>());
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-        badKey(key, "must be finite, got " + v.dump());
-    return p;
-}
-
-double positive(const json& v, const std::string& key)
-{
-    if (!v.is_number() || !(v.get<double>() > 0.0) || !std::isfinite(v.get<double>()))
-        badKey(key, "must be a positive number, got " + v.dump());
-    return v.get<double>();
-}
 
 glm::dmat3 matrix3(const json& v, const std::string& key)
 {
@@ -197,20 +176,20 @@ ClipTextureSpec parseClipTextureSpec(const json& spec, const std::string& key)
         if (std::find(known.begin(), known.end(), k) == known.end())
             badKey(key + "." + k, "unknown key (known: " + list + ")");
     if (spec.contains("center"))
-        s.center = vec3(spec["center"], key + ".center");
+        s.center = jsonVec3(spec["center"], key + ".center");
     if (spec.contains("radius"))
-        s.radius = positive(spec["radius"], key + ".radius");
+        s.radius = jsonPositive(spec["radius"], key + ".radius");
     if (spec.contains("height"))
-        s.height = positive(spec["height"], key + ".height");
+        s.height = jsonPositive(spec["height"], key + ".height");
     if (spec.contains("axis")) {
-        s.axis = vec3(spec["axis"], key + ".axis");
+        s.axis = jsonVec3(spec["axis"], key + ".axis");
         if (glm::length(s.axis) == 0.0)
             badKey(key + ".axis", "must not be zero");
     }
     if (spec.contains("min"))
-        s.min = vec3(spec["min"], key + ".min");
+        s.min = jsonVec3(spec["min"], key + ".min");
     if (spec.contains("max"))
-        s.max = vec3(spec["max"], key + ".max");
+        s.max = jsonVec3(spec["max"], key + ".max");
     if (s.shape == ClipTextureSpec::Shape::Box && !(s.min.x < s.max.x && s.min.y < s.max.y && s.min.z < s.max.z))
         badKey(key + ".max", "must be greater than min in x, y and z");
     if (spec.contains("resolution")) {
@@ -226,7 +205,7 @@ ClipTextureSpec parseClipTextureSpec(const json& spec, const std::string& key)
         s.inverse = spec["inverse"].get<bool>();
     }
     if (spec.contains("offset"))
-        s.offset = vec3(spec["offset"], key + ".offset");
+        s.offset = jsonVec3(spec["offset"], key + ".offset");
     if (spec.contains("matrix"))
         s.matrix = matrix3(spec["matrix"], key + ".matrix");
     return s;
