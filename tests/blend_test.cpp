@@ -41,20 +41,12 @@ Scene makeScene(const Camera& camera, json options)
 
 Camera perspectiveCamera()
 {
-    Camera c;
-    c.position = {1.2, 1.6, 3.7};
-    c.viewAngle = 40.0;
-    return c;
+    return test::obliquePerspectiveCamera(40.0);
 }
 
 Camera parallelCamera()
 {
-    Camera c;
-    c.position = {3.5, 1.0, 1.9};
-    c.viewUp = {0.0, 0.0, 1.0};
-    c.parallel = true;
-    c.parallelScale = 1.2;
-    return c;
+    return test::obliqueParallelCamera(1.2);
 }
 
 Image4f render(const Scene& scene, FrameStats* statsOut = nullptr)

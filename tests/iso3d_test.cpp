@@ -32,20 +32,12 @@ const Volume& marschnerLobb41()
 
 Camera perspectiveCamera()
 {
-    Camera c;
-    c.position = {1.2, 1.6, 3.7};
-    c.viewAngle = 24.0;
-    return c;
+    return test::obliquePerspectiveCamera(24.0);
 }
 
 Camera parallelCamera()
 {
-    Camera c;
-    c.position = {3.5, 1.0, 1.9};
-    c.viewUp = {0.0, 0.0, 1.0};
-    c.parallel = true;
-    c.parallelScale = 1.2;
-    return c;
+    return test::obliqueParallelCamera(1.2);
 }
 
 Scene makeScene(const Camera& camera, double iso, json options = json::object())

@@ -46,20 +46,12 @@ json material() { return json::parse(R"({"ambient": 0.15, "diffuse": 0.7, "specu
 
 Camera perspectiveCamera()
 {
-    Camera c;
-    c.position = {1.2, 1.6, 3.7};
-    c.viewAngle = 40.0;
-    return c;
+    return test::obliquePerspectiveCamera(40.0);
 }
 
 Camera parallelCamera()
 {
-    Camera c;
-    c.position = {3.5, 1.0, 1.9};
-    c.viewUp = {0.0, 0.0, 1.0};
-    c.parallel = true;
-    c.parallelScale = 1.2;
-    return c;
+    return test::obliqueParallelCamera(1.2);
 }
 
 Scene makeScene(const Camera& camera, json options, bool shaded = true, int size = 40)

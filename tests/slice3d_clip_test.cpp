@@ -30,20 +30,12 @@ TransferFunction mlTransferFunction()
 // The cameras of tests/slice3d_test.cpp, for the convex meshes.
 Camera perspectiveCamera()
 {
-    Camera c;
-    c.position = {1.2, 1.6, 3.7};
-    c.viewAngle = 40.0;
-    return c;
+    return test::obliquePerspectiveCamera(40.0);
 }
 
 Camera parallelCamera()
 {
-    Camera c;
-    c.position = {3.5, 1.0, 1.9};
-    c.viewUp = {0.0, 0.0, 1.0};
-    c.parallel = true;
-    c.parallelScale = 1.8;
-    return c;
+    return test::obliqueParallelCamera(1.8);
 }
 
 // For the torus (axis z): low views, 8-10 degrees above its plane, so that rays through its hole

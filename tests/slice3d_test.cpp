@@ -32,23 +32,12 @@ TransferFunction mlTransferFunction()
 
 Camera perspectiveCamera()
 {
-    Camera c;
-    c.position = {1.2, 1.6, 3.7};
-    c.focalPoint = {0.0, 0.0, 0.0};
-    c.viewUp = {0.0, 1.0, 0.0};
-    c.viewAngle = 40.0;
-    return c;
+    return test::obliquePerspectiveCamera(40.0);
 }
 
 Camera parallelCamera()
 {
-    Camera c;
-    c.position = {3.5, 1.0, 1.9};
-    c.focalPoint = {0.0, 0.0, 0.0};
-    c.viewUp = {0.0, 0.0, 1.0};
-    c.parallel = true;
-    c.parallelScale = 1.8;
-    return c;
+    return test::obliqueParallelCamera(1.8);
 }
 
 Scene makeScene(const Camera& camera, const TransferFunction& tf, int size, json options = json::object(),

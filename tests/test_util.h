@@ -2,6 +2,7 @@
 // tolerances (NaN never passes, failure images written), seeded randomness, data paths.
 #pragma once
 
+#include "host/camera.h"
 #include "host/device.h"
 #include "host/image.h"
 
@@ -66,5 +67,26 @@ public:
 private:
     std::uint64_t state_;
 };
+
+// The two cameras of tests/slice3d_test.cpp that most regular-grid tests share, looking at the origin
+// (a volume in [-1, 1]^3): perspective from (1.2, 1.6, 3.7), 28 degrees off the z axis, with this view
+// angle; parallel from (3.5, 1.0, 1.9), z up, 32 degrees off the x axis, with this parallel scale.
+inline Camera obliquePerspectiveCamera(double viewAngle)
+{
+    Camera c;
+    c.position = {1.2, 1.6, 3.7};
+    c.viewAngle = viewAngle;
+    return c;
+}
+
+inline Camera obliqueParallelCamera(double parallelScale)
+{
+    Camera c;
+    c.position = {3.5, 1.0, 1.9};
+    c.viewUp = {0.0, 0.0, 1.0};
+    c.parallel = true;
+    c.parallelScale = parallelScale;
+    return c;
+}
 
 }  // namespace clvr::test
