@@ -10,11 +10,13 @@
 #pragma once
 
 #include "host/camera.h"
+#include "host/clip_texture.h"
 #include "host/render/renderer.h"
 
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
+#include <optional>
 #include <vector>
 
 namespace clvr {
@@ -23,6 +25,9 @@ struct Stack2dOptions {
     int intermediate = 0;  // slices interpolated between two neighbouring stack slices (0: the stack itself)
     int reflectanceMapSize = 128;  // shaded ("lights" in the scene): n, 6 n^2 shades (host/reflectance_map.h)
     int slicesPerPolygon = 1;      // slices one quad stands for (seeds/003's multi-texture speed-up)
+    // options.clip_texture (as slice3d's, host/clip_texture.h): samples the second texture calls
+    // clipped are not drawn (iso-surfaces: are no hit). docs/stack2d.md, "Clip textures".
+    std::optional<ClipTextureSpec> clipTexture;
 };
 
 // Reads the scene's "options" for stack2d. Throws InputError naming the key ("options.intermediate: ...").
