@@ -5,7 +5,9 @@
 // (the paper's shading of semi-transparent volumes, with planes/blend's Phong model and reflectance
 // map); with "iso", a shaded iso-surface through the alpha test. Intermediate slices between two stack
 // slices lerp the bilinear samples of both (the paper's multi-texture combiner), so their sampling is
-// trilinear. Pass by pass through raster::draw with kernels/stack2d.cl as fragment program.
+// trilinear. With options.clip_texture (slice3d's, host/clip_texture.h), a second "stencil" texture
+// drops the samples it calls clipped (seeds/003's clipping with arbitrary clipping geometry). Pass by
+// pass through raster::draw with kernels/stack2d.cl as fragment program.
 // docs/stack2d.md.
 #pragma once
 
