@@ -26,13 +26,54 @@
  * fastest): 1 channel, the value, returned as (v, v, v, v); or, shaded, 4 channels (gradient, value)
  * from host/gradient_volume.h. buffer[1] the transfer function (transfer_function.h); buffer[2] the
  * reflectance map (reflectance_map.h), shaded only; buffer[3] the slice table (float4 per slice:
- * world coordinate on the axis, lower, weight, thickness), several slices per polygon only.
+ * world coordinate on the axis, lower, weight, thickness), several slices per polygon only, followed
+ * by the clip texture's texels (clip textures, below: uniforms 18..22, attr[2]).
  * Sample: bilinear in each slice; an intermediate slice lerps two bilinear samples, the paper's
  * register-combiner step, which makes the sample (and the gradient) trilinear. Classified after
  * interpolation; shaded, the color is C times the map's shade of the interpolated gradient (the
  * model of host/reflectance_map.h, as planes and blend; tau is not shaded);
  * alpha = 1 - exp(-tau Delta) with Delta the ray's length through the slab, thickness / |cos| of
  * the angle between the pixel's ray and the axis. Output premultiplied (C alpha, alpha). */
+
+/* Clip texture (seeds/003, "Clipping with arbitrary clipping geometry"; host/clip_texture.h, as
+ * slice3d): with CLVR_STACK2D_CLIP_TEXTURE defined, a second, one-channel texture (negative inside,
+ * linear filtering, clamp to edge) decides per sample whether it is drawn. uniforms 18 (width,
+ * height, depth, 1 if inverse), 19..21 the rows of world -> clip-texture coordinates
+ * (clipTextureCoordinates), 22 (offset of the texels in buffer[3], in floats, 0, 0, 0); buffer[3]
+ * holds the slice table (several slices per polygon; empty otherwise) followed by the texels. One
+ * slice per quad: attr[2] = the clip-texture coordinates of the fragment's point on the slice
+ * (perspective-correct; affine in the point, so exact up to rounding), and a clipped fragment is
+ * discarded. Several slices per polygon: the coordinates of the ray's hit point p on each slice,
+ * a clipped sample skipped. Iso-surfaces: a clipped sample is no hit. */
+#ifdef CLVR_STACK2D_CLIP_TEXTURE
+/* slice3d_clip_keep of kernels/slice3d.cl: 1 when the sample at clip-texture coordinates uc is
+ * drawn — inside the box of texel centers with a filtered value < 0, or not that when inverse. */
+static int stack2d_clip_keep(const ClFragmentResources* r, const float3 uc)
+{
+    constant float4* u = r->uniforms;
+    ClTexture t;
+    t.width = (uint)u[18].x;
+    t.height = (uint)u[18].y;
+    t.depth = (uint)u[18].z;
+    t.channels = 1u;
+    t.filter = CLVR_FILTER_LINEAR;
+    t.wrap = CLVR_WRAP_CLAMP_TO_EDGE;
+    t.pad0 = t.pad1 = 0u;
+    t.border = (float4)(0.0f);
+    global const float* texels = r->buffer[3] + (size_t)u[22].x;
+    const float3 n = (float3)((float)t.width, (float)t.height, (float)t.depth);
+    const float3 x = uc * n;
+    const int in_box = all(x >= 0.5f) && all(x <= n - 0.5f);
+    const int inside = in_box && clvr_tex3d(texels, t, (float4)(uc, 0.0f)).x < 0.0f;
+    return inside != (int)u[18].w;
+}
+
+/* World point p -> clip-texture coordinates (uniforms 19..21, affine). */
+static float3 stack2d_clip_coordinates(constant float4* u, const float3 p)
+{
+    return (float3)(dot(u[19].xyz, p) + u[19].w, dot(u[20].xyz, p) + u[20].w, dot(u[21].xyz, p) + u[21].w);
+}
+#endif
 
 /* The stack's slices as one 2D texture each (uniform 7). */
 static ClTexture stack2d_slice_texture(constant float4* u)
@@ -111,6 +152,10 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
     if (count == 0) {
         /* One slice per quad: lower and weight are interpolated constants: round lower, take weight as
          * it comes (its rounding error is a few ulp). */
+#ifdef CLVR_STACK2D_CLIP_TEXTURE
+        if (!stack2d_clip_keep(r, f->attr[2].xyz))
+            return 0;
+#endif
         const float4 sample =
             stack2d_fetch(r->buffer[0], slice, (int)round(f->attr[0].z), f->attr[0].w, f->attr[0].xy);
         *color = iso ? stack2d_iso_shade(u, sample) : stack2d_classify(r, sample, f->attr[1].x / cos_theta);
@@ -142,6 +187,10 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
         const float2 bc = (float2)(dot(p, u[13].xyz), dot(p, u[14].xyz));
         if (bc.x < u[15].x || bc.x > u[15].z || bc.y < u[15].y || bc.y > u[15].w)
             continue;
+#ifdef CLVR_STACK2D_CLIP_TEXTURE
+        if (!stack2d_clip_keep(r, stack2d_clip_coordinates(u, p)))
+            continue;
+#endif
         const float2 uv = u[16].xy + (bc - u[15].xy) / (u[15].zw - u[15].xy) * (u[16].zw - u[16].xy);
         const float4 sample = stack2d_fetch(r->buffer[0], slice, (int)e.y, e.z, uv);
         if (iso) {

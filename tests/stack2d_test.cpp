@@ -120,7 +120,7 @@ void expectInputError(const json& options, const std::string& fragment)
 
 TEST(Stack2dOptions, BadOptionsThrowInputErrorNamingTheKey)
 {
-    expectInputError({{"foo", 1}}, "options.foo: unknown option for stack2d (known: intermediate, reflectance_map_size, slices_per_polygon)");
+    expectInputError({{"foo", 1}}, "options.foo: unknown option for stack2d (known: intermediate, reflectance_map_size, slices_per_polygon, clip_texture)");
     expectInputError({{"slices_per_polygon", 0}}, "options.slices_per_polygon: must be an integer in [1, 64], got 0");
     expectInputError({{"slices_per_polygon", 65}}, "options.slices_per_polygon");
     EXPECT_EQ(parseStack2dOptions({{"slices_per_polygon", 4}}).slicesPerPolygon, 4);

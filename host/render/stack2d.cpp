@@ -29,7 +29,7 @@ namespace {
 constexpr int kMaxIntermediate = 64;
 constexpr int kMaxMapSize = 1024;
 constexpr int kMaxSlicesPerPolygon = 64;
-constexpr const char* kKnownOptions = "intermediate, reflectance_map_size, slices_per_polygon";
+constexpr const char* kKnownOptions = "intermediate, reflectance_map_size, slices_per_polygon, clip_texture";
 constexpr const char* kAxisNames[3] = {"x", "y", "z"};
 
 // The stack along `axis`: slice i (grid index i on that axis) is a 2D texture over the other two
@@ -89,7 +89,10 @@ private:
     int axis_ = 2;
     std::vector<StackSlice> slices_;
     SliceGroups grouped_;  // slices_per_polygon > 1 only
-    cl::Buffer sliceTable_;
+    cl::Buffer sliceTable_;  // buffer[3]: the slice table (slices_per_polygon > 1), then the clip texels
+    // Clip texture: the texture and world -> clip-texture coordinates.
+    std::optional<ClipTexture> clipTexture_;
+    glm::dmat4 clipCoordinates_{1.0};
     std::vector<raster::Texture> stacks_;  // x, y, z: all three stay resident, as on the paper's boards
     cl::Buffer tf_, map_;
     std::size_t tfBytes_ = 0;
@@ -132,6 +135,11 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
         iso.dataMax = *mx;
         iso_ = iso;
     }
+    if (options_.clipTexture) {
+        clipTexture_ = makeClipTexture(*options_.clipTexture, scene.baseDir);
+        clipCoordinates_ =
+            clipTextureCoordinates(*clipTexture_, options_.clipTexture->offset, options_.clipTexture->matrix);
+    }
     axis_ = stackAxis(camera_);
     slices_ = planStack(camera_, origin_, spacing_, dims_, axis_, options_.intermediate);
 
@@ -169,7 +177,8 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
     for (const EmbeddedKernel& k : embeddedKernels())
         if (k.name == "stack2d.cl")
             source = k.source;
-    fragmentProgram_.source = "#define CLVR_STACK2D_FRAGMENT 1\n" + std::string(source);
+    fragmentProgram_.source = "#define CLVR_STACK2D_FRAGMENT 1\n" +
+                              std::string(clipTexture_ ? "#define CLVR_STACK2D_CLIP_TEXTURE 1\n" : "") + std::string(source);
     fragmentProgram_.buffers[0] = stacks_[axis_].buffer();
     glm::vec4 axisVector(0.0f);
     axisVector[axis_] = 1.0f;
@@ -195,15 +204,28 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
         isoFinish_ = device_.kernel("stack2d.cl", "stack2d_iso_finish");
     }
     fragmentProgram_.buffers[2] = map_;
+    // buffer[3]: the slice table (several slices per polygon), then the clip texels (four buffers in
+    // all, and the reflectance map takes the third): one upload, the texels at a float offset.
+    std::vector<glm::vec4> table;
     if (options_.slicesPerPolygon > 1) {
         grouped_ = groupStackSlices(slices_, camera_, origin_, spacing_, axis_, options_.slicesPerPolygon);
-        std::vector<glm::vec4> table;
         for (const StackSlice& slice : grouped_.slices)
             table.emplace_back(static_cast<float>(origin_[axis_] + slice.position * spacing_[axis_]),
                                static_cast<float>(slice.lower), slice.weight, static_cast<float>(slice.thickness));
+    }
+    if (clipTexture_) {
+        std::vector<float> packed(reinterpret_cast<const float*>(table.data()),
+                                  reinterpret_cast<const float*>(table.data() + table.size()));
+        packed.insert(packed.end(), clipTexture_->texels.begin(), clipTexture_->texels.end());
+        sliceTable_ = device_.upload("stack2d slice table and clip texture", packed);
+        residentBytes_ += packed.size() * sizeof(float);
+        fragmentProgram_.buffers[3] = sliceTable_;
+    } else if (!table.empty()) {
         sliceTable_ = device_.upload("stack2d slice table", table);
         residentBytes_ += table.size() * sizeof(glm::vec4);
         fragmentProgram_.buffers[3] = sliceTable_;
+    }
+    if (options_.slicesPerPolygon > 1) {
         glm::vec4 eb(0.0f), ec(0.0f);
         eb[s.b] = 1.0f;
         ec[s.c] = 1.0f;
@@ -217,6 +239,17 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
         fragmentProgram_.uniforms.push_back(glm::vec4(0.5f / dims_[s.b], 0.5f / dims_[s.c], (dims_[s.b] - 0.5f) / dims_[s.b],
                                                       (dims_[s.c] - 0.5f) / dims_[s.c]));  // 16, as the quads' corners
         fragmentProgram_.uniforms.push_back(glm::vec4(static_cast<float>(alphaRef), 0.0f, 0.0f, 0.0f));  // 17
+    }
+    if (clipTexture_) {
+        fragmentProgram_.uniforms.resize(18, glm::vec4(0.0f));  // 13..17 unused with one slice per quad
+        const glm::ivec3 n = clipTexture_->dims();
+        fragmentProgram_.uniforms.push_back(glm::vec4(n.x, n.y, n.z, options_.clipTexture->inverse ? 1.0f : 0.0f));  // 18
+        for (int r = 0; r < 3; ++r)  // 19..21: the rows of world -> clip-texture coordinates
+            fragmentProgram_.uniforms.push_back(glm::vec4(static_cast<float>(clipCoordinates_[0][r]),
+                                                          static_cast<float>(clipCoordinates_[1][r]),
+                                                          static_cast<float>(clipCoordinates_[2][r]),
+                                                          static_cast<float>(clipCoordinates_[3][r])));
+        fragmentProgram_.uniforms.push_back(glm::vec4(static_cast<float>(table.size() * 4), 0.0f, 0.0f, 0.0f));  // 22
     }
     fragmentProgram_.uniforms[5].z = static_cast<float>(scene.transferFunction.points().size());
     fragmentProgram_.buffers[1] = tf_;
@@ -283,6 +316,8 @@ Image4f Stack2dRenderer::render(FrameStats& stats)
             v.position = glm::vec4(viewProjection * glm::dvec4(p, 1.0));
             v.attributes[0] = glm::vec4(static_cast<float>(uv.x), static_cast<float>(uv.y), lower, weight);
             v.attributes[1] = attribute1;
+            if (clipTexture_)  // the second texture's coordinates of the slice point (one slice per quad)
+                v.attributes[2] = glm::vec4(glm::vec3(clipCoordinates_ * glm::dvec4(p, 1.0)), 1.0f);
             vertices.push_back(v);
         }
     };
@@ -380,6 +415,12 @@ Image4f Stack2dRenderer::render(FrameStats& stats)
     stats.extra["triangles"] = drawStats.triangles;
     stats.extra["voxels"] = static_cast<std::uint64_t>(dims_.x) * dims_.y * dims_.z;
     stats.extra["resident_bytes"] = residentBytes_;
+    if (clipTexture_) {
+        const glm::ivec3 n = clipTexture_->dims();
+        stats.extra["clip_texture"] = clipTexture_->source;
+        stats.extra["clip_texture_dims"] = {n.x, n.y, n.z};
+        stats.extra["clip_texture_inverse"] = options_.clipTexture->inverse;
+    }
     return image;
 }
 
@@ -395,6 +436,8 @@ Stack2dOptions parseStack2dOptions(const nlohmann::json& options)
             o.reflectanceMapSize = integerOption(key, value, 1, kMaxMapSize);
         else if (key == "slices_per_polygon")
             o.slicesPerPolygon = integerOption(key, value, 1, kMaxSlicesPerPolygon);
+        else if (key == "clip_texture")
+            o.clipTexture = parseClipTextureSpec(value, "options.clip_texture");
         else
             badOption(key, std::string("unknown option for stack2d (known: ") + kKnownOptions + ")");
     });

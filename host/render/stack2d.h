@@ -5,16 +5,20 @@
 // (the paper's shading of semi-transparent volumes, with planes/blend's Phong model and reflectance
 // map); with "iso", a shaded iso-surface through the alpha test. Intermediate slices between two stack
 // slices lerp the bilinear samples of both (the paper's multi-texture combiner), so their sampling is
-// trilinear. Pass by pass through raster::draw with kernels/stack2d.cl as fragment program.
+// trilinear. With options.clip_texture (slice3d's, host/clip_texture.h), a second "stencil" texture
+// drops the samples it calls clipped (seeds/003's clipping with arbitrary clipping geometry). Pass by
+// pass through raster::draw with kernels/stack2d.cl as fragment program.
 // docs/stack2d.md.
 #pragma once
 
 #include "host/camera.h"
+#include "host/clip_texture.h"
 #include "host/render/renderer.h"
 
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
+#include <optional>
 #include <vector>
 
 namespace clvr {
@@ -23,6 +27,9 @@ struct Stack2dOptions {
     int intermediate = 0;  // slices interpolated between two neighbouring stack slices (0: the stack itself)
     int reflectanceMapSize = 128;  // shaded ("lights" in the scene): n, 6 n^2 shades (host/reflectance_map.h)
     int slicesPerPolygon = 1;      // slices one quad stands for (seeds/003's multi-texture speed-up)
+    // options.clip_texture (as slice3d's, host/clip_texture.h): samples the second texture calls
+    // clipped are not drawn (iso-surfaces: are no hit). docs/stack2d.md, "Clip textures".
+    std::optional<ClipTextureSpec> clipTexture;
 };
 
 // Reads the scene's "options" for stack2d. Throws InputError naming the key ("options.intermediate: ...").
