@@ -312,8 +312,8 @@ TEST(BenchRegular, ScenesAreValidAndPairsDifferOnlyWhereTheyShould)
     std::sort(listed.begin(), listed.end());
     EXPECT_EQ(listed, present);
     // 3 volumes x (iso3d, bricked iso3d, 3 stacks, raster baseline, clip mesh, fused baseline, clip
-    // texture) + the gradientless engine + spherical
-    ASSERT_EQ(files.size(), 29u);
+    // texture) + the gradientless engine + the clipped stack on the engine + spherical
+    ASSERT_EQ(files.size(), 30u);
     for (const auto& file : files) {
         const clvr::Scene scene = clvr::loadScene(file);
         const std::string name = file.filename().string();
@@ -335,6 +335,8 @@ TEST(BenchRegular, ScenesAreValidAndPairsDifferOnlyWhereTheyShould)
             differsOnlyIn("reg-slice3d-raster-" + name.substr(9), "/clip");
         if (name.ends_with("-bricked.json"))
             differsOnlyIn(name.substr(0, name.size() - 13) + ".json", "/brick_budget");
+        if (name.ends_with("-k1-cliptex.json"))
+            differsOnlyIn(name.substr(0, name.size() - 13) + ".json", "/clip_texture");
         if (name.starts_with("reg-cliptex-"))
             differsOnlyIn("reg-slice3d-" + name.substr(12), "/clip_texture");
         if (name.ends_with("-k1.json"))

@@ -34,6 +34,8 @@ std::vector<std::string> benchSuiteScenes(const std::string& suite)
             regular.push_back("reg-iso3d-engine-gradientless.json");
         for (const char* suffix : {"", "-k1", "-k1-p4"})
             regular.push_back(std::string("reg-stack2d-") + volume + suffix + ".json");
+        if (std::string(volume) == "engine")
+            regular.push_back("reg-stack2d-engine-k1-cliptex.json");
         regular.push_back(std::string("reg-slice3d-raster-") + volume + ".json");
         regular.push_back(std::string("reg-clip-") + volume + ".json");
         regular.push_back(std::string("reg-slice3d-") + volume + ".json");

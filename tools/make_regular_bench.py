@@ -16,6 +16,7 @@ Per volume:
   reg-stack2d-V          stack2d, plain bilinear slices of the stack (seeds/003)
   reg-stack2d-V-k1       stack2d, one lerped intermediate slice between stack slices (trilinear again)
   reg-stack2d-V-k1-p4    the same with four slices per polygon (seeds/003's multi-texture speed-up)
+  reg-stack2d-engine-k1-cliptex  (engine only) reg-stack2d-engine-k1 clipped by the clip texture below
   reg-slice3d-raster-V   slice3d through the raster stage, 256 slices: the baseline of the clip rows
   reg-clip-V             the same with a sphere clip mesh, two-pass stencil (seeds/000 §2.1)
   reg-slice3d-V          slice3d's default fused path, 256 slices: the baseline of the next row
@@ -84,6 +85,10 @@ def scenes():
         out.append(("reg-stack2d-%s-k1.json" % volume, translucent_scene(volume, "stack2d", {"intermediate": 1})))
         out.append(("reg-stack2d-%s-k1-p4.json" % volume,
                     translucent_scene(volume, "stack2d", {"intermediate": 1, "slices_per_polygon": 4})))
+        if volume == "engine":
+            out.append(("reg-stack2d-engine-k1-cliptex.json",
+                        translucent_scene(volume, "stack2d", {"intermediate": 1, "clip_texture": {
+                            "shape": "sphere", "center": center, "radius": radius, "inverse": True}})))
         out.append(("reg-slice3d-raster-%s.json" % volume,
                     translucent_scene(volume, "slice3d", {"slices": 256, "path": "raster"})))
         out.append(("reg-clip-%s.json" % volume,
