@@ -78,7 +78,7 @@ TEST(SphericalOptions, BadOptionsAreOneClearLine)
         {{{"shells", -3}}, "options.shells: must be an integer in [2, 4096], got -3"},
         {{{"shells", 1}}, "options.shells: must be an integer in [2, 4096], got 1"},
         {{{"shells", 2.5}}, "options.shells: must be an integer in [2, 4096], got 2.5"},
-        {{{"segments", 3}}, "options.segments: must be an integer in [4, 4096], got 3"},
+        {{{"segments", 3}}, "options.segments: must be an integer in [4, 1024], got 3"},
         {{{"r_min", 1.0}, {"r_max", 1.0}}, "options.r_max: must be greater than r_min (1.000000), got 1.000000"},
         {{{"r_min", 2.0}}, "options.r_max: must be greater than r_min (2.000000), got 1.000000"},
         {{{"r_min", -0.5}}, "options.r_min: must be >= 0, got -0.5"},

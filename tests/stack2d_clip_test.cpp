@@ -279,6 +279,38 @@ TEST(Stack2dClip, AClipTextureHoldingTheVolumeChangesNothing)
             }
 }
 
+// Moving the clip texture between frames (setStack2dClipPlacement) changes only texture coordinates:
+// the next frame is bit-identical to a new renderer made with that placement, on both paths; moving it
+// back gives the first image again; a renderer without a clip texture, or a singular matrix, is an
+// InputError.
+TEST(Stack2dClip, MovingTheClipBetweenFramesGivesTheImageOfANewRenderer)
+{
+    const json sphere = {{"shape", "sphere"}, {"center", {0.1, -0.1, 0.2}}, {"radius", 0.55}};
+    const glm::dvec3 offset(0.2, 0.1, -0.15);
+    const glm::dmat3 matrix(glm::dvec3(1.0, 0.0, 0.0), glm::dvec3(0.1, 0.9, 0.0), glm::dvec3(0.0, 0.0, 1.1));
+    for (const int k : {1, 3}) {
+        const Scene scene = makeScene(perspectiveCamera(), sphere, k);
+        auto renderer = makeRenderer(test::device(), scene, marschnerLobb41());
+        FrameStats stats;
+        const Image4f first = renderer->render(stats);
+        setStack2dClipPlacement(*renderer, offset, matrix);
+        const Image4f moved = renderer->render(stats);
+        Scene movedScene = scene;
+        movedScene.options["clip_texture"]["offset"] = {offset.x, offset.y, offset.z};
+        movedScene.options["clip_texture"]["matrix"] = {{1.0, 0.1, 0.0}, {0.0, 0.9, 0.0}, {0.0, 0.0, 1.1}};  // rows
+        const Image4f fresh = render(movedScene);
+        const std::size_t bytes = first.pixels().size() * sizeof(glm::vec4);
+        EXPECT_EQ(std::memcmp(moved.pixels().data(), fresh.pixels().data(), bytes), 0) << "k " << k;
+        EXPECT_NE(std::memcmp(moved.pixels().data(), first.pixels().data(), bytes), 0) << "k " << k << ": it moved";
+        setStack2dClipPlacement(*renderer, glm::dvec3(0.0));
+        const Image4f back = renderer->render(stats);
+        EXPECT_EQ(std::memcmp(back.pixels().data(), first.pixels().data(), bytes), 0) << "k " << k;
+        EXPECT_THROW(setStack2dClipPlacement(*renderer, offset, glm::dmat3(0.0)), InputError);
+    }
+    auto unclipped = makeRenderer(test::device(), makeScene(perspectiveCamera(), json(), 1), marschnerLobb41());
+    EXPECT_THROW(setStack2dClipPlacement(*unclipped, offset), InputError);
+}
+
 // Iso-surfaces: a clipped sample is no hit. The surface 0.5 of "sphere" (1 - |p|) is the sphere of
 // radius 0.5; clipped to the sphere of radius 0.3 about the center, every kept sample lies inside the
 // surface (value >= 0.7), so a pixel is covered exactly where its ray meets the clip sphere on a

@@ -19,7 +19,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr int kMaxShells = 4096;
-constexpr int kMaxSegments = 4096;
+constexpr int kMaxSegments = 1024;  // 1024 x 512 x 2 = 1 M triangles (240 MB of vertices) per shell
 constexpr const char* kKnownOptions = "shells, segments, r_min, r_max, center, color_matrix, scale, bias, opacity";
 
 double finiteNumber(const std::string& key, const nlohmann::json& value)

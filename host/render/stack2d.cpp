@@ -66,8 +66,11 @@ public:
     Image4f render(FrameStats& stats) override;
     std::uint64_t residentBytes() const override { return residentBytes_; }
     void setTransferFunction(const TransferFunction& tf) override;
+    void setClipPlacement(const glm::dvec3& offset, const glm::dmat3& matrix);
 
 private:
+    void setClipCoordinateUniforms();
+
     Device& device_;
     Stack2dOptions options_;
     Camera camera_;
@@ -244,15 +247,34 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
         fragmentProgram_.uniforms.resize(18, glm::vec4(0.0f));  // 13..17 unused with one slice per quad
         const glm::ivec3 n = clipTexture_->dims();
         fragmentProgram_.uniforms.push_back(glm::vec4(n.x, n.y, n.z, options_.clipTexture->inverse ? 1.0f : 0.0f));  // 18
-        for (int r = 0; r < 3; ++r)  // 19..21: the rows of world -> clip-texture coordinates
-            fragmentProgram_.uniforms.push_back(glm::vec4(static_cast<float>(clipCoordinates_[0][r]),
-                                                          static_cast<float>(clipCoordinates_[1][r]),
-                                                          static_cast<float>(clipCoordinates_[2][r]),
-                                                          static_cast<float>(clipCoordinates_[3][r])));
+        fragmentProgram_.uniforms.resize(22, glm::vec4(0.0f));  // 19..21: setClipCoordinateUniforms
+        setClipCoordinateUniforms();
         fragmentProgram_.uniforms.push_back(glm::vec4(static_cast<float>(table.size() * 4), 0.0f, 0.0f, 0.0f));  // 22
     }
     fragmentProgram_.uniforms[5].z = static_cast<float>(scene.transferFunction.points().size());
     fragmentProgram_.buffers[1] = tf_;
+}
+
+// Uniforms 19..21: the rows of world -> clip-texture coordinates (the several-slices path maps the
+// ray's hit points with them; the one-slice path's vertices carry the mapped points, made per frame).
+void Stack2dRenderer::setClipCoordinateUniforms()
+{
+    for (int r = 0; r < 3; ++r)
+        fragmentProgram_.uniforms[19 + r] =
+            glm::vec4(static_cast<float>(clipCoordinates_[0][r]), static_cast<float>(clipCoordinates_[1][r]),
+                      static_cast<float>(clipCoordinates_[2][r]), static_cast<float>(clipCoordinates_[3][r]));
+}
+
+void Stack2dRenderer::setClipPlacement(const glm::dvec3& offset, const glm::dmat3& matrix)
+{
+    if (!clipTexture_)
+        throw InputError("stack2d: no clip texture to move (options.clip_texture is not given)");
+    if (!(std::abs(glm::determinant(matrix)) > 0.0))
+        throw InputError("stack2d: the clip texture's matrix must be invertible");
+    options_.clipTexture->offset = offset;
+    options_.clipTexture->matrix = matrix;
+    clipCoordinates_ = clipTextureCoordinates(*clipTexture_, offset, matrix);
+    setClipCoordinateUniforms();
 }
 
 void Stack2dRenderer::setTransferFunction(const TransferFunction& tf)
@@ -504,6 +526,14 @@ SliceGroups groupStackSlices(const std::vector<StackSlice>& drawOrder, const Cam
 std::unique_ptr<Renderer> makeStack2dRenderer(Device& device, const Scene& scene, const Volume& volume)
 {
     return std::make_unique<Stack2dRenderer>(device, scene, volume);
+}
+
+void setStack2dClipPlacement(Renderer& renderer, const glm::dvec3& offset, const glm::dmat3& matrix)
+{
+    auto* stack2d = dynamic_cast<Stack2dRenderer*>(&renderer);
+    if (!stack2d)
+        throw InputError("setStack2dClipPlacement: the renderer is not stack2d");
+    stack2d->setClipPlacement(offset, matrix);
 }
 
 }  // namespace clvr

@@ -75,4 +75,10 @@ SliceGroups groupStackSlices(const std::vector<StackSlice>& drawOrder, const Cam
 // Sobel gradient: 3 x 16 bytes) and the packed transfer function (and the reflectance map); throws InputError for bad options, DeviceError when the stacks do not fit.
 std::unique_ptr<Renderer> makeStack2dRenderer(Device& device, const Scene& scene, const Volume& volume);
 
+// Moves the clip texture of a stack2d renderer made with options.clip_texture for the following frames,
+// as slice3d's setSlice3dClipPlacement does: only texture coordinates change; the next frame is
+// bit-identical to a new renderer's with that placement. InputError for another renderer, one without
+// a clip texture, or a singular matrix.
+void setStack2dClipPlacement(Renderer& renderer, const glm::dvec3& offset, const glm::dmat3& matrix = glm::dmat3(1.0));
+
 }  // namespace clvr
