@@ -11,6 +11,7 @@
 #include "host/reference_integral.h"
 #include "host/render/renderer.h"
 #include "host/render/slice3d.h"
+#include "tests/clip_reference.h"
 #include "tests/test_util.h"
 
 #include <algorithm>
@@ -72,40 +73,10 @@ Image4f render(const Scene& scene, FrameStats* stats = nullptr)
 
 ClipTextureSpec specOf(const Scene& scene) { return *parseSlice3dOptions(scene.options).clipTexture; }
 
-Image4d referenceOver(const Scene& scene,
-                      const std::function<std::vector<glm::dvec2>(const Ray&, double, double)>& intervals)
-{
-    ReferenceStats stats;
-    ReferenceOptions options;
-    options.stats = &stats;
-    options.intervals = intervals;
-    Image4d image = referenceIntegral(marschnerLobb41(), scene.transferFunction, *scene.camera, scene.image, options);
-    EXPECT_EQ(stats.raysNotConverged, 0u);
-    return image;
-}
+// The references of tests/clip_reference.h for this file's volume and the scene's clip texture.
+Image4d shapeReference(const Scene& scene) { return test::shapeClipReference(marschnerLobb41(), scene, specOf(scene)); }
 
-// The reference integral over the exact parts of each ray inside the placed shape (outside: inverse).
-Image4d shapeReference(const Scene& scene)
-{
-    const ClipTextureSpec spec = specOf(scene);
-    return referenceOver(scene, [&](const Ray& ray, double t0, double t1) { return shapeClipIntervals(spec, ray, t0, t1); });
-}
-
-// The reference integral over the parts of each ray where the texture itself says inside (its
-// trilinear value < 0 in double, within its box), crossings found by 1/16-texel steps and bisection.
-Image4d textureReference(const Scene& scene)
-{
-    const ClipTextureSpec spec = specOf(scene);
-    const ClipTexture texture = makeClipTexture(spec, scene.baseDir);
-    const glm::dmat4 coordinates = clipTextureCoordinates(texture, spec.offset, spec.matrix);
-    // A matrix that shrinks the texture shrinks its texels in the world: scale the step down by it.
-    const glm::dmat3 inv = glm::inverse(spec.matrix);
-    const double stretch = std::max(1.0, std::sqrt(glm::dot(inv[0], inv[0]) + glm::dot(inv[1], inv[1]) + glm::dot(inv[2], inv[2])));
-    const double step = std::min({texture.spacing.x, texture.spacing.y, texture.spacing.z}) / 16.0 / stretch;
-    return referenceOver(scene, [&](const Ray& ray, double t0, double t1) {
-        return textureClipIntervals(texture, coordinates, spec.inverse, ray, t0, t1, step);
-    });
-}
+Image4d textureReference(const Scene& scene) { return test::textureClipReference(marschnerLobb41(), scene, specOf(scene)); }
 
 void report(const std::string& label, const test::ImageError& e, const test::Tolerance& t)
 {

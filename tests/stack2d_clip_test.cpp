@@ -12,6 +12,7 @@
 #include "host/reference_integral.h"
 #include "host/render/renderer.h"
 #include "host/render/stack2d.h"
+#include "tests/clip_reference.h"
 #include "tests/test_util.h"
 
 #include <algorithm>
@@ -36,20 +37,12 @@ TransferFunction mlTransferFunction()
 // The cameras of tests/stack2d_test.cpp (z stack, and x stack for the parallel one).
 Camera perspectiveCamera()
 {
-    Camera c;
-    c.position = {1.2, 1.6, 3.7};
-    c.viewAngle = 40.0;
-    return c;
+    return test::obliquePerspectiveCamera(40.0);
 }
 
 Camera parallelCamera()
 {
-    Camera c;
-    c.position = {3.5, 1.0, 1.9};
-    c.viewUp = {0.0, 0.0, 1.0};
-    c.parallel = true;
-    c.parallelScale = 1.8;
-    return c;
+    return test::obliqueParallelCamera(1.8);
 }
 
 const Volume& marschnerLobb41()
@@ -83,37 +76,10 @@ Image4f render(const Scene& scene, const Volume& volume = marschnerLobb41(), Fra
 
 ClipTextureSpec specOf(const Scene& scene) { return *parseStack2dOptions(scene.options).clipTexture; }
 
-Image4d referenceOver(const Scene& scene,
-                      const std::function<std::vector<glm::dvec2>(const Ray&, double, double)>& intervals)
-{
-    ReferenceStats stats;
-    ReferenceOptions options;
-    options.stats = &stats;
-    options.intervals = intervals;
-    Image4d image = referenceIntegral(marschnerLobb41(), scene.transferFunction, *scene.camera, scene.image, options);
-    EXPECT_EQ(stats.raysNotConverged, 0u);
-    return image;
-}
+// The references of tests/clip_reference.h for this file's volume and the scene's clip texture.
+Image4d shapeReference(const Scene& scene) { return test::shapeClipReference(marschnerLobb41(), scene, specOf(scene)); }
 
-// The reference integral over the exact parts of each ray inside the placed shape (outside: inverse).
-Image4d shapeReference(const Scene& scene)
-{
-    const ClipTextureSpec spec = specOf(scene);
-    return referenceOver(scene, [&](const Ray& ray, double t0, double t1) { return shapeClipIntervals(spec, ray, t0, t1); });
-}
-
-// The reference integral where the texture itself says inside (tests/clip_texture_test.cpp's: its
-// crossings found by 1/16-texel steps and bisection). Placements here do not shrink the texture.
-Image4d textureReference(const Scene& scene)
-{
-    const ClipTextureSpec spec = specOf(scene);
-    const ClipTexture texture = makeClipTexture(spec, scene.baseDir);
-    const glm::dmat4 coordinates = clipTextureCoordinates(texture, spec.offset, spec.matrix);
-    const double step = std::min({texture.spacing.x, texture.spacing.y, texture.spacing.z}) / 16.0;
-    return referenceOver(scene, [&](const Ray& ray, double t0, double t1) {
-        return textureClipIntervals(texture, coordinates, spec.inverse, ray, t0, t1, step);
-    });
-}
+Image4d textureReference(const Scene& scene) { return test::textureClipReference(marschnerLobb41(), scene, specOf(scene)); }
 
 // Smallest |cos| between a pixel's ray and the stack axis over the image: the longest slab.
 double minCos(const Camera& camera, int size, int axis)

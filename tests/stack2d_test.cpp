@@ -31,20 +31,12 @@ constexpr double kTauMax = 8.0;
 
 Camera perspectiveCamera()  // the camera of tests/slice3d_test.cpp: 28 degrees off the z axis
 {
-    Camera c;
-    c.position = {1.2, 1.6, 3.7};
-    c.viewAngle = 40.0;
-    return c;
+    return test::obliquePerspectiveCamera(40.0);
 }
 
 Camera parallelCamera()  // ... and its parallel one: x stack, 32 degrees off the x axis
 {
-    Camera c;
-    c.position = {3.5, 1.0, 1.9};
-    c.viewUp = {0.0, 0.0, 1.0};
-    c.parallel = true;
-    c.parallelScale = 1.8;
-    return c;
+    return test::obliqueParallelCamera(1.8);
 }
 
 Scene makeScene(const Camera& camera, int size, json options = json::object())
