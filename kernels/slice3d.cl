@@ -7,6 +7,7 @@
 //    program of the pass-by-pass path (the specification): one fragment per slice and pixel.
 // The host has validated everything; this file only does arithmetic.
 #include "clvr_common.h"
+#include "clip_texture.h"
 #include "texture.h"
 #include "transfer_function.h"
 #include "volume_sampling.h"
@@ -42,20 +43,6 @@ float slice3d_stretch(const float2 ndc, const float4 params)
         return 1.0f;
     const float sx = ndc.x * params.x * params.y, sy = ndc.y * params.x;
     return sqrt(1.0f + sx * sx + sy * sy);
-}
-
-/* Clip texture (seeds/003, "Clipping with arbitrary clipping geometry"; host/clip_texture.h): a second,
- * one-channel texture, negative inside (a signed distance, or 0.5 - mask value), sampled with linear
- * filtering at the sample's clip-texture coordinates u (normalized, GL's: texel i centered at
- * (i + 0.5) / n). Inside: u within the box of texel centers and the filtered value < 0. Returns 1 when
- * the sample is drawn: inside, or outside when inverse is 1 (the alpha test on the mask). */
-int slice3d_clip_keep(global const float* texels, const ClTexture t, const float3 u, const int inverse)
-{
-    const float3 n = (float3)((float)t.width, (float)t.height, (float)t.depth);
-    const float3 x = u * n;
-    const int in_box = all(x >= 0.5f) && all(x <= n - 0.5f);
-    const int inside = in_box && clvr_tex3d(texels, t, (float4)(u, 0.0f)).x < 0.0f;
-    return inside != inverse;
 }
 
 #ifndef CLVR_SLICE3D_FRAGMENT
@@ -226,7 +213,7 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
             }
             ++taken;
 #ifdef SLICE3D_CLIP_TEXTURE
-            if (!slice3d_clip_keep(clip_texels, clip_tex, uo + (depth0 + (float)k * delta_s) * ud, clip_inverse))
+            if (!clvr_clip_keep(clip_texels, clip_tex, uo + (depth0 + (float)k * delta_s) * ud, clip_inverse))
                 continue;
 #endif
             const float4 ct = clvr_tf_eval(tf, tf_count, SLICE3D_TRILINEAR(volume, dims, g));
@@ -255,7 +242,7 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
             }
             ++taken;
 #ifdef SLICE3D_CLIP_TEXTURE
-            if (!slice3d_clip_keep(clip_texels, clip_tex, uo + (depth0 + (float)k * delta_s) * ud, clip_inverse))
+            if (!clvr_clip_keep(clip_texels, clip_tex, uo + (depth0 + (float)k * delta_s) * ud, clip_inverse))
                 continue;
 #endif
             const float4 ct = clvr_tf_eval(tf, tf_count, SLICE3D_TRILINEAR(volume, dims, g));
@@ -297,16 +284,7 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
 #ifdef CLVR_SLICE3D_CLIP_TEXTURE
     /* The second texture (multitexturing): attr[1] = clip-texture coordinates of the slice point;
      * uniform 9 = (width, height, depth, inverse) of buffer[2], one channel, linear, clamp to edge. */
-    ClTexture clip;
-    clip.width = (uint)u[9].x;
-    clip.height = (uint)u[9].y;
-    clip.depth = (uint)u[9].z;
-    clip.channels = 1u;
-    clip.filter = CLVR_FILTER_LINEAR;
-    clip.wrap = CLVR_WRAP_CLAMP_TO_EDGE;
-    clip.pad0 = clip.pad1 = 0u;
-    clip.border = (float4)(0.0f);
-    if (!slice3d_clip_keep(r->buffer[2], clip, f->attr[1].xyz, (int)u[9].w))
+    if (!clvr_clip_keep(r->buffer[2], clvr_clip_texture(u[9]), f->attr[1].xyz, (int)u[9].w))
         return 0;
 #endif
     const float2 ndc = slice3d_ndc(f->window, (int)u[5].x, (int)u[5].y);

@@ -3,6 +3,7 @@
 // defined, after kernels/raster.cl; compiled on its own (the offline syntax test) it pulls in
 // raster.cl itself, so that the fragment program is checked in the context it runs in.
 // The host has validated everything; this file only does arithmetic.
+#include "clip_texture.h"
 #include "transfer_function.h"
 #include "reflectance_map.h"
 #ifndef CLVR_STACK2D_FRAGMENT
@@ -46,26 +47,11 @@
  * discarded. Several slices per polygon: the coordinates of the ray's hit point p on each slice,
  * a clipped sample skipped. Iso-surfaces: a clipped sample is no hit. */
 #ifdef CLVR_STACK2D_CLIP_TEXTURE
-/* slice3d_clip_keep of kernels/slice3d.cl: 1 when the sample at clip-texture coordinates uc is
- * drawn — inside the box of texel centers with a filtered value < 0, or not that when inverse. */
+/* clvr_clip_keep (clip_texture.h) on the clip texture behind the slice table in buffer[3]. */
 static int stack2d_clip_keep(const ClFragmentResources* r, const float3 uc)
 {
     constant float4* u = r->uniforms;
-    ClTexture t;
-    t.width = (uint)u[18].x;
-    t.height = (uint)u[18].y;
-    t.depth = (uint)u[18].z;
-    t.channels = 1u;
-    t.filter = CLVR_FILTER_LINEAR;
-    t.wrap = CLVR_WRAP_CLAMP_TO_EDGE;
-    t.pad0 = t.pad1 = 0u;
-    t.border = (float4)(0.0f);
-    global const float* texels = r->buffer[3] + (size_t)u[22].x;
-    const float3 n = (float3)((float)t.width, (float)t.height, (float)t.depth);
-    const float3 x = uc * n;
-    const int in_box = all(x >= 0.5f) && all(x <= n - 0.5f);
-    const int inside = in_box && clvr_tex3d(texels, t, (float4)(uc, 0.0f)).x < 0.0f;
-    return inside != (int)u[18].w;
+    return clvr_clip_keep(r->buffer[3] + (size_t)u[22].x, clvr_clip_texture(u[18]), uc, (int)u[18].w);
 }
 
 /* World point p -> clip-texture coordinates (uniforms 19..21, affine). */
