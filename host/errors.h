@@ -1,5 +1,5 @@
-// host/errors.h — the three kinds of failure the library reports. Library code throws; only
-// tools/clvr.cpp prints and chooses an exit code (InputError: 2, DeviceError and BuildError: 3).
+// host/errors.h — the kinds of failure the library reports. Library code throws; only tools/clvr.cpp
+// prints and chooses an exit code (InputError: 2, DeviceError and BuildError: 3, InternalError: 4).
 #pragma once
 
 #include <stdexcept>
@@ -21,6 +21,13 @@ struct DeviceError : std::runtime_error {
 struct BuildError : DeviceError {
     BuildError(const std::string& what, std::string log) : DeviceError(what), log(std::move(log)) {}
     std::string log;
+};
+
+// A violated internal invariant: a bug in clvr (or in a program calling the library wrongly), never
+// the user's input or the device. Callers of the library check their arguments before passing them on;
+// whatever reaches a check that throws this is a programming error.
+struct InternalError : std::logic_error {
+    using logic_error::logic_error;
 };
 
 // The symbolic name of an OpenCL error code ("CL_OUT_OF_RESOURCES"), or "CL error N".

@@ -23,11 +23,14 @@ int main(int argc, char** argv)
     } catch (const cl::Error& e) {  // any other OpenCL call: its name and its code
         std::cerr << "clvr: error: " << e.what() << " failed: " << clvr::clErrorName(e.err()) << '\n';
         return 3;
+    } catch (const clvr::InternalError& e) {  // a bug, never the user's input: its own status
+        std::cerr << "clvr: internal error: " << e.what() << '\n';
+        return 4;
     } catch (const std::bad_alloc&) {
         std::cerr << "clvr: error: out of host memory\n";
         return 3;
     } catch (const std::exception& e) {
-        std::cerr << "clvr: error: internal: " << e.what() << '\n';
-        return 1;
+        std::cerr << "clvr: internal error: " << e.what() << '\n';
+        return 4;
     }
 }
