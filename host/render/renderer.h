@@ -83,7 +83,7 @@ const TechniqueInfo& technique(const std::string& name);
 // unknown technique (listing the known ones) or an unknown or invalid option.
 std::unique_ptr<Renderer> makeRenderer(Device& device, const Scene& scene, const Volume& volume);
 
-// The mesh technique the scene names ("harc"), set up on `device` for `mesh` (checked by checkMesh;
+// The mesh technique the scene names (DataKind::Mesh), set up on `device` for `mesh` (checked by checkMesh;
 // its adjacency is built here). Throws InputError as makeRenderer does.
 std::unique_ptr<Renderer> makeMeshRenderer(Device& device, const Scene& scene, const TetMesh& mesh);
 
