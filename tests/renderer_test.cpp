@@ -1,11 +1,11 @@
 // tests/renderer_test.cpp — the technique registry (host/render/renderer.h): every technique is listed
 // with a data kind, a line and its options; a technique accepts exactly the options it lists, and each
 // listed default, given explicitly, renders the same bits as leaving the option out.
-#include "host/errors.h"
-#include "host/generators.h"
-#include "host/mesh.h"
+#include "host/runtime/errors.h"
+#include "host/io/generators.h"
+#include "host/model/mesh.h"
 #include "host/render/renderer.h"
-#include "test_util.h"
+#include "tests/support/test_util.h"
 
 #include <gtest/gtest.h>
 

@@ -4,7 +4,7 @@
 // share (one name, one meaning, one check, one line of help), and a host vector as a cl_float4.
 #pragma once
 
-#include "host/errors.h"
+#include "host/runtime/errors.h"
 #include "host/render/renderer.h"
 
 #include <CL/opencl.hpp>
