@@ -34,8 +34,7 @@ Scene makeScene(const Camera& camera, json options)
     s.transferFunction = TransferFunction({{0.2, {0.2, 0.4, 1.0}, 0.0}, {0.3, {0.3, 0.6, 1.0}, 3.0},
                                            {0.5, {1.0, 0.8, 0.3}, 6.0}, {0.6, {1.0, 0.9, 0.7}, 0.0}});
     s.options = std::move(options);
-    s.lights = json::parse(R"([{"direction": [0.4, 0.6, 1.0]}, {"direction": [-1.0, -0.2, 0.3], "color": [0.3, 0.3, 0.5]}])");
-    s.material = json::parse(R"({"ambient": 0.15, "diffuse": 0.7, "specular": 0.3, "shininess": 10})");
+    s.lighting = test::twoLightLighting();
     return s;
 }
 
@@ -62,7 +61,7 @@ Image4f render(const Scene& scene, FrameStats* statsOut = nullptr)
 Image4d shadedReference(const Scene& scene)
 {
     static const std::vector<glm::vec4> gradients = sobelGradientVolume(sphere33());
-    const ReferenceShading shading{&gradients, sceneLighting(scene), -scene.camera->forward()};
+    const ReferenceShading shading{&gradients, scene.lighting, -scene.camera->forward()};
     ReferenceOptions options;
     options.shading = &shading;
     return referenceIntegral(sphere33(), scene.transferFunction, *scene.camera, scene.image, options);
@@ -115,7 +114,7 @@ TEST(Blend, ShadedMatchesReferenceBothCameras)
         std::printf("[ measured ] blend %s: max rgb %.2e %.2e %.2e a %.2e; mean rgb %.2e %.2e %.2e a %.2e\n",
                     camera.parallel ? "parallel" : "perspective", e.maxAbs.r, e.maxAbs.g, e.maxAbs.b, e.maxAbs.a,
                     e.meanAbs.r, e.meanAbs.g, e.meanAbs.b, e.meanAbs.a);
-        const double mapBound = reflectanceMapBound(sceneLighting(scene), 256);
+        const double mapBound = reflectanceMapBound(scene.lighting, 256);
         EXPECT_TRUE(test::imagesNear(image, expected, {.maxAbs = mapBound + 1e-2, .meanAbs = 2e-3}));
     }
 }

@@ -111,6 +111,30 @@ file(WRITE "${WORK}/cube.json" [=[{
 expect_run(0 "wrote .*cube.png \\(40x30, slice3d" ${CLVR} render ${WORK}/cube.json -o ${WORK}/cube.png)
 expect_png(${WORK}/cube.png 40 30)
 
+# --- clvr techniques: every technique with its data kind and options, defaults and one line each
+expect_run(0 "slice3d \\(volume\\): [^\n]+\n  slices +256 +view-aligned" ${CLVR} techniques)
+expect_run(0 "\nharc \\(mesh\\): [^\n]+\n.*  max_layers +64 " ${CLVR} techniques)
+expect_run(0 "^planes \\(volume\\): [^\n]+\n  sample_spacing +\\(half the smallest grid spacing\\)" ${CLVR} techniques planes)
+expect_error(2 "${WORK}/none.png" "technique: unknown technique \"slice4d\" \\(known: slice3d, " ${CLVR} techniques slice4d)
+
+# --- --unset: a key removed before validation; the default scene's options are the defaults, its camera
+# is not the fitted one; a key that is not there is an error naming it
+expect_run(0 "wrote" ${CLVR} render -o ${WORK}/unset-none.png ${SMALL})
+expect_run(0 "wrote" ${CLVR} render -o ${WORK}/unset-options.png ${SMALL} --unset options)
+expect_run(0 "wrote" ${CLVR} render -o ${WORK}/unset-camera.png ${SMALL} --unset camera)
+file(SHA256 "${WORK}/unset-none.png" hashNone)
+file(SHA256 "${WORK}/unset-options.png" hashOptions)
+file(SHA256 "${WORK}/unset-camera.png" hashCamera)
+if(NOT hashOptions STREQUAL hashNone)
+  message(FATAL_ERROR "--unset options (the default slices: 256) differs from the default scene's {\"slices\": 256}")
+endif()
+if(hashCamera STREQUAL hashNone)
+  message(FATAL_ERROR "--unset camera (the fitted camera) gives the scene camera's image")
+endif()
+expect_error(2 "${WORK}/none.png" "default scene: --unset \"camera.fov\": the scene has no key \"camera.fov\""
+  ${CLVR} render -o ${WORK}/none.png ${SMALL} --unset camera.fov)
+expect_run(0 "--unset" ${CLVR} bench --help)
+
 # --- bad input: exit 2, one line naming the file, no output file
 set(out "${WORK}/out.png")
 expect_error(2 ${out} "missing.json: no such scene file" ${CLVR} render ${WORK}/missing.json -o ${out})

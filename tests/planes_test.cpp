@@ -37,12 +37,6 @@ const Volume& sphere33()
     return v;
 }
 
-json twoLights()
-{
-    return json::parse(R"([{"direction": [0.4, 0.6, 1.0]}, {"direction": [-1.0, -0.2, 0.3], "color": [0.3, 0.3, 0.5]}])");
-}
-
-json material() { return json::parse(R"({"ambient": 0.15, "diffuse": 0.7, "specular": 0.3, "shininess": 10})"); }
 
 Camera perspectiveCamera()
 {
@@ -63,8 +57,7 @@ Scene makeScene(const Camera& camera, json options, bool shaded = true, int size
     s.transferFunction = shellTransferFunction();
     s.options = std::move(options);
     if (shaded) {
-        s.lights = twoLights();
-        s.material = material();
+        s.lighting = test::twoLightLighting();
     }
     return s;
 }
@@ -82,7 +75,7 @@ Image4f render(const Scene& scene, const Volume& volume, FrameStats* statsOut = 
 Image4d shadedReference(const Scene& scene, const Volume& volume)
 {
     static const std::vector<glm::vec4> gradients = sobelGradientVolume(volume);
-    ReferenceShading shading{&gradients, sceneLighting(scene), -scene.camera->forward()};
+    ReferenceShading shading{&gradients, scene.lighting, -scene.camera->forward()};
     ReferenceStats stats;
     ReferenceOptions options;
     options.stats = &stats;
@@ -156,7 +149,7 @@ TEST(Planes, ShadedMatchesReferenceBothCameras)
         const Image4f image = render(scene, sphere33());
         const Image4d expected = shadedReference(scene, sphere33());
         report(camera.parallel ? "shaded parallel" : "shaded perspective", image, expected);
-        const double mapBound = reflectanceMapBound(sceneLighting(scene), 256);
+        const double mapBound = reflectanceMapBound(scene.lighting, 256);
         EXPECT_NEAR(mapBound, 0.031, 1e-3);
         EXPECT_TRUE(test::imagesNear(image, expected, {.maxAbs = mapBound + 5e-3, .meanAbs = 2e-3}));
     }
@@ -192,7 +185,7 @@ TEST(Planes, ErrorFallsWithSampleSpacing)
 // Largest emitted color times shade of the scene: tf color <= 1, shade <= ka + sum_l max(color_l) (kd + ks).
 double maxEmission(const Scene& scene)
 {
-    const Lighting l = sceneLighting(scene);
+    const Lighting l = scene.lighting;
     double shade = l.material.ambient;
     for (const DirectionalLight& light : l.lights)
         shade += std::max({light.color.r, light.color.g, light.color.b}) * (l.material.diffuse + l.material.specular);
@@ -256,7 +249,7 @@ TEST(Planes, ReflectanceMapSizeWithinItsBound)
     Image4d expected(a.width(), a.height());
     for (std::size_t i = 0; i < a.pixelCount(); ++i)
         expected.pixels()[i] = glm::dvec4(a.pixels()[i]);
-    const Lighting l = sceneLighting(fine);
+    const Lighting l = fine.lighting;
     const double bound = reflectanceMapBound(l, 4) + reflectanceMapBound(l, 1024) + 1e-5;
     report("map n=4 vs n=1024", b, expected);
     EXPECT_TRUE(test::imagesNear(b, expected, {.maxAbs = bound, .meanAbs = bound}));
@@ -298,7 +291,7 @@ TEST(Planes, AsymmetricBlobLandsUpperLeftLitFromUpperLeft)
         Scene scene = makeScene(camera, json::object(), true, 48);
         scene.image.background = glm::dvec3(0.0);
         scene.transferFunction = TransferFunction({{0.3, {1, 1, 1}, 0.0}, {0.4, {1, 1, 1}, 60.0}});
-        scene.lights = json::parse(R"([{"direction": [-1, 1, 1]}])");
+        scene.lighting.lights = {{glm::normalize(glm::dvec3(-1.0, 1.0, 1.0)), glm::dvec3(1.0)}};
         const Image4f image = render(scene, v);
         std::filesystem::create_directories("test_output");
         writeImage(std::string("test_output/planes_blob_") + (camera.parallel ? "parallel" : "perspective") + ".png", image);

@@ -120,7 +120,7 @@ TEST(ReflectanceMap, SceneLightingDefaultsAndValues)
         "lights": [{"direction": [0, 0, 2]}, {"direction": [3, 0, 4], "color": [0.5, 0.25, 1]}],
         "material": {"specular": 0.5}})",
                                "test.json", ".");
-    const Lighting l = sceneLighting(s);
+    const Lighting& l = s.lighting;
     ASSERT_EQ(l.lights.size(), 2u);
     EXPECT_EQ(l.lights[0].direction, glm::dvec3(0, 0, 1));
     EXPECT_EQ(l.lights[0].color, glm::dvec3(1.0));

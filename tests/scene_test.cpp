@@ -22,16 +22,18 @@ const std::string kMinimal = R"({
   "transfer_function": {"points": [[0, 0,0,0, 0], [1, 1,1,1, 4]]}
 })";
 
-Scene parse(const std::string& text, const std::vector<std::string>& overrides = {})
+Scene parse(const std::string& text, const std::vector<std::string>& overrides = {},
+            const std::vector<std::string>& unsets = {})
 {
-    return clvr::parseScene(text, "scene.json", "/data/scenes", overrides);
+    return clvr::parseScene(text, "scene.json", "/data/scenes", overrides, unsets);
 }
 
 // The InputError message parsing `text` gives; fails the test when there is none.
-std::string errorOf(const std::string& text, const std::vector<std::string>& overrides = {})
+std::string errorOf(const std::string& text, const std::vector<std::string>& overrides = {},
+                    const std::vector<std::string>& unsets = {})
 {
     try {
-        parse(text, overrides);
+        parse(text, overrides, unsets);
     } catch (const InputError& e) {
         return e.what();
     } catch (const std::exception& e) {
@@ -64,7 +66,9 @@ TEST(Scene, MinimalUsesDefaults)
     EXPECT_EQ(s.transferFunction.points().size(), 2u);
     EXPECT_TRUE(s.options.is_object());
     EXPECT_TRUE(s.options.empty());
-    EXPECT_TRUE(s.iso.is_null());
+    EXPECT_FALSE(s.iso.has_value());
+    EXPECT_FALSE(s.lighting.shaded());
+    EXPECT_EQ(s.lighting.material.shininess, clvr::Material{}.shininess);
 }
 
 TEST(Scene, FullSceneParses)
@@ -77,9 +81,9 @@ TEST(Scene, FullSceneParses)
       "image": {"width": 320, "height": 200, "background": [0.1, 0.2, 0.3]},
       "transfer_function": {"points": [[0.0, 0,0,0, 0.0], [0.5, 1,0.5,0, 4.0], [1.0, 1,1,1, 8.0]]},
       "options": {"slices": 64},
-      "iso": {"value": 0.5, "shading": "gradient", "light": [0,0,1], "ambient": 0.1, "diffuse": 0.9},
-      "lights": [{"direction": [1,1,1], "color": [1,1,1]}],
-      "material": {"ambient": 0.1, "diffuse": 0.7, "specular": 0.2, "shininess": 20}
+      "iso": {"value": 0.5, "shading": "gradientless", "light": [0,0,2], "ambient": 0.2, "diffuse": 0.7},
+      "lights": [{"direction": [1,1,1], "color": [1,0.5,1]}],
+      "material": {"ambient": 0.1, "diffuse": 0.6, "specular": 0.2, "shininess": 30}
     })");
     ASSERT_TRUE(s.camera.has_value());
     EXPECT_EQ(s.camera->viewAngle, 20.0);
@@ -90,9 +94,77 @@ TEST(Scene, FullSceneParses)
     EXPECT_DOUBLE_EQ(s.image.background.b, 0.3);
     EXPECT_EQ(s.transferFunction.points().size(), 3u);
     EXPECT_EQ(s.options["slices"], 64);
-    EXPECT_EQ(s.iso["value"], 0.5);
-    EXPECT_EQ(s.lights.size(), 1u);
-    EXPECT_EQ(s.material["shininess"], 20);
+    ASSERT_TRUE(s.iso.has_value());
+    EXPECT_EQ(s.iso->value, 0.5);
+    EXPECT_EQ(s.iso->shading, clvr::IsoSpec::Shading::Gradientless);
+    ASSERT_TRUE(s.iso->light.has_value());
+    EXPECT_EQ(*s.iso->light, glm::dvec3(0, 0, 1));  // normalized
+    EXPECT_EQ(s.iso->ambient, 0.2);
+    EXPECT_EQ(s.iso->diffuse, 0.7);
+    ASSERT_EQ(s.lighting.lights.size(), 1u);
+    EXPECT_NEAR(glm::length(s.lighting.lights[0].direction - glm::normalize(glm::dvec3(1.0))), 0.0, 1e-15);
+    EXPECT_EQ(s.lighting.lights[0].color, glm::dvec3(1, 0.5, 1));
+    EXPECT_EQ(s.lighting.material.diffuse, 0.6);
+    EXPECT_EQ(s.lighting.material.shininess, 30.0);
+}
+
+TEST(Scene, IsoWithoutLightUsesTheHeadlight)
+{
+    const Scene s = parse(kMinimal, {"iso.value=0.5"});
+    ASSERT_TRUE(s.iso.has_value());
+    EXPECT_FALSE(s.iso->light.has_value());
+    clvr::Camera camera;
+    camera.position = {3, 0, 4};
+    camera.focalPoint = {0, 0, 0};
+    EXPECT_NEAR(glm::length(s.iso->lightFor(camera) - glm::dvec3(0.6, 0, 0.8)), 0.0, 1e-15);
+}
+
+TEST(Scene, BadIsoLightsAndMaterialNameTheKey)
+{
+    EXPECT_SCENE_ERROR(errorOf(kMinimal, {"iso={\"value\": 0.5, \"shading\": \"phong\"}"}),
+                       "iso.shading must be \"gradient\", \"gradientless\" or \"none\", got \"phong\"");
+    EXPECT_SCENE_ERROR(errorOf(kMinimal, {"iso={\"value\": 0.5, \"light\": [0,0,0]}"}), "iso.light must not be the zero");
+    EXPECT_SCENE_ERROR(errorOf(kMinimal, {"iso={\"value\": 0.5, \"ambient\": -1}"}), "iso.ambient must be >= 0");
+    EXPECT_SCENE_ERROR(errorOf(kMinimal, {"iso={\"light\": [0,0,1]}"}), "iso.value is missing");
+    EXPECT_SCENE_ERROR(errorOf(kMinimal, {"lights=[{\"color\": [1,1,1]}]"}), "lights[0].direction is missing");
+    EXPECT_SCENE_ERROR(errorOf(kMinimal, {"lights=[{\"direction\": [1,0,0], \"color\": [2,1,1]}]"}),
+                       "lights[0].color must have components in [0, 1]");
+    EXPECT_SCENE_ERROR(errorOf(kMinimal, {"material.shininess=-2"}), "material.shininess must be >= 0");
+}
+
+// A scene with every top-level key --unset may remove.
+const std::string kUnsetScene = R"({
+  "volume": {"generator": "sphere", "dims": [8, 8, 8]},
+  "camera": {"position": [0, 0, 9], "view_angle": 20},
+  "transfer_function": {"points": [[0, 0,0,0, 0], [1, 1,1,1, 4]]},
+  "options": {"slices": 64, "early_termination": 0.9},
+  "lights": [{"direction": [0, 0, 1]}]
+})";
+
+TEST(Scene, UnsetRemovesKeysBeforeValidation)
+{
+    EXPECT_TRUE(parse(kUnsetScene).camera.has_value());
+    EXPECT_FALSE(parse(kUnsetScene, {}, {"camera"}).camera.has_value());  // the fitted camera
+    EXPECT_TRUE(parse(kUnsetScene, {}, {"options"}).options.empty());    // the defaults
+    const Scene one = parse(kUnsetScene, {}, {"options.slices"});
+    EXPECT_FALSE(one.options.contains("slices"));
+    EXPECT_EQ(one.options["early_termination"], 0.9);
+    EXPECT_EQ(parse(kUnsetScene, {}, {"camera.view_angle"}).camera->viewAngle, clvr::Camera{}.viewAngle);
+    EXPECT_FALSE(parse(kUnsetScene, {}, {"lights"}).lighting.shaded());
+    // Unsets come first, then --set: a fresh options object.
+    const Scene reset = parse(kUnsetScene, {"options.slices=16"}, {"options"});
+    EXPECT_EQ(reset.options, nlohmann::json({{"slices", 16}}));
+    // Removing what validation needs is then an error about the scene.
+    EXPECT_SCENE_ERROR(errorOf(kUnsetScene, {}, {"transfer_function"}), "transfer_function is missing");
+}
+
+TEST(Scene, UnsetOfAMissingKeyNamesIt)
+{
+    EXPECT_SCENE_ERROR(errorOf(kUnsetScene, {}, {"iso"}), "--unset \"iso\"", "no key \"iso\"");
+    EXPECT_SCENE_ERROR(errorOf(kUnsetScene, {}, {"options.slice_spacing"}), "no key \"options.slice_spacing\"");
+    EXPECT_SCENE_ERROR(errorOf(kUnsetScene, {}, {"camera.position.x"}), "no key \"camera.position.x\"");
+    EXPECT_SCENE_ERROR(errorOf(kUnsetScene, {}, {"image.width"}), "no key \"image.width\"");
+    EXPECT_SCENE_ERROR(errorOf(kUnsetScene, {}, {"options..slices"}), "empty key");
 }
 
 TEST(Scene, MalformedJsonGivesLineAndColumn)

@@ -103,7 +103,7 @@ TEST(SphericalOptions, SceneWithBadOptionFailsInMakeRenderer)
     const Scene scene = makeScene(obliqueCamera(), 8, {{"shells", 0}});
     EXPECT_THROW(makeRenderer(test::device(), scene, atmosphere()), InputError);
     Scene lit = makeScene(obliqueCamera(), 8);
-    lit.lights = json::array({{{"direction", {0, 0, 1}}}});
+    lit.lighting.lights = {DirectionalLight{}};  // from +z, white
     try {
         makeRenderer(test::device(), lit, atmosphere());
         ADD_FAILURE() << "no error for a scene with lights";

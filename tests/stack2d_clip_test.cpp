@@ -26,6 +26,14 @@ namespace {
 
 using nlohmann::json;
 
+// An "iso" at `value`, every other key left out (gradient shading, the headlight).
+IsoSpec isoAt(double value)
+{
+    IsoSpec iso;
+    iso.value = value;
+    return iso;
+}
+
 constexpr double kTauMax = 8.0;  // of mlTransferFunction
 constexpr int kSize = 48;
 
@@ -219,7 +227,7 @@ TEST(Stack2dClip, AClipTextureHoldingTheVolumeChangesNothing)
             for (const bool iso : {false, true}) {
                 Scene plain = makeScene(camera, json(), k);
                 if (iso)
-                    plain.iso = {{"value", 0.5}};
+                    plain.iso = isoAt(0.5);
                 Scene clipped = plain;
                 clipped.options["clip_texture"] = whole;
                 const Image4f a = render(plain), b = render(clipped);
@@ -294,7 +302,7 @@ TEST(Stack2dClip, ClippedSamplesAreNoIsoSurfaceHits)
             Scene scene = makeScene(camera, clip, k);
             scene.options["intermediate"] = 3;
             scene.transferFunction = TransferFunction();
-            scene.iso = {{"value", 0.5}};
+            scene.iso = isoAt(0.5);
             const Image4f image = render(scene, sphere);
             int inside = 0, outside = 0, wrong = 0;
             for (int y = 0; y < kSize; ++y)

@@ -286,15 +286,14 @@ Scene shadedScene(const Camera& camera, json options)
     Scene s = makeScene(camera, 40, std::move(options));
     s.transferFunction = TransferFunction({{0.2, {0.2, 0.4, 1.0}, 0.0}, {0.3, {0.3, 0.6, 1.0}, 3.0},
                                            {0.5, {1.0, 0.8, 0.3}, 6.0}, {0.6, {1.0, 0.9, 0.7}, 0.0}});
-    s.lights = json::parse(R"([{"direction": [0.4, 0.6, 1.0]}, {"direction": [-1.0, -0.2, 0.3], "color": [0.3, 0.3, 0.5]}])");
-    s.material = json::parse(R"({"ambient": 0.15, "diffuse": 0.7, "specular": 0.3, "shininess": 10})");
+    s.lighting = test::twoLightLighting();
     return s;
 }
 
 Image4d shadedReference(const Scene& scene)
 {
     static const std::vector<glm::vec4> gradients = sobelGradientVolume(sphere33());
-    const ReferenceShading shading{&gradients, sceneLighting(scene), -scene.camera->forward()};
+    const ReferenceShading shading{&gradients, scene.lighting, -scene.camera->forward()};
     ReferenceOptions options;
     options.shading = &shading;
     return referenceIntegral(sphere33(), scene.transferFunction, *scene.camera, scene.image, options);
@@ -324,7 +323,7 @@ TEST(Stack2dShaded, MatchesShadedReferenceAndErrorFallsWithIntermediateSlices)
                         camera.parallel ? "parallel" : "perspective", intermediate, e.maxAbs.r, e.maxAbs.g, e.maxAbs.b,
                         e.maxAbs.a, e.meanAbs.r, e.meanAbs.g, e.meanAbs.b, e.meanAbs.a, deltaMax);
             const double slab = 1.0 - std::exp(-6.0 * deltaMax);
-            const double mapBound = reflectanceMapBound(sceneLighting(scene), 256);
+            const double mapBound = reflectanceMapBound(scene.lighting, 256);
             EXPECT_TRUE(test::imagesNear(image, expected, {.maxAbs = 2.0 * 1.65 * slab + mapBound,
                                                            .meanAbs = 1.65 * 0.02 * 6.0 * deltaMax}))
                 << (camera.parallel ? "parallel" : "perspective") << ", intermediate " << intermediate;
@@ -338,8 +337,7 @@ TEST(Stack2dShaded, LightsChangeTheImage)
 {
     const Scene shaded = shadedScene(perspectiveCamera(), {{"intermediate", 1}});
     Scene unshaded = shaded;
-    unshaded.lights = json();
-    unshaded.material = json();
+    unshaded.lighting = Lighting{};
     const Image4f a = renderScene(shaded, sphere33()), b = renderScene(unshaded, sphere33());
     Image4d bd(b.width(), b.height());
     for (std::size_t i = 0; i < b.pixelCount(); ++i)
@@ -366,7 +364,7 @@ TEST(Stack2dIso, SphereSilhouetteAndShadeMatchTheAnalyticSurface)
     for (const Camera& camera : {perspectiveCamera(), parallelCamera()}) {
         Scene scene = makeScene(camera, 48, {{"intermediate", 3}});
         scene.transferFunction = TransferFunction();
-        scene.iso = {{"value", 0.5}, {"light", {0.4, 0.6, 1.0}}, {"ambient", ambient}, {"diffuse", diffuse}};
+        scene.iso = test::isoSpec(0.5, {0.4, 0.6, 1.0}, ambient, diffuse);
         FrameStats stats;
         const Image4f image = renderScene(scene, sphere33(), &stats);
         EXPECT_EQ(stats.extra["iso"], true);
@@ -532,7 +530,7 @@ TEST(Stack2dPolygons, ShadedAndIsoSurfacesWithSeveralSlicesPerPolygon)
 
         Scene iso = makeScene(camera, 48, {{"intermediate", 3}});
         iso.transferFunction = TransferFunction();
-        iso.iso = {{"value", 0.5}, {"light", {0.4, 0.6, 1.0}}, {"ambient", 0.15}, {"diffuse", 0.8}};
+        iso.iso = test::isoSpec(0.5, {0.4, 0.6, 1.0}, 0.15, 0.8);
         const Image4f isoOne = renderScene(iso, sphere33());
         iso.options["slices_per_polygon"] = 6;
         const Image4f isoSix = renderScene(iso, sphere33());

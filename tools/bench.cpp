@@ -482,7 +482,7 @@ int bench(const BenchOptions& options)
     for (const fs::path& scenePath : scenes) {
         const std::string name = scenePath.stem().string();
         const fs::path prefix = outDir / ("bench." + name);
-        const Scene scene = loadScene(scenePath, options.overrides);
+        const Scene scene = loadScene(scenePath, options.overrides, options.unsets);
         if (!scene.mesh.is_null()) {
             report["scenes"].push_back(benchMeshScene(device, scenePath, scene, options, frames, prefix));
             continue;
@@ -504,7 +504,7 @@ int bench(const BenchOptions& options)
         // The ceiling's first frame warms its caches; then clvr and ceiling frames alternate.
         // The ceiling mirrors slice3d's fused path only (the raster path counts fragments, not samples).
         const std::unique_ptr<Ceiling> ceiling =
-            scene.technique == "slice3d" && parseSlice3dOptions(scene.options).path == Slice3dOptions::Path::Fused
+            scene.technique == slice3dTechnique().name && parseSlice3dOptions(scene.options).path == Slice3dOptions::Path::Fused
                 ? makeCeiling(scene, volume, camera)
                 : nullptr;
         const int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));

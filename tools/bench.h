@@ -21,6 +21,7 @@ struct BenchOptions {
     std::string meshCache;             // TetGen meshes of surface scenes; empty: bench-data beside clvr
     std::vector<std::string> overrides;  // --set path=json, applied to every scene (as clvr render --set),
                                          // e.g. options.integration="full" on the harc suite
+    std::vector<std::string> unsets;     // --unset path, removed from every scene before the overrides
 };
 
 // The scene files (under data/scenes/bench/) a suite runs: "slice3d" -> slice3d-{ml256,engine}.json,

@@ -1,4 +1,4 @@
-// tools/commands.cpp — command-line parsing (CLI11) and the info subcommand; render lives in
+// tools/commands.cpp — command-line parsing (CLI11) and the info and techniques subcommands; render lives in
 // tools/render_command.cpp, bench in tools/bench.cpp. docs/cli.md documents every option.
 #include "tools/commands.h"
 
@@ -51,6 +51,36 @@ std::string techniqueList()
     return out;
 }
 
+// The value an option's default is listed as: its JSON, or what the registry says happens.
+std::string defaultShown(const OptionInfo& o)
+{
+    return o.defaultValue.is_null() ? "(" + o.defaultText + ")" : o.defaultValue.dump();
+}
+
+// `clvr techniques [NAME]`: every technique (or one) with its data kind, one line, and its options
+// with defaults and one line each, from the registry (host/render/renderer.h).
+int listTechniques(const std::string& name)
+{
+    if (!name.empty() && !findTechnique(name))
+        throw InputError("technique: unknown technique \"" + name + "\" (known: " + techniqueList() + ")");
+    for (const TechniqueInfo& t : techniques()) {
+        if (!name.empty() && t.name != name)
+            continue;
+        std::cout << t.name << " (" << dataKindName(t.data) << "): " << t.description << '\n';
+        std::size_t nameWidth = 0, defaultWidth = 0;
+        for (const OptionInfo& o : t.options) {
+            nameWidth = std::max(nameWidth, o.name.size());
+            defaultWidth = std::max(defaultWidth, defaultShown(o).size());
+        }
+        for (const OptionInfo& o : t.options) {
+            const std::string shown = defaultShown(o);
+            std::cout << "  " << o.name << std::string(nameWidth - o.name.size() + 2, ' ') << shown
+                      << std::string(defaultWidth - shown.size() + 2, ' ') << o.description << '\n';
+        }
+    }
+    return 0;
+}
+
 }  // namespace
 
 // `clvr mesh` (tools/mesh_command.cpp).
@@ -79,9 +109,20 @@ int run(int argc, char** argv)
         ->expected(1)
         ->allow_extra_args(false)
         ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+    render->add_option("--unset", renderOptions.unsets,
+                       "remove a scene key before --set and validation: dotted.path, e.g. --unset camera (the "
+                       "fitted camera) or --unset options (the defaults); a key not in the scene is an error; repeatable")
+        ->expected(1)
+        ->allow_extra_args(false)
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
     render->add_option("--device", renderOptions.deviceSpec, deviceHelp);
     render->add_option("--stats", renderOptions.statsPath, "write per-pass times and counts as JSON to this file");
-    render->footer("techniques: " + techniqueList());
+    render->footer("techniques: " + techniqueList() + " (clvr techniques lists their options)");
+
+    std::string techniqueName;
+    CLI::App* techniquesCommand =
+        app.add_subcommand("techniques", "list the techniques with their options, defaults and one line each");
+    techniquesCommand->add_option("name", techniqueName, "only this technique");
 
     std::string infoDevice;
     CLI::App* infoCommand = app.add_subcommand("info", "list OpenCL platforms and devices and say which one is used");
@@ -111,6 +152,8 @@ int run(int argc, char** argv)
         ->capture_default_str();
     benchCommand->add_option("--set", benchOptions.overrides,
                              "override a value of every scene, path=json (e.g. options.integration=\"full\")");
+    benchCommand->add_option("--unset", benchOptions.unsets,
+                             "remove a key of every scene before --set, dotted.path (e.g. options)");
     benchCommand->add_option("--mesh-cache", benchOptions.meshCache,
                              "folder for TetGen meshes of surface scenes (default: bench-data beside clvr)");
 #endif
@@ -120,9 +163,9 @@ int run(int argc, char** argv)
     // CLI11 would only say "A subcommand is required" for a misspelt one.
     const std::string first = argc > 1 ? argv[1] : "";
     if (!first.empty() && first[0] != '-' && first != "render" && first != "info" && first != "bench" &&
-        first != "mesh")
+        first != "mesh" && first != "techniques")
         throw InputError("command line: unknown command \"" + std::string(argv[1]) +
-                         "\" (known: render, info, bench, mesh; see clvr --help)");
+                         "\" (known: render, info, techniques, bench, mesh; see clvr --help)");
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -138,6 +181,8 @@ int run(int argc, char** argv)
         return tools::render(renderOptions);
     if (*infoCommand)
         return info(infoDevice);
+    if (*techniquesCommand)
+        return listTechniques(techniqueName);
     if (*meshCommand)
         return runMeshCommand();
 #if CLVR_HAVE_BENCH

@@ -15,6 +15,7 @@ struct RenderOptions {
     std::string scene;                   // scene file; empty or "default": the embedded default scene
     std::string output;                  // .png or .exr
     std::vector<std::string> overrides;  // --set path=json, applied in order
+    std::vector<std::string> unsets;     // --unset path, applied before the overrides
     std::string deviceSpec;              // --device (else $CLVR_DEVICE, else the first CPU device)
     std::string statsPath;               // --stats: JSON with times and counts; empty: none
 };

@@ -160,7 +160,8 @@ int render(const RenderOptions& options)
     // 2. Scene and data: every InputError names its file.
     const bool useDefault = options.scene.empty() || options.scene == "default";
     const std::string sceneLabel = useDefault ? "default scene" : options.scene;
-    Scene scene = useDefault ? defaultScene(options.overrides) : loadScene(options.scene, options.overrides);
+    Scene scene = useDefault ? defaultScene(options.overrides, options.unsets)
+                             : loadScene(options.scene, options.overrides, options.unsets);
     const Clock::time_point loadStart = Clock::now();
     Volume volume;
     if (!scene.volume.is_null())

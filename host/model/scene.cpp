@@ -137,6 +137,22 @@ json parseJson(std::string_view text, const std::string& label, std::string_view
     return result;
 }
 
+// Splits "a.b.c" into its keys; `where` prefixes the error for an empty key.
+std::vector<std::string> splitPath(const std::string& path, const std::string& where)
+{
+    std::vector<std::string> keys;
+    std::size_t start = 0;
+    while (true) {
+        const std::size_t dot = path.find('.', start);
+        keys.push_back(path.substr(start, dot == std::string::npos ? std::string::npos : dot - start));
+        if (keys.back().empty())
+            throw InputError(where + ": empty key in path \"" + path + "\"");
+        if (dot == std::string::npos)
+            return keys;
+        start = dot + 1;
+    }
+}
+
 // Applies one `--set path=json` to `root`: intermediate objects are created; the value is parsed as
 // JSON, or taken as a plain string when it is not JSON (so technique=slice3d works).
 void applyOverride(json& root, const std::string& override, const std::string& label)
@@ -148,17 +164,7 @@ void applyOverride(json& root, const std::string& override, const std::string& l
     const std::string path = override.substr(0, eq);
     const std::string valueText = override.substr(eq + 1);
 
-    std::vector<std::string> keys;
-    std::size_t start = 0;
-    while (true) {
-        const std::size_t dot = path.find('.', start);
-        keys.push_back(path.substr(start, dot == std::string::npos ? std::string::npos : dot - start));
-        if (keys.back().empty())
-            throw InputError(where + ": empty key in path \"" + path + "\"");
-        if (dot == std::string::npos)
-            break;
-        start = dot + 1;
-    }
+    const std::vector<std::string> keys = splitPath(path, where);
 
     json value;
     const std::size_t first = valueText.find_first_not_of(" \t");
@@ -337,57 +343,100 @@ TransferFunction parseTransferFunction(const Checker& check, const json& v)
     }
 }
 
-void checkIso(const Checker& check, const json& v)
+IsoSpec parseIso(const Checker& check, const json& v)
 {
     check.object(v, "iso");
     check.knownKeys(v, "iso", {"value", "shading", "light", "ambient", "diffuse"});
     if (!v.contains("value"))
         check.fail("iso.value is missing");
-    check.number(v["value"], "iso.value");
-    if (v.contains("shading"))
-        check.string(v["shading"], "iso.shading");
+    IsoSpec iso;
+    iso.value = check.number(v["value"], "iso.value");
+    if (v.contains("shading")) {
+        const std::string s = check.string(v["shading"], "iso.shading");
+        if (s == "gradient")
+            iso.shading = IsoSpec::Shading::Gradient;
+        else if (s == "gradientless")
+            iso.shading = IsoSpec::Shading::Gradientless;
+        else if (s == "none")
+            iso.shading = IsoSpec::Shading::None;
+        else
+            check.fail("iso.shading must be \"gradient\", \"gradientless\" or \"none\", got \"" + s + "\"");
+    }
     if (v.contains("light")) {
         const glm::dvec3 l = check.vec3(v["light"], "iso.light");
         if (glm::length(l) == 0.0)
             check.fail("iso.light must not be the zero vector");
+        iso.light = glm::normalize(l);
     }
-    for (const char* key : {"ambient", "diffuse"})
-        if (v.contains(key))
-            check.nonNegative(v[key], keyPath("iso", key));
+    if (v.contains("ambient"))
+        iso.ambient = check.nonNegative(v["ambient"], "iso.ambient");
+    if (v.contains("diffuse"))
+        iso.diffuse = check.nonNegative(v["diffuse"], "iso.diffuse");
+    return iso;
 }
 
-void checkLights(const Checker& check, const json& v)
+std::vector<DirectionalLight> parseLights(const Checker& check, const json& v)
 {
     if (!v.is_array())
         check.fail("lights must be an array of {\"direction\": [x,y,z], \"color\": [r,g,b]}");
+    std::vector<DirectionalLight> lights;
     for (std::size_t i = 0; i < v.size(); ++i) {
         const std::string path = "lights[" + std::to_string(i) + "]";
         check.object(v[i], path);
         check.knownKeys(v[i], path, {"direction", "color"});
         if (!v[i].contains("direction"))
             check.fail(path + ".direction is missing");
-        if (glm::length(check.vec3(v[i]["direction"], path + ".direction")) == 0.0)
+        DirectionalLight light;
+        const glm::dvec3 d = check.vec3(v[i]["direction"], path + ".direction");
+        if (glm::length(d) == 0.0)
             check.fail(path + ".direction must not be the zero vector");
+        light.direction = glm::normalize(d);
         if (v[i].contains("color"))
-            check.color(v[i]["color"], path + ".color");
+            light.color = check.color(v[i]["color"], path + ".color");
+        lights.push_back(light);
     }
+    return lights;
 }
 
-void checkMaterial(const Checker& check, const json& v)
+Material parseMaterial(const Checker& check, const json& v)
 {
     check.object(v, "material");
     check.knownKeys(v, "material", {"ambient", "diffuse", "specular", "shininess"});
-    for (const char* key : {"ambient", "diffuse", "specular", "shininess"})
+    Material m;
+    const std::pair<const char*, double*> fields[] = {
+        {"ambient", &m.ambient}, {"diffuse", &m.diffuse}, {"specular", &m.specular}, {"shininess", &m.shininess}};
+    for (const auto& [key, field] : fields)
         if (v.contains(key))
-            check.nonNegative(v[key], keyPath("material", key));
+            *field = check.nonNegative(v[key], keyPath("material", key));
+    return m;
+}
+
+// Applies one `--unset path` to `root`: the key is removed; a path that is not in the scene is an error.
+void applyUnset(json& root, const std::string& path, const std::string& label)
+{
+    const std::string where = label + ": --unset \"" + path + "\"";
+    if (path.empty())
+        throw InputError(where + ": expected a key path, e.g. camera or options.slices");
+    const std::vector<std::string> keys = splitPath(path, where);
+    json* node = &root;
+    for (std::size_t i = 0; i + 1 < keys.size(); ++i) {
+        if (!node->is_object() || !node->contains(keys[i]))
+            break;
+        node = &(*node)[keys[i]];
+    }
+    if (!node->is_object() || !node->contains(keys.back()))
+        throw InputError(where + ": the scene has no key \"" + path + "\"");
+    node->erase(keys.back());
 }
 
 Scene parseSceneJson(json root, const std::string& label, const std::filesystem::path& baseDir,
-                     const std::vector<std::string>& overrides)
+                     const std::vector<std::string>& overrides, const std::vector<std::string>& unsets)
 {
     const Checker check(label);
     if (!root.is_object())
         check.fail("a scene must be a JSON object, got " + std::string(root.type_name()));
+    for (const std::string& u : unsets)
+        applyUnset(root, u, label);
     for (const std::string& o : overrides)
         applyOverride(root, o, label);
 
@@ -418,34 +467,39 @@ Scene parseSceneJson(json root, const std::string& label, const std::filesystem:
         check.object(root["options"], "options");
         scene.options = root["options"];
     }
-    if (root.contains("iso")) {
-        checkIso(check, root["iso"]);
-        scene.iso = root["iso"];
-    }
-    if (root.contains("lights")) {
-        checkLights(check, root["lights"]);
-        scene.lights = root["lights"];
-    }
-    if (root.contains("material")) {
-        checkMaterial(check, root["material"]);
-        scene.material = root["material"];
-    }
+    if (root.contains("iso"))
+        scene.iso = parseIso(check, root["iso"]);
+    if (root.contains("lights"))
+        scene.lighting.lights = parseLights(check, root["lights"]);
+    if (root.contains("material"))
+        scene.lighting.material = parseMaterial(check, root["material"]);
     if (root.contains("transfer_function"))
         scene.transferFunction = parseTransferFunction(check, root["transfer_function"]);
-    else if (scene.iso.is_null())
+    else if (!scene.iso)
         check.fail("transfer_function is missing (only iso-surface scenes, with \"iso\", may leave it out)");
     return scene;
 }
 
 }  // namespace
 
-Scene parseScene(const std::string& text, const std::string& label, const std::filesystem::path& baseDir,
-                 const std::vector<std::string>& overrides)
+const char* shadingName(IsoSpec::Shading shading)
 {
-    return parseSceneJson(parseJson(text, label), label, baseDir, overrides);
+    switch (shading) {
+    case IsoSpec::Shading::Gradient: return "gradient";
+    case IsoSpec::Shading::Gradientless: return "gradientless";
+    case IsoSpec::Shading::None: return "none";
+    }
+    throw InternalError("shadingName: unknown IsoSpec::Shading " + std::to_string(static_cast<int>(shading)));
 }
 
-Scene loadScene(const std::filesystem::path& path, const std::vector<std::string>& overrides)
+Scene parseScene(const std::string& text, const std::string& label, const std::filesystem::path& baseDir,
+                 const std::vector<std::string>& overrides, const std::vector<std::string>& unsets)
+{
+    return parseSceneJson(parseJson(text, label), label, baseDir, overrides, unsets);
+}
+
+Scene loadScene(const std::filesystem::path& path, const std::vector<std::string>& overrides,
+                const std::vector<std::string>& unsets)
 {
     const std::string label = path.string();
     std::error_code ec;
@@ -460,12 +514,12 @@ Scene loadScene(const std::filesystem::path& path, const std::vector<std::string
     text << in.rdbuf();
     if (in.bad())
         throw InputError(label + ": read error");
-    return parseScene(text.str(), label, path.parent_path(), overrides);
+    return parseScene(text.str(), label, path.parent_path(), overrides, unsets);
 }
 
-Scene defaultScene(const std::vector<std::string>& overrides)
+Scene defaultScene(const std::vector<std::string>& overrides, const std::vector<std::string>& unsets)
 {
-    return parseScene(std::string(kDefaultSceneJson), "default scene", {}, overrides);
+    return parseScene(std::string(kDefaultSceneJson), "default scene", {}, overrides, unsets);
 }
 
 Camera fitCamera(const glm::dvec3& lo, const glm::dvec3& hi, double viewAngle)

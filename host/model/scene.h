@@ -1,5 +1,7 @@
 // host/model/scene.h — a scene as DESIGN.md defines it (JSON, paths relative to the file), parsed and
-// validated. Data is not loaded here: `volume` keeps its JSON for host/io/volume_io.h's loadVolume().
+// validated once: camera, image, transfer function, "iso", "lights" and "material" as typed values that
+// renderers take as they are. Data is not loaded here: `volume` keeps its JSON for host/io/volume_io.h's
+// loadVolume(); `options` stays JSON, checked by the technique (host/render/renderer.h's registry).
 #pragma once
 
 #include "host/model/camera.h"
@@ -20,6 +22,43 @@ struct ImageSpec {
     glm::dvec3 background{0.0};
 };
 
+// The scene's "iso" (docs/scene-format.md): an iso-surface and how it is shaded.
+struct IsoSpec {
+    enum class Shading { Gradient, Gradientless, None };
+    double value = 0.0;                   // data units
+    Shading shading = Shading::Gradient;  // "gradient", "gradientless" (iso3d only) or "none"
+    std::optional<glm::dvec3> light;      // unit, world space, towards the light; absent: the headlight
+    double ambient = 0.1, diffuse = 0.9;  // I_a and k_d
+
+    // The light direction a renderer uses with `camera`: "light", else the headlight -forward (from
+    // the camera, so a surface facing the viewer is lit whatever the view).
+    glm::dvec3 lightFor(const Camera& camera) const { return light ? *light : -camera.forward(); }
+};
+
+// "shading" as the scene writes it.
+const char* shadingName(IsoSpec::Shading shading);
+
+// One entry of the scene's "lights".
+struct DirectionalLight {
+    glm::dvec3 direction{0.0, 0.0, 1.0};  // unit length, world space, towards the light
+    glm::dvec3 color{1.0};
+};
+
+// The scene's "material"; these defaults stand where it leaves a key out.
+struct Material {
+    double ambient = 0.1;
+    double diffuse = 0.7;
+    double specular = 0.2;
+    double shininess = 20.0;
+};
+
+// "lights" and "material" together: the shading of direct volume rendering (host/optics/reflectance_map.h).
+struct Lighting {
+    std::vector<DirectionalLight> lights;  // empty: unshaded (the shade is 1)
+    Material material;
+    bool shaded() const { return !lights.empty(); }
+};
+
 struct Scene {
     std::string technique = "slice3d";
     std::filesystem::path baseDir;  // folder of the scene file: relative data paths start here
@@ -29,20 +68,24 @@ struct Scene {
     ImageSpec image;
     TransferFunction transferFunction;
     nlohmann::json options = nlohmann::json::object();  // technique options, checked by the technique
-    nlohmann::json iso, lights, material;               // null when absent
+    std::optional<IsoSpec> iso;  // absent: no "iso" (direct volume rendering)
+    Lighting lighting;           // "lights" (none: unshaded) and "material"
 };
 
-// Parses scene JSON text; `label` (the file name) prefixes every error. `overrides` are `--set`
-// arguments "path=json" applied to the JSON before validation (camera.view_angle=20,
-// options.slices=64, image={"width":64,"height":64}). Throws InputError naming the key or value.
+// Parses scene JSON text; `label` (the file name) prefixes every error. `unsets` are `--unset` paths
+// ("camera", "options.slices") removed from the JSON first; a path that is not in the scene is an
+// InputError naming it. `overrides` are `--set` arguments "path=json" applied after them, before
+// validation (camera.view_angle=20, options.slices=64, image={"width":64,"height":64}). Throws
+// InputError naming the key or value.
 Scene parseScene(const std::string& text, const std::string& label, const std::filesystem::path& baseDir,
-                 const std::vector<std::string>& overrides = {});
+                 const std::vector<std::string>& overrides = {}, const std::vector<std::string>& unsets = {});
 
 // Reads and parses a scene file. Throws InputError for a missing or unreadable file.
-Scene loadScene(const std::filesystem::path& path, const std::vector<std::string>& overrides = {});
+Scene loadScene(const std::filesystem::path& path, const std::vector<std::string>& overrides = {},
+                const std::vector<std::string>& unsets = {});
 
 // The scene embedded in the binary (data/scenes/default.json's content): a generated volume.
-Scene defaultScene(const std::vector<std::string>& overrides = {});
+Scene defaultScene(const std::vector<std::string>& overrides = {}, const std::vector<std::string>& unsets = {});
 
 // A camera looking at the box [lo, hi] from +z (as vtkRenderer::ResetCamera): the whole box in view.
 Camera fitCamera(const glm::dvec3& lo, const glm::dvec3& hi, double viewAngle = 30.0);

@@ -1,4 +1,4 @@
-// host/optics/reflectance_map.cpp — scene lighting, direct Phong and the reflectance map (host/optics/reflectance_map.h).
+// host/optics/reflectance_map.cpp — direct Phong and the reflectance map (host/optics/reflectance_map.h).
 #include "host/optics/reflectance_map.h"
 
 #include <algorithm>
@@ -31,29 +31,6 @@ glm::dvec3 facingNormal(const glm::dvec3& g, const glm::dvec3& toEye)
 }
 
 }  // namespace
-
-Lighting sceneLighting(const Scene& scene)
-{
-    Lighting lighting;
-    if (scene.lights.is_array()) {
-        for (const auto& l : scene.lights) {
-            DirectionalLight light;
-            const auto& d = l["direction"];
-            light.direction = glm::normalize(glm::dvec3(d[0].get<double>(), d[1].get<double>(), d[2].get<double>()));
-            if (l.contains("color"))
-                light.color = {l["color"][0].get<double>(), l["color"][1].get<double>(), l["color"][2].get<double>()};
-            lighting.lights.push_back(light);
-        }
-    }
-    if (scene.material.is_object()) {
-        Material& m = lighting.material;
-        m.ambient = scene.material.value("ambient", m.ambient);
-        m.diffuse = scene.material.value("diffuse", m.diffuse);
-        m.specular = scene.material.value("specular", m.specular);
-        m.shininess = scene.material.value("shininess", m.shininess);
-    }
-    return lighting;
-}
 
 glm::dvec3 phongShade(const Lighting& lighting, const glm::dvec3& g, const glm::dvec3& toEye)
 {

@@ -1,8 +1,8 @@
 // host/optics/reflectance_map.h — Phong shading of volume samples through a reflectance map (§2.2 of
 // seeds/004_35d3c76e603b55b1.txt): the shade of 6 n^2 normal directions, a cube whose six faces are cut
 // into n x n equal patches, looked up with the sample's gradient normalized by its largest component.
-// Also the lights and material of a scene (DESIGN.md "lights" and "material") and direct Phong, which
-// the CPU reference integral and the tests use.
+// Also direct Phong with a scene's Lighting (host/model/scene.h), which the CPU reference integral and the
+// tests use.
 #pragma once
 
 #include "host/model/scene.h"
@@ -12,27 +12,6 @@
 #include <vector>
 
 namespace clvr {
-
-struct DirectionalLight {
-    glm::dvec3 direction{0.0, 0.0, 1.0};  // unit length, world space, towards the light
-    glm::dvec3 color{1.0};
-};
-
-struct Material {  // defaults when the scene's "material" leaves a key out
-    double ambient = 0.1;
-    double diffuse = 0.7;
-    double specular = 0.2;
-    double shininess = 20.0;
-};
-
-struct Lighting {
-    std::vector<DirectionalLight> lights;  // empty: unshaded (the shade is 1)
-    Material material;
-    bool shaded() const { return !lights.empty(); }
-};
-
-// The scene's "lights" and "material" (already checked by parseScene); directions normalized.
-Lighting sceneLighting(const Scene& scene);
 
 // The shade (r, g, b factors that multiply the transfer function's color) of a sample with gradient g
 // seen along toEye (unit, towards the viewer). The model, shared by every shaded technique here:

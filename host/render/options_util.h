@@ -1,9 +1,11 @@
 // host/render/options_util.h — small pieces every renderer shares: the walk over the scene's "options"
-// with the InputError for a bad one ("options.KEY: what"), the checks of integer and number options,
-// and a host vector as a cl_float4 kernel argument.
+// checked against the technique's registry entry (host/render/renderer.h), the InputError for a bad one
+// ("options.KEY: what"), the checks of integer and number options, the options several techniques
+// share (one name, one meaning, one check, one line of help), and a host vector as a cl_float4.
 #pragma once
 
 #include "host/runtime/errors.h"
+#include "host/render/renderer.h"
 
 #include <CL/opencl.hpp>
 #include <glm/glm.hpp>
@@ -20,16 +22,27 @@ namespace clvr {
 }
 
 // Calls visit(key, value) for every key of a scene's "options" (none when it is null); InputError
-// "options: must be an object" for anything else.
+// "options: must be an object" for anything else, and "options.KEY: unknown option for T (known: ...)"
+// for a key the technique's registry entry does not list, so a technique accepts only what
+// `clvr techniques` shows. A listed key that `visit` does not handle must call unparsedOption.
 template <class Visit>
-void forEachOption(const nlohmann::json& options, Visit visit)
+void forEachOption(const nlohmann::json& options, const TechniqueInfo& info, Visit visit)
 {
     if (options.is_null())
         return;
     if (!options.is_object())
         throw InputError("options: must be an object");
-    for (const auto& [key, value] : options.items())
+    for (const auto& [key, value] : options.items()) {
+        if (!info.option(key))
+            badOption(key, "unknown option for " + info.name + " (known: " + info.optionList() + ")");
         visit(key, value);
+    }
+}
+
+// A listed option the parser has no branch for: the registry and the parser disagree.
+[[noreturn]] inline void unparsedOption(const TechniqueInfo& info, const std::string& key)
+{
+    throw InternalError("options." + key + " is listed for " + info.name + " but its parser does not read it");
 }
 
 // The value of integer option `key` in [lo, hi]; else "options.KEY: must be an integer in [lo, hi], got V".
@@ -46,6 +59,72 @@ inline double numberOption(const std::string& key, const nlohmann::json& value, 
     if (!value.is_number() || !std::isfinite(value.get<double>()) || !ok(value.get<double>()))
         badOption(key, "must be " + what + ", got " + value.dump());
     return value.get<double>();
+}
+
+// The options that mean the same in every technique that has them: the check and the registry entry.
+constexpr int kMaxSlices = 65536;
+constexpr int kMaxReflectanceMapSize = 1024;  // 6 * 1024^2 entries * 16 bytes = 96 MiB
+
+// "slices": view-aligned slices across the volume box's eye-depth range.
+inline int slicesOption(const nlohmann::json& value) { return integerOption("slices", value, 1, kMaxSlices); }
+
+// "slice_spacing": world units between slices along the view direction (instead of slices).
+inline double sliceSpacingOption(const nlohmann::json& value)
+{
+    return numberOption("slice_spacing", value, [](double x) { return x > 0.0; }, "a positive number (world units)");
+}
+
+// InputError when both slices and slice_spacing are given.
+inline void checkSlicesOrSpacing(const nlohmann::json& options)
+{
+    if (options.is_object() && options.contains("slices") && options.contains("slice_spacing"))
+        badOption("slice_spacing", "give either slices or slice_spacing, not both");
+}
+
+// "early_termination": stop a ray (front to back) once its accumulated opacity A >= this; 1 = off.
+inline double earlyTerminationOption(const nlohmann::json& value)
+{
+    return numberOption("early_termination", value, [](double x) { return x > 0.0 && x <= 1.0; },
+                        "an opacity in (0, 1] (1 = off)");
+}
+
+// "opacity_threshold": samples with alpha <= this are neither shaded nor composited.
+inline double opacityThresholdOption(const nlohmann::json& value)
+{
+    return numberOption("opacity_threshold", value, [](double x) { return x >= 0.0 && x < 1.0; },
+                        "an opacity in [0, 1) (0 = skip only transparent samples)");
+}
+
+// "reflectance_map_size": n of the shaded techniques' reflectance map, 6 n^2 shades.
+inline int reflectanceMapSizeOption(const nlohmann::json& value)
+{
+    return integerOption("reflectance_map_size", value, 1, kMaxReflectanceMapSize);
+}
+
+// Their registry entries, each with the default of the technique that lists it.
+inline OptionInfo slicesInfo(int slices = 256)
+{
+    return {"slices", slices, "", "view-aligned slices across the volume's eye-depth range"};
+}
+inline OptionInfo sliceSpacingInfo()
+{
+    return {"slice_spacing", nullptr, "from slices", "world units between slices along the view direction (not with slices)"};
+}
+inline OptionInfo earlyTerminationInfo(double opacity)
+{
+    return {"early_termination", opacity, "", "stop a ray once its opacity reaches this, in (0, 1]; 1 = off"};
+}
+inline OptionInfo opacityThresholdInfo()
+{
+    return {"opacity_threshold", 0.0, "", "samples with alpha <= this, in [0, 1), are neither shaded nor composited"};
+}
+inline OptionInfo reflectanceMapSizeInfo()
+{
+    return {"reflectance_map_size", 128, "", "n of the reflectance map of shaded rendering (\"lights\"): 6 n^2 shades"};
+}
+inline OptionInfo clipTextureInfo()
+{
+    return {"clip_texture", nullptr, "none", "clip by a second texture (file or generator; docs/slice3d.md, Clip textures)"};
 }
 
 inline cl_float4 toCl4(const glm::dvec3& v, double w = 0.0)

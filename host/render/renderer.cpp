@@ -1,4 +1,5 @@
-// host/render/renderer.cpp — technique names and the factories makeRenderer and makeMeshRenderer.
+// host/render/renderer.cpp — the technique registry (each technique's entry comes from its own file,
+// next to its option parser) and the factories makeRenderer and makeMeshRenderer.
 #include "host/render/renderer.h"
 
 #include "host/runtime/errors.h"
@@ -10,68 +11,107 @@
 #include "host/render/grid/spherical.h"
 #include "host/render/grid/stack2d.h"
 
-#include <functional>
-
 namespace clvr {
 namespace {
 
-// The regular-grid techniques, in the order `clvr info` and error messages list them.
-struct VolumeTechnique {
-    const char* name;
-    std::function<std::unique_ptr<Renderer>(Device&, const Scene&, const Volume&)> make;
-};
-
-const std::vector<VolumeTechnique>& volumeTechniques()
+std::string joined(const std::vector<std::string>& names)
 {
-    static const std::vector<VolumeTechnique> techniques = {
-        {"slice3d", makeSlice3dRenderer}, {"stack2d", makeStack2dRenderer}, {"iso3d", makeIso3dRenderer},
-        {"planes", makePlanesRenderer},   {"blend", makeBlendRenderer},   {"spherical", makeSphericalRenderer},
-    };
-    return techniques;
+    std::string out;
+    for (const std::string& name : names)
+        out += (out.empty() ? "" : ", ") + name;
+    return out;
 }
 
-const VolumeTechnique* findVolumeTechnique(const std::string& name)
+std::vector<std::string> namesOf(DataKind kind)
 {
-    for (const VolumeTechnique& t : volumeTechniques())
-        if (name == t.name)
-            return &t;
-    return nullptr;
+    std::vector<std::string> names;
+    for (const TechniqueInfo& t : techniques())
+        if (t.data == kind)
+            names.push_back(t.name);
+    return names;
+}
+
+[[noreturn]] void unknownTechnique(const std::string& name)
+{
+    throw InputError("technique: unknown technique \"" + name + "\" (known: " + joined(techniqueNames()) + ")");
 }
 
 }  // namespace
 
+const char* dataKindName(DataKind kind)
+{
+    return kind == DataKind::Volume ? "volume" : "mesh";
+}
+
+const OptionInfo* TechniqueInfo::option(const std::string& key) const
+{
+    for (const OptionInfo& o : options)
+        if (o.name == key)
+            return &o;
+    return nullptr;
+}
+
+std::string TechniqueInfo::optionList() const
+{
+    std::vector<std::string> names;
+    for (const OptionInfo& o : options)
+        names.push_back(o.name);
+    return joined(names);
+}
+
+const std::vector<TechniqueInfo>& techniques()
+{
+    static const std::vector<TechniqueInfo> all = {slice3dTechnique(), stack2dTechnique(), iso3dTechnique(),
+                                                   planesTechnique(),  blendTechnique(),   sphericalTechnique(),
+                                                   harcTechnique()};
+    return all;
+}
+
+const TechniqueInfo* findTechnique(const std::string& name)
+{
+    for (const TechniqueInfo& t : techniques())
+        if (t.name == name)
+            return &t;
+    return nullptr;
+}
+
+const TechniqueInfo& technique(const std::string& name)
+{
+    if (const TechniqueInfo* t = findTechnique(name))
+        return *t;
+    throw InternalError("technique \"" + name + "\" is not in the registry");
+}
+
 std::vector<std::string> techniqueNames()
 {
     std::vector<std::string> names;
-    for (const VolumeTechnique& t : volumeTechniques())
-        names.emplace_back(t.name);
-    names.emplace_back("harc");
+    for (const TechniqueInfo& t : techniques())
+        names.push_back(t.name);
     return names;
 }
 
 std::unique_ptr<Renderer> makeRenderer(Device& device, const Scene& scene, const Volume& volume)
 {
-    if (const VolumeTechnique* t = findVolumeTechnique(scene.technique)) {
-        if (volume.values.empty())
-            throw InputError("technique " + scene.technique + " needs a regular-grid \"volume\", and the scene has none");
-        return t->make(device, scene, volume);
-    }
-    if (scene.technique == "harc")
-        throw InputError("technique harc needs a tetrahedral \"mesh\", and the scene has none");
-    std::string known;
-    for (const std::string& name : techniqueNames())
-        known += (known.empty() ? "" : ", ") + name;
-    throw InputError("technique: unknown technique \"" + scene.technique + "\" (known: " + known + ")");
+    const TechniqueInfo* t = findTechnique(scene.technique);
+    if (!t)
+        unknownTechnique(scene.technique);
+    if (t->data != DataKind::Volume)
+        throw InputError("technique " + t->name + " needs a tetrahedral \"mesh\", and the scene has none");
+    if (volume.values.empty())
+        throw InputError("technique " + t->name + " needs a regular-grid \"volume\", and the scene has none");
+    return t->makeForVolume(device, scene, volume);
 }
 
 std::unique_ptr<Renderer> makeMeshRenderer(Device& device, const Scene& scene, const TetMesh& mesh)
 {
-    if (scene.technique == "harc")
-        return makeHarcRenderer(device, scene, mesh, buildTopology(mesh));
-    if (!findVolumeTechnique(scene.technique))
-        throw InputError("technique: unknown technique \"" + scene.technique + "\" (mesh techniques: harc)");
-    throw InputError("technique \"" + scene.technique +
-                     "\" renders regular-grid volumes, and the scene has a \"mesh\" (mesh techniques: harc)");
+    const TechniqueInfo* t = findTechnique(scene.technique);
+    if (!t)
+        throw InputError("technique: unknown technique \"" + scene.technique +
+                         "\" (mesh techniques: " + joined(namesOf(DataKind::Mesh)) + ")");
+    if (t->data != DataKind::Mesh)
+        throw InputError("technique \"" + t->name + "\" renders regular-grid volumes, and the scene has a \"mesh\" " +
+                         "(mesh techniques: " + joined(namesOf(DataKind::Mesh)) + ")");
+    return t->makeForMesh(device, scene, mesh);
 }
 
 }  // namespace clvr

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -39,15 +40,54 @@ public:
     virtual void setTransferFunction(const TransferFunction& tf) = 0;
 };
 
+// The technique registry (host/render/renderer.cpp): every technique by name, with the data it
+// renders, one line about it and its options. `clvr techniques`, the factories below and the option
+// parsers' "unknown option" errors all read it; no other code names a technique.
+enum class DataKind { Volume, Mesh };
+
+const char* dataKindName(DataKind kind);  // "volume" or "mesh", the scene key the technique needs
+
+// One technique option as `clvr techniques` lists it.
+struct OptionInfo {
+    std::string name;
+    // What leaving the option out means, as a value the option accepts (the image is then the same,
+    // bit for bit; tests/renderer_test.cpp). Null where no value says it: defaultText says what happens.
+    nlohmann::json defaultValue;
+    std::string defaultText;  // only where defaultValue is null: "derived from slices", "none", ...
+    std::string description;  // one line
+};
+
+struct TechniqueInfo {
+    std::string name;
+    DataKind data = DataKind::Volume;
+    std::string description;  // one line
+    std::vector<OptionInfo> options;
+    // The factory for the technique's data kind (the other one is empty).
+    std::function<std::unique_ptr<Renderer>(Device&, const Scene&, const Volume&)> makeForVolume;
+    std::function<std::unique_ptr<Renderer>(Device&, const Scene&, const TetMesh&)> makeForMesh;
+
+    const OptionInfo* option(const std::string& key) const;
+    std::string optionList() const;  // "slices, slice_spacing, ..." in registry order
+};
+
+// Every technique, in the order `clvr techniques` and error messages list them.
+const std::vector<TechniqueInfo>& techniques();
+
+// The technique named `name`; nullptr when there is none.
+const TechniqueInfo* findTechnique(const std::string& name);
+
+// The technique named `name`; InternalError when there is none (a renderer asking for its own entry).
+const TechniqueInfo& technique(const std::string& name);
+
 // The technique the scene names, set up on `device` for `volume`. Throws InputError for an
 // unknown technique (listing the known ones) or an unknown or invalid option.
 std::unique_ptr<Renderer> makeRenderer(Device& device, const Scene& scene, const Volume& volume);
 
-// The mesh technique the scene names ("harc"), set up on `device` for `mesh` (checked by checkMesh;
+// The mesh technique the scene names (DataKind::Mesh), set up on `device` for `mesh` (checked by checkMesh;
 // its adjacency is built here). Throws InputError as makeRenderer does.
 std::unique_ptr<Renderer> makeMeshRenderer(Device& device, const Scene& scene, const TetMesh& mesh);
 
-// Technique names makeRenderer and makeMeshRenderer know, in the order `clvr render --help` lists them.
+// Technique names, in registry order.
 std::vector<std::string> techniqueNames();
 
 }  // namespace clvr

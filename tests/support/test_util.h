@@ -5,6 +5,7 @@
 #include "host/model/camera.h"
 #include "host/runtime/device.h"
 #include "host/model/image.h"
+#include "host/model/scene.h"
 
 #include <gtest/gtest.h>
 
@@ -87,6 +88,40 @@ inline Camera obliqueParallelCamera(double parallelScale)
     c.parallel = true;
     c.parallelScale = parallelScale;
     return c;
+}
+
+// An "iso" with its light given (normalized, as parseScene does) and gradient shading unless told.
+inline IsoSpec isoSpec(double value, const glm::dvec3& light, double ambient, double diffuse,
+                       IsoSpec::Shading shading = IsoSpec::Shading::Gradient)
+{
+    IsoSpec iso;
+    iso.value = value;
+    iso.shading = shading;
+    iso.light = glm::normalize(light);
+    iso.ambient = ambient;
+    iso.diffuse = diffuse;
+    return iso;
+}
+
+// "iso.shading" by its scene name ("gradient", "gradientless", "none").
+inline IsoSpec::Shading shadingNamed(const std::string& name)
+{
+    for (IsoSpec::Shading s : {IsoSpec::Shading::Gradient, IsoSpec::Shading::Gradientless, IsoSpec::Shading::None})
+        if (name == shadingName(s))
+            return s;
+    ADD_FAILURE() << "no shading named " << name;
+    return IsoSpec::Shading::Gradient;
+}
+
+// The lights and material the shaded planes, blend and stack2d tests share: a white light from
+// (0.4, 0.6, 1), a dim blue one from (-1, -0.2, 0.3); ka 0.15, kd 0.7, ks 0.3, shininess 10.
+inline Lighting twoLightLighting()
+{
+    Lighting l;
+    l.lights = {{glm::normalize(glm::dvec3(0.4, 0.6, 1.0)), glm::dvec3(1.0)},
+                {glm::normalize(glm::dvec3(-1.0, -0.2, 0.3)), glm::dvec3(0.3, 0.3, 0.5)}};
+    l.material = {0.15, 0.7, 0.3, 10.0};
+    return l;
 }
 
 }  // namespace clvr::test

@@ -16,9 +16,6 @@
 namespace clvr {
 namespace {
 
-constexpr int kMaxSlices = 65536;
-constexpr int kMaxMapSize = 1024;
-constexpr const char* kKnownOptions = "slices, slice_spacing, opacity_threshold, reflectance_map_size";
 
 class BlendRenderer final : public Renderer {
 public:
@@ -44,7 +41,7 @@ private:
 };
 
 BlendRenderer::BlendRenderer(Device& device, const Scene& scene, const Volume& volume)
-    : device_(device), options_(parseBlendOptions(scene.options)), image_(scene.image), lighting_(sceneLighting(scene))
+    : device_(device), options_(parseBlendOptions(scene.options)), image_(scene.image), lighting_(scene.lighting)
 {
     volume.validate();
     if (volume.voxelCount() > 0xffffffffull)
@@ -136,24 +133,34 @@ Image4f BlendRenderer::render(FrameStats& stats)
 
 }  // namespace
 
+TechniqueInfo blendTechnique()
+{
+    TechniqueInfo t;
+    t.name = "blend";
+    t.data = DataKind::Volume;
+    t.description = "shaded slices blended back to front in one kernel, seeds/004 (docs/planes.md)";
+    t.options = {slicesInfo(), sliceSpacingInfo(), opacityThresholdInfo(), reflectanceMapSizeInfo()};
+    t.makeForVolume = makeBlendRenderer;
+    return t;
+}
+
 BlendOptions parseBlendOptions(const nlohmann::json& options)
 {
+    static const TechniqueInfo& info = technique("blend");
     BlendOptions o;
-    forEachOption(options, [&](const std::string& key, const nlohmann::json& value) {
+    forEachOption(options, info, [&](const std::string& key, const nlohmann::json& value) {
         if (key == "slices")
-            o.slices = integerOption(key, value, 1, kMaxSlices);
+            o.slices = slicesOption(value);
         else if (key == "slice_spacing")
-            o.sliceSpacing = numberOption(key, value, [](double x) { return x > 0.0; }, "a positive number (world units)");
+            o.sliceSpacing = sliceSpacingOption(value);
         else if (key == "opacity_threshold")
-            o.opacityThreshold = numberOption(key, value, [](double x) { return x >= 0.0 && x < 1.0; },
-                                              "an opacity in [0, 1) (0 = skip only transparent samples)");
+            o.opacityThreshold = opacityThresholdOption(value);
         else if (key == "reflectance_map_size")
-            o.reflectanceMapSize = integerOption(key, value, 1, kMaxMapSize);
+            o.reflectanceMapSize = reflectanceMapSizeOption(value);
         else
-            badOption(key, std::string("unknown option for blend (known: ") + kKnownOptions + ")");
+            unparsedOption(info, key);
     });
-    if (options.contains("slices") && options.contains("slice_spacing"))
-        badOption("slice_spacing", "give either slices or slice_spacing, not both");
+    checkSlicesOrSpacing(options);
     return o;
 }
 

@@ -18,6 +18,9 @@ struct BlendOptions {
     int reflectanceMapSize = 128;   // n: 6 n^2 shades
 };
 
+// Its registry entry (host/render/renderer.h): name, data kind, one line, options with defaults.
+TechniqueInfo blendTechnique();
+
 // Reads the scene's "options" for blend (slices, slice_spacing, opacity_threshold,
 // reflectance_map_size). Throws InputError naming the key for unknown keys, wrong types, values out of
 // range, and slices given together with slice_spacing.

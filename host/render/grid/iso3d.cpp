@@ -21,7 +21,6 @@
 namespace clvr {
 namespace {
 
-constexpr int kMaxSlices = 65536;
 // Figure 7: how far behind the box entry (in slices) the depth buffer is put. The first slice inside the box
 // lies within one slice of the entry; 1.5 keeps it in front on faces seen obliquely by a perspective camera.
 constexpr double kEntryDepthSlices = 1.5;
@@ -68,8 +67,10 @@ private:
 };
 
 Iso3dRendererImpl::Iso3dRendererImpl(Device& device, const Scene& scene, const Volume& volume)
-    : device_(device), options_(parseIso3dOptions(scene.options)), iso_(parseIsoSurface(scene)), image_(scene.image)
+    : device_(device), options_(parseIso3dOptions(scene.options)), image_(scene.image)
 {
+    if (!scene.iso)
+        throw InputError("iso: technique iso3d needs \"iso\": {\"value\": ...}, and the scene has none");
     volume.validate();
     if (volume.voxelCount() > 0xffffffffull)
         throw InputError(volume.source + ": iso3d takes at most 2^32 - 1 grid points (32-bit voxel indices)");
@@ -77,6 +78,7 @@ Iso3dRendererImpl::Iso3dRendererImpl(Device& device, const Scene& scene, const V
     hi_ = volume.boundsMax();
     camera_ = scene.camera ? *scene.camera : fitCamera(lo_, hi_);
     camera_.validate();
+    iso_ = isoSurface(scene, camera_);
     if (image_.width < 1 || image_.height < 1)
         throw InputError("image: width and height must be >= 1");
     Slice3dOptions sliceOptions;
@@ -340,9 +342,7 @@ Image4f Iso3dRendererImpl::render(FrameStats& stats)
     stats.extra["slice_spacing"] = plan_.deltaS;
     stats.extra["triangles"] = drawStats.triangles;
     stats.extra["iso_value"] = iso_.value;
-    stats.extra["shading"] = iso_.shading == IsoSurface::Shading::Gradient       ? "gradient"
-                             : iso_.shading == IsoSurface::Shading::Gradientless ? "gradientless"
-                                                                                 : "none";
+    stats.extra["shading"] = shadingName(iso_.shading);
     stats.extra["resident_bytes"] = residentBytes_;
     stats.extra["interior"] = options_.interior;
     stats.extra["bricks"] = bricks_.count();
@@ -458,25 +458,36 @@ std::vector<double> Iso3dRendererImpl::hitDepth()
 
 }  // namespace
 
+TechniqueInfo iso3dTechnique()
+{
+    TechniqueInfo t;
+    t.name = "iso3d";
+    t.data = DataKind::Volume;
+    t.description = "shaded iso-surfaces by the alpha test on view-aligned slices, seeds/000 (docs/iso3d.md)";
+    t.options = {
+        slicesInfo(),
+        sliceSpacingInfo(),
+        {"gradientless_step", nullptr, "the smallest grid spacing", "gradientless shading: Delta, world units towards the light"},
+        {"gradientless_scale", nullptr, "1 / (Delta median |grad| at iso)", "gradientless shading: k, per data unit"},
+        {"interior", false, "", "Figure 7: show the interior surface where the box entry is already inside"},
+        {"brick_budget", nullptr, "unbricked", "at most this many bytes of brick textures on the device"},
+        {"bricks", nullptr, "unbricked", "[nx, ny, nz]: exactly this brick grid (not with brick_budget)"},
+    };
+    t.makeForVolume = [](Device& device, const Scene& scene, const Volume& volume) -> std::unique_ptr<Renderer> {
+        return makeIso3dRenderer(device, scene, volume);
+    };
+    return t;
+}
+
 Iso3dOptions parseIso3dOptions(const nlohmann::json& options)
 {
+    static const TechniqueInfo& info = technique("iso3d");
     Iso3dOptions o;
-    if (options.is_null())
-        return o;
-    if (!options.is_object())
-        throw InputError("options: must be an object");
-    for (const auto& [key, value] : options.items()) {
+    forEachOption(options, info, [&](const std::string& key, const nlohmann::json& value) {
         if (key == "slices") {
-            if (!value.is_number_integer())
-                badOption(key, "must be an integer, got " + value.dump());
-            const auto n = value.get<long long>();
-            if (n < 1 || n > kMaxSlices)
-                badOption(key, "must be in [1, " + std::to_string(kMaxSlices) + "], got " + std::to_string(n));
-            o.slices = static_cast<int>(n);
+            o.slices = slicesOption(value);
         } else if (key == "slice_spacing") {
-            if (!value.is_number() || !(value.get<double>() > 0.0) || !std::isfinite(value.get<double>()))
-                badOption(key, "must be a positive number (world units), got " + value.dump());
-            o.sliceSpacing = value.get<double>();
+            o.sliceSpacing = sliceSpacingOption(value);
         } else if (key == "gradientless_step") {
             if (!value.is_number() || !(value.get<double>() > 0.0) || !std::isfinite(value.get<double>()))
                 badOption(key, "must be a positive number (world units), got " + value.dump());
@@ -502,44 +513,26 @@ Iso3dOptions parseIso3dOptions(const nlohmann::json& options)
                 badOption(key, "must be true or false, got " + value.dump());
             o.interior = value.get<bool>();
         } else {
-            badOption(key, "unknown option for iso3d (known: slices, slice_spacing, gradientless_step, gradientless_scale, "
-                           "interior, brick_budget, bricks)");
+            unparsedOption(info, key);
         }
-    }
-    if (options.contains("slices") && options.contains("slice_spacing"))
-        badOption("slice_spacing", "give either slices or slice_spacing, not both");
+    });
+    checkSlicesOrSpacing(options);
     if (options.contains("brick_budget") && options.contains("bricks"))
         badOption("bricks", "give either brick_budget or bricks, not both");
     return o;
 }
 
-IsoSurface parseIsoSurface(const Scene& scene)
+IsoSurface isoSurface(const Scene& scene, const Camera& camera)
 {
-    // scene.cpp has checked types and ranges; what is left is iso3d's own choices.
-    const nlohmann::json& v = scene.iso;
-    if (!v.is_object())
+    if (!scene.iso)
         throw InputError("iso: technique iso3d needs \"iso\": {\"value\": ...}, and the scene has none");
+    const IsoSpec& spec = *scene.iso;
     IsoSurface iso;
-    iso.value = v.at("value").get<double>();
-    if (v.contains("shading")) {
-        const std::string s = v["shading"].get<std::string>();
-        if (s == "gradient")
-            iso.shading = IsoSurface::Shading::Gradient;
-        else if (s == "gradientless")
-            iso.shading = IsoSurface::Shading::Gradientless;
-        else if (s == "none")
-            iso.shading = IsoSurface::Shading::None;
-        else
-            throw InputError("iso.shading: must be \"gradient\", \"gradientless\" or \"none\" for iso3d, got \"" + s + "\"");
-    }
-    if (v.contains("light")) {
-        const auto l = v["light"];
-        iso.light = glm::normalize(glm::dvec3(l[0].get<double>(), l[1].get<double>(), l[2].get<double>()));
-    }
-    if (v.contains("ambient"))
-        iso.ambient = v["ambient"].get<double>();
-    if (v.contains("diffuse"))
-        iso.diffuse = v["diffuse"].get<double>();
+    iso.value = spec.value;
+    iso.shading = spec.shading;
+    iso.light = spec.lightFor(camera);
+    iso.ambient = spec.ambient;
+    iso.diffuse = spec.diffuse;
     if (!scene.transferFunction.points().empty())
         iso.color = glm::dvec3(scene.transferFunction(iso.value));
     return iso;

@@ -34,13 +34,17 @@ struct Iso3dOptions {
     glm::ivec3 bricks{0};
 };
 
+// Its registry entry (host/render/renderer.h): name, data kind, one line, options with defaults.
+TechniqueInfo iso3dTechnique();
+
 // Reads the scene's "options" for iso3d (slices, slice_spacing, gradientless_step, gradientless_scale,
 // interior, brick_budget, bricks). Throws InputError naming the key.
 Iso3dOptions parseIso3dOptions(const nlohmann::json& options);
 
-// The scene's "iso" as iso3d uses it (scene-format.md, iso), with iso3d's defaults.
+// The scene's "iso" as iso3d and its reference use it: the light resolved for the camera, the color
+// taken from the transfer function.
 struct IsoSurface {
-    enum class Shading { Gradient, Gradientless, None };
+    using Shading = IsoSpec::Shading;
     double value = 0.0;                   // data units
     Shading shading = Shading::Gradient;  // Gradientless: forward differences (docs/iso3d.md); None: flat color
     glm::dvec3 light{0.0, 0.0, 1.0};      // towards the light, world space, unit length
@@ -48,8 +52,9 @@ struct IsoSurface {
     glm::dvec3 color{1.0};                // the transfer function's color at the value, or white
 };
 
-// Throws InputError ("iso: ...", "iso.shading: ...") when the scene has no "iso" or names an unknown shading.
-IsoSurface parseIsoSurface(const Scene& scene);
+// The scene's "iso" seen from `camera` (IsoSpec::lightFor: "light", else the headlight). Throws
+// InputError ("iso: ...") when the scene has no "iso".
+IsoSurface isoSurface(const Scene& scene, const Camera& camera);
 
 // Per grid point (0.5 N + 0.5, value), N = -grad/|grad| from the Sobel gradient (host/optics/gradient_volume.h),
 // the unit normal pointing out of the region at or above any iso-value (towards lower values); (0.5, 0.5,

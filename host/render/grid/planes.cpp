@@ -17,9 +17,7 @@
 namespace clvr {
 namespace {
 
-constexpr int kMaxMapSize = 1024;        // 6 * 1024^2 entries * 16 bytes = 96 MiB
 constexpr double kMaxSamplesPerRay = 1 << 20;
-constexpr const char* kKnownOptions = "sample_spacing, early_termination, opacity_threshold, reflectance_map_size";
 
 class PlanesRenderer final : public Renderer {
 public:
@@ -48,7 +46,7 @@ private:
 
 PlanesRenderer::PlanesRenderer(Device& device, const Scene& scene, const Volume& volume)
     : device_(device), options_(parsePlanesOptions(scene.options)), image_(scene.image),
-      lighting_(sceneLighting(scene))
+      lighting_(scene.lighting)
 {
     volume.validate();
     if (volume.voxelCount() > 0xffffffffull)
@@ -161,22 +159,38 @@ Image4f PlanesRenderer::render(FrameStats& stats)
 
 }  // namespace
 
+TechniqueInfo planesTechnique()
+{
+    TechniqueInfo t;
+    t.name = "planes";
+    t.data = DataKind::Volume;
+    t.description = "shaded ray casting through gradient planes, seeds/004 (docs/planes.md)";
+    t.options = {
+        {"sample_spacing", nullptr, "half the smallest grid spacing",
+         "world units between samples along each ray (a ray caster: along the ray, not the view axis)"},
+        earlyTerminationInfo(0.99),
+        opacityThresholdInfo(),
+        reflectanceMapSizeInfo(),
+    };
+    t.makeForVolume = makePlanesRenderer;
+    return t;
+}
+
 PlanesOptions parsePlanesOptions(const nlohmann::json& options)
 {
+    static const TechniqueInfo& info = technique("planes");
     PlanesOptions o;
-    forEachOption(options, [&](const std::string& key, const nlohmann::json& value) {
+    forEachOption(options, info, [&](const std::string& key, const nlohmann::json& value) {
         if (key == "sample_spacing")
             o.sampleSpacing = numberOption(key, value, [](double x) { return x > 0.0; }, "a positive number (world units)");
         else if (key == "early_termination")
-            o.earlyTermination =
-                numberOption(key, value, [](double x) { return x > 0.0 && x <= 1.0; }, "an opacity in (0, 1] (1 = off)");
+            o.earlyTermination = earlyTerminationOption(value);
         else if (key == "opacity_threshold")
-            o.opacityThreshold = numberOption(key, value, [](double x) { return x >= 0.0 && x < 1.0; },
-                                              "an opacity in [0, 1) (0 = skip only transparent samples)");
+            o.opacityThreshold = opacityThresholdOption(value);
         else if (key == "reflectance_map_size")
-            o.reflectanceMapSize = integerOption(key, value, 1, kMaxMapSize);
+            o.reflectanceMapSize = reflectanceMapSizeOption(value);
         else
-            badOption(key, std::string("unknown option for planes (known: ") + kKnownOptions + ")");
+            unparsedOption(info, key);
     });
     return o;
 }

@@ -19,12 +19,15 @@ struct PlanesOptions {
     int reflectanceMapSize = 128;    // n: the map holds 6 n^2 shades
 };
 
+// Its registry entry (host/render/renderer.h): name, data kind, one line, options with defaults.
+TechniqueInfo planesTechnique();
+
 // Reads the scene's "options" for planes (sample_spacing, early_termination, opacity_threshold,
 // reflectance_map_size). Throws InputError naming the key ("options.sample_spacing: ...") for unknown
 // keys, wrong types and values out of range.
 PlanesOptions parsePlanesOptions(const nlohmann::json& options);
 
-// Renderer for "planes". Shaded when the scene has "lights" (sceneLighting), else unshaded (then it
+// Renderer for "planes". Shaded when the scene has "lights" (scene.lighting), else unshaded (then it
 // approximates the same integral as slice3d). The reflectance map is built at creation from the lights and
 // the camera's view direction. Throws InputError for bad options, a volume over 2^32 - 1 grid points or
 // rays that would need over 2^20 samples, and DeviceError when the volume does not fit on the device.

@@ -20,9 +20,6 @@
 namespace clvr {
 namespace {
 
-constexpr int kMaxSlices = 65536;
-constexpr const char* kKnownOptions =
-    "slices, slice_spacing, order, early_termination, path, empty_space_skipping, voxel_type, clip, clip_texture";
 
 class Slice3dRenderer final : public Renderer {
 public:
@@ -477,19 +474,36 @@ Slice3dClip parseClip(const nlohmann::json& value)
 
 }  // namespace
 
+TechniqueInfo slice3dTechnique()
+{
+    TechniqueInfo t;
+    t.name = "slice3d";
+    t.data = DataKind::Volume;
+    t.description = "3D-texture slicing: view-aligned slices composited (docs/slice3d.md)";
+    t.options = {
+        slicesInfo(),
+        sliceSpacingInfo(),
+        {"order", "back-to-front", "", "\"back-to-front\" (over) or \"front-to-back\" (under, with early termination)"},
+        earlyTerminationInfo(1.0),
+        {"path", "fused", "", "\"fused\" (all slices of a pixel in one kernel) or \"raster\" (pass by pass)"},
+        {"empty_space_skipping", true, "", "fused path: step over bricks where tau is 0 (same image)"},
+        {"voxel_type", "auto", "", "\"auto\" (uint8/uint16 on the device when the values fit) or \"float32\""},
+        {"clip", nullptr, "none", "clip by a closed mesh through the stencil buffer: {\"mesh\": ..., \"inverse\", \"method\"}"},
+        clipTextureInfo(),
+    };
+    t.makeForVolume = makeSlice3dRenderer;
+    return t;
+}
+
 Slice3dOptions parseSlice3dOptions(const nlohmann::json& options)
 {
+    static const TechniqueInfo& info = technique("slice3d");
     Slice3dOptions o;
-    forEachOption(options, [&](const std::string& key, const nlohmann::json& value) {
+    forEachOption(options, info, [&](const std::string& key, const nlohmann::json& value) {
         if (key == "slices") {
-            if (!value.is_number_integer())
-                badOption(key, "must be an integer, got " + value.dump());
-            const auto n = value.get<long long>();
-            if (n < 1 || n > kMaxSlices)
-                badOption(key, "must be in [1, " + std::to_string(kMaxSlices) + "], got " + std::to_string(n));
-            o.slices = static_cast<int>(n);
+            o.slices = slicesOption(value);
         } else if (key == "slice_spacing") {
-            o.sliceSpacing = numberOption(key, value, [](double x) { return x > 0.0; }, "a positive number (world units)");
+            o.sliceSpacing = sliceSpacingOption(value);
         } else if (key == "order") {
             const std::string s = value.is_string() ? value.get<std::string>() : "";
             if (s == "back-to-front")
@@ -499,8 +513,7 @@ Slice3dOptions parseSlice3dOptions(const nlohmann::json& options)
             else
                 badOption(key, "must be \"back-to-front\" or \"front-to-back\", got " + value.dump());
         } else if (key == "early_termination") {
-            o.earlyTermination =
-                numberOption(key, value, [](double x) { return x > 0.0 && x <= 1.0; }, "an opacity in (0, 1] (1 = off)");
+            o.earlyTermination = earlyTerminationOption(value);
         } else if (key == "path") {
             const std::string s = value.is_string() ? value.get<std::string>() : "";
             if (s == "fused")
@@ -526,7 +539,7 @@ Slice3dOptions parseSlice3dOptions(const nlohmann::json& options)
         } else if (key == "clip_texture") {
             o.clipTexture = parseClipTextureSpec(value, "options.clip_texture");
         } else {
-            badOption(key, std::string("unknown option for slice3d (known: ") + kKnownOptions + ")");
+            unparsedOption(info, key);
         }
     });
     if (o.clip) {
@@ -536,8 +549,7 @@ Slice3dOptions parseSlice3dOptions(const nlohmann::json& options)
                               "the fused kernel has no stencil), got \"path\": \"fused\"");
         o.path = Slice3dOptions::Path::Raster;
     }
-    if (options.contains("slices") && options.contains("slice_spacing"))
-        badOption("slice_spacing", "give either slices or slice_spacing, not both");
+    checkSlicesOrSpacing(options);
     if (o.earlyTermination < 1.0 && o.order != Slice3dOptions::Order::FrontToBack)
         badOption("early_termination", "needs \"order\": \"front-to-back\" (back to front cannot stop early)");
     if (o.earlyTermination < 1.0 && o.path == Slice3dOptions::Path::Raster)

@@ -43,6 +43,9 @@ struct Slice3dOptions {
     std::optional<ClipTextureSpec> clipTexture;
 };
 
+// Its registry entry (host/render/renderer.h): name, data kind, one line, options with defaults.
+TechniqueInfo slice3dTechnique();
+
 // Reads the scene's "options" for slice3d. Throws InputError naming the key ("options.slices: ...")
 // for unknown keys, wrong types and values out of range.
 Slice3dOptions parseSlice3dOptions(const nlohmann::json& options);

@@ -20,7 +20,6 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr int kMaxShells = 4096;
 constexpr int kMaxSegments = 1024;  // 1024 x 512 x 2 = 1 M triangles (240 MB of vertices) per shell
-constexpr const char* kKnownOptions = "shells, segments, r_min, r_max, center, color_matrix, scale, bias, opacity";
 
 double finiteNumber(const std::string& key, const nlohmann::json& value)
 {
@@ -57,14 +56,33 @@ cl_float4 f4(const glm::dvec3& v, double w = 0.0)
 
 }  // namespace
 
+TechniqueInfo sphericalTechnique()
+{
+    TechniqueInfo t;
+    t.name = "spherical";
+    t.data = DataKind::Volume;
+    t.description = "spherical shells textured through a pixel texture, seeds/004 (docs/spherical.md)";
+    const nlohmann::json identity = {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}};
+    t.options = {
+        {"shells", 64, "", "spheres drawn between r_min and r_max, 2..4096"},
+        {"segments", 64, "", "tessellation: segments in phi, segments / 2 in theta, 4..1024"},
+        {"r_min", 0.5, "", "innermost shell radius, world units"},
+        {"r_max", 1.0, "", "outermost shell radius, world units (> r_min)"},
+        {"center", {0, 0, 0}, "", "center of the shells, world space"},
+        {"color_matrix", identity, "", "pixel transfer on (u, v, w, 1): 4 rows of 4 numbers"},
+        {"scale", {1, 1, 1, 1}, "", "pixel transfer scale, after the color matrix"},
+        {"bias", {0, 0, 0, 0}, "", "pixel transfer bias, after the scale"},
+        {"opacity", "path", "", "a shell's opacity from \"path\" (the ray's length in its slab) or \"radial\""},
+    };
+    t.makeForVolume = makeSphericalRenderer;
+    return t;
+}
+
 SphericalOptions parseSphericalOptions(const nlohmann::json& options)
 {
+    static const TechniqueInfo& info = technique("spherical");
     SphericalOptions o;
-    if (options.is_null())
-        return o;
-    if (!options.is_object())
-        throw InputError("options: must be an object");
-    for (const auto& [key, value] : options.items()) {
+    forEachOption(options, info, [&](const std::string& key, const nlohmann::json& value) {
         if (key == "shells") {
             o.shells = integerIn(key, value, 2, kMaxShells);
         } else if (key == "segments") {
@@ -99,9 +117,9 @@ SphericalOptions parseSphericalOptions(const nlohmann::json& options)
             else
                 badOption(key, "must be \"path\" or \"radial\", got " + value.dump());
         } else {
-            badOption(key, std::string("unknown option for spherical (known: ") + kKnownOptions + ")");
+            unparsedOption(info, key);
         }
-    }
+    });
     if (!(o.domain.rMax > o.domain.rMin))
         badOption("r_max", "must be greater than r_min (" + std::to_string(o.domain.rMin) + "), got " +
                                std::to_string(o.domain.rMax));
@@ -191,9 +209,9 @@ raster::PixelTransfer composeTextureMap(const raster::PixelTransfer& user, const
 SphericalRenderer::SphericalRenderer(Device& device, const Scene& scene, const Volume& volume)
     : device_(device), options_(parseSphericalOptions(scene.options)), imageSpec_(scene.image)
 {
-    if (!scene.lights.is_null())
+    if (scene.lighting.shaded())
         throw InputError("lights: technique spherical renders unshaded (no \"lights\")");
-    if (!scene.iso.is_null())
+    if (scene.iso)
         throw InputError("iso: technique spherical renders no iso-surfaces (no \"iso\")");
     volume.validate();
     dims_ = volume.dims;

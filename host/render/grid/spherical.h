@@ -45,6 +45,9 @@ struct SphericalOptions {
     enum class Opacity { Path, Radial } opacity = Opacity::Path;
 };
 
+// Its registry entry (host/render/renderer.h): name, data kind, one line, options with defaults.
+TechniqueInfo sphericalTechnique();
+
 // Reads the scene's "options" for spherical. Throws InputError naming the key ("options.shells: ...").
 SphericalOptions parseSphericalOptions(const nlohmann::json& options);
 

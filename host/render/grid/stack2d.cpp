@@ -27,9 +27,7 @@ namespace {
 
 // The most intermediate slices per stack interval; 64 already samples far finer than the data.
 constexpr int kMaxIntermediate = 64;
-constexpr int kMaxMapSize = 1024;
 constexpr int kMaxSlicesPerPolygon = 64;
-constexpr const char* kKnownOptions = "intermediate, reflectance_map_size, slices_per_polygon, clip_texture";
 constexpr const char* kAxisNames[3] = {"x", "y", "z"};
 
 // The stack along `axis`: slice i (grid index i on that axis) is a 2D texture over the other two
@@ -106,7 +104,7 @@ private:
 };
 
 Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volume& volume)
-    : device_(device), options_(parseStack2dOptions(scene.options)), image_(scene.image), lighting_(sceneLighting(scene))
+    : device_(device), options_(parseStack2dOptions(scene.options)), image_(scene.image), lighting_(scene.lighting)
 {
     volume.validate();
     dims_ = volume.dims;
@@ -118,19 +116,15 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
     camera_.validate();
     if (image_.width < 1 || image_.height < 1)
         throw InputError("image: width and height must be >= 1");
-    if (!scene.iso.is_null()) {  // keys and types checked by parseScene
+    if (scene.iso) {
         Iso iso;
-        iso.value = scene.iso["value"].get<double>();
-        const std::string shading = scene.iso.value("shading", std::string("gradient"));
-        if (shading != "gradient" && shading != "none")
-            throw InputError("iso.shading: stack2d knows \"gradient\" and \"none\", got \"" + shading + "\"");
-        iso.gradientShading = shading == "gradient";
-        iso.light = scene.iso.contains("light")
-                        ? glm::normalize(glm::dvec3(scene.iso["light"][0].get<double>(), scene.iso["light"][1].get<double>(),
-                                                    scene.iso["light"][2].get<double>()))
-                        : -camera_.forward();
-        iso.ambient = scene.iso.value("ambient", iso.ambient);
-        iso.diffuse = scene.iso.value("diffuse", iso.diffuse);
+        iso.value = scene.iso->value;
+        if (scene.iso->shading == IsoSpec::Shading::Gradientless)
+            throw InputError("iso.shading: stack2d knows \"gradient\" and \"none\", got \"gradientless\"");
+        iso.gradientShading = scene.iso->shading == IsoSpec::Shading::Gradient;
+        iso.light = scene.iso->lightFor(camera_);
+        iso.ambient = scene.iso->ambient;
+        iso.diffuse = scene.iso->diffuse;
         if (!scene.transferFunction.points().empty())
             iso.color = glm::dvec3(scene.transferFunction(iso.value));
         const auto [mn, mx] = std::minmax_element(volume.values.begin(), volume.values.end());
@@ -448,20 +442,37 @@ Image4f Stack2dRenderer::render(FrameStats& stats)
 
 }  // namespace
 
+TechniqueInfo stack2dTechnique()
+{
+    TechniqueInfo t;
+    t.name = "stack2d";
+    t.data = DataKind::Volume;
+    t.description = "object-aligned 2D texture stacks, the one most facing the view (docs/stack2d.md)";
+    t.options = {
+        {"intermediate", 0, "", "slices interpolated between two neighbouring stack slices"},
+        reflectanceMapSizeInfo(),
+        {"slices_per_polygon", 1, "", "stack slices one quad stands for (seeds/003's multi-texture speed-up)"},
+        clipTextureInfo(),
+    };
+    t.makeForVolume = makeStack2dRenderer;
+    return t;
+}
+
 Stack2dOptions parseStack2dOptions(const nlohmann::json& options)
 {
+    static const TechniqueInfo& info = technique("stack2d");
     Stack2dOptions o;
-    forEachOption(options, [&](const std::string& key, const nlohmann::json& value) {
+    forEachOption(options, info, [&](const std::string& key, const nlohmann::json& value) {
         if (key == "intermediate")
             o.intermediate = integerOption(key, value, 0, kMaxIntermediate);
         else if (key == "reflectance_map_size")
-            o.reflectanceMapSize = integerOption(key, value, 1, kMaxMapSize);
+            o.reflectanceMapSize = reflectanceMapSizeOption(value);
         else if (key == "slices_per_polygon")
             o.slicesPerPolygon = integerOption(key, value, 1, kMaxSlicesPerPolygon);
         else if (key == "clip_texture")
             o.clipTexture = parseClipTextureSpec(value, "options.clip_texture");
         else
-            badOption(key, std::string("unknown option for stack2d (known: ") + kKnownOptions + ")");
+            unparsedOption(info, key);
     });
     return o;
 }

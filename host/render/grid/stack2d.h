@@ -32,6 +32,9 @@ struct Stack2dOptions {
     std::optional<ClipTextureSpec> clipTexture;
 };
 
+// Its registry entry (host/render/renderer.h): name, data kind, one line, options with defaults.
+TechniqueInfo stack2dTechnique();
+
 // Reads the scene's "options" for stack2d. Throws InputError naming the key ("options.intermediate: ...").
 Stack2dOptions parseStack2dOptions(const nlohmann::json& options);
 

@@ -24,7 +24,6 @@
 namespace clvr {
 namespace {
 
-constexpr const char* kKnownOptions = "integration, full_table, max_steps, early_termination, entry, max_layers";
 
 void meshBounds(const TetMesh& mesh, glm::dvec3& lo, glm::dvec3& hi)
 {
@@ -269,14 +268,31 @@ Image4f HarcRenderer::render(FrameStats& stats)
 
 }  // namespace
 
+TechniqueInfo harcTechnique()
+{
+    TechniqueInfo t;
+    t.name = "harc";
+    t.data = DataKind::Mesh;
+    t.description = "tetrahedral ray casting with partial pre-integration, seeds/001 (docs/harc.md)";
+    t.options = {
+        {"integration", "partial", "", "\"partial\" (Eq. 2-4), \"average\" (mean color per segment) or \"full\" (3D table)"},
+        {"full_table", nullptr, "[64, 64], with integration full only", "[NS, NL]: the full table's samples of s_f, s_b and of l"},
+        {"max_steps", nullptr, "4 cbrt(tets) + 10000", "traversal steps per ray before it is stopped and counted"},
+        earlyTerminationInfo(1.0),
+        {"entry", "host", "", "entry faces per pixel: \"host\" (exact ray/face tests) or \"raster\" (depth peeling)"},
+        {"max_layers", 64, "", "raster entry: depth-peeling layers per frame, 1..255"},
+    };
+    t.makeForMesh = [](Device& device, const Scene& scene, const TetMesh& mesh) -> std::unique_ptr<Renderer> {
+        return makeHarcRenderer(device, scene, mesh, buildTopology(mesh));
+    };
+    return t;
+}
+
 HarcOptions parseHarcOptions(const nlohmann::json& options)
 {
+    static const TechniqueInfo& info = technique("harc");
     HarcOptions o;
-    if (options.is_null())
-        return o;
-    if (!options.is_object())
-        throw InputError("options: must be an object");
-    for (const auto& [key, value] : options.items()) {
+    forEachOption(options, info, [&](const std::string& key, const nlohmann::json& value) {
         if (key == "integration") {
             const std::string s = value.is_string() ? value.get<std::string>() : "";
             if (s == "partial")
@@ -319,13 +335,11 @@ HarcOptions parseHarcOptions(const nlohmann::json& options)
                 badOption(key, "must be an integer in [1, 4294967295], got " + value.dump());
             o.maxSteps = value.get<std::uint64_t>();
         } else if (key == "early_termination") {
-            if (!value.is_number() || !(value.get<double>() > 0.0 && value.get<double>() <= 1.0))
-                badOption(key, "must be an opacity in (0, 1] (1 = off), got " + value.dump());
-            o.earlyTermination = value.get<double>();
+            o.earlyTermination = earlyTerminationOption(value);
         } else {
-            badOption(key, std::string("unknown option for harc (known: ") + kKnownOptions + ")");
+            unparsedOption(info, key);
         }
-    }
+    });
     if (options.contains("full_table") && o.integration != HarcOptions::Integration::Full)
         badOption("full_table", "applies only to \"integration\": \"full\"");
     return o;

@@ -35,6 +35,9 @@ struct HarcOptions {
     int maxLayers = 64;  // raster entry: peeling layers per frame (1..255); rays past them are counted
 };
 
+// Its registry entry (host/render/renderer.h): name, data kind, one line, options with defaults.
+TechniqueInfo harcTechnique();
+
 // Reads the scene's "options" for harc: "integration" ("partial" | "average" | "full"), "full_table"
 // ([NS, NL], integers in [2, 512], at most kMaxFullTableBytes, only with "full"), "max_steps" (integer
 // >= 1), "early_termination" (opacity in (0, 1]), "entry" ("raster" | "host"), "max_layers" (integer
