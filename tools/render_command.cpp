@@ -26,6 +26,7 @@
 #include <iomanip>
 #include <iostream>
 #include <mutex>
+#include <set>
 #include <sstream>
 #include <stop_token>
 #include <thread>
@@ -189,7 +190,7 @@ std::string framePath(const std::string& pattern, int k)
 }
 
 // The image files the command writes: one, or one per orbit frame; each checked (format, writable
-// folder) before anything is rendered.
+// folder, a name of its own) before anything is rendered.
 std::vector<std::string> outputPaths(const RenderOptions& options)
 {
     std::vector<std::string> paths;
@@ -206,10 +207,10 @@ std::vector<std::string> outputPaths(const RenderOptions& options)
             throw InputError(path + ": unsupported image format \"" + ext + "\" (use .png or .exr)");
         checkWritable(path, "output");
     }
-    for (std::size_t k = 1; k < paths.size(); ++k)
-        if (paths[k] == paths[k - 1])
-            throw InputError(options.output + ": frames " + std::to_string(k - 1) + " and " + std::to_string(k) +
-                             " would both be written to " + paths[k]);
+    std::set<std::string> seen;
+    for (const std::string& path : paths)
+        if (!seen.insert(path).second)
+            throw InputError(options.output + ": two frames would both be written to " + path);
     return paths;
 }
 
