@@ -115,6 +115,32 @@ Frame Session::render()
     return frame;
 }
 
+nlohmann::json Session::stats(const Frame& frame) const
+{
+    nlohmann::json passes = nlohmann::json::array();
+    for (const PassTime& p : frame.stats.passes)
+        passes.push_back({{"name", p.name}, {"ms", p.ms}});
+    nlohmann::json out = {
+        {"technique", scene_.technique},
+        {"device", device_->listing().name},
+        {"device_description", device_->description()},
+        {"width", scene_.image.width},
+        {"height", scene_.image.height},
+        {"frame_ms", frame.stats.frameMs},
+        {"compile_ms", device_->compileMs()},
+        {"load_ms", data_.loadMs},
+        {"passes", passes},
+        {"samples", frame.stats.samples},
+        {"resident_bytes", renderer_->residentBytes()},
+    };
+    if (!isMesh())
+        out["voxels"] = data_.volume.voxelCount();
+    for (const auto& [key, value] : frame.stats.extra.items())
+        if (!out.contains(key))
+            out[key] = value;
+    return out;
+}
+
 void Session::setCamera(const Camera& camera)
 {
     camera.validate();

@@ -11,6 +11,8 @@
 #include "host/scene.h"
 #include "host/volume.h"
 
+#include <nlohmann/json.hpp>
+
 #include <memory>
 #include <string>
 
@@ -71,6 +73,11 @@ public:
     const Renderer& renderer() const { return *renderer_; }
     // Wall time of the latest renderer set-up (upload, kernel builds), in ms.
     double setupMs() const { return setupMs_; }
+    // The --stats object of docs/cli.md for `frame`: technique, device, device_description, width, height,
+    // frame_ms, compile_ms, load_ms, passes, samples, resident_bytes, voxels (volume scenes), then the
+    // technique's own counts (FrameStats::extra), which never replace those keys. The caller adds what
+    // only it knows (clvr render: scene, first_frame_ms, orbit frames).
+    nlohmann::json stats(const Frame& frame) const;
 
 private:
     void makeRenderer();

@@ -82,6 +82,13 @@ TEST(Session, CameraChangeMatchesAFreshSession)
     ASSERT_EQ(first.image.height(), 20);
     EXPECT_GT(first.stats.frameMs, 0.0);
     EXPECT_TRUE(sameBits(session.render().image, first.image)) << "two frames of one camera differ";
+    const nlohmann::json stats = session.stats(first);
+    EXPECT_EQ(stats["technique"], "slice3d");
+    EXPECT_EQ(stats["width"], 24);
+    EXPECT_EQ(stats["voxels"], 16 * 16 * 16);
+    EXPECT_EQ(stats["frame_ms"].get<double>(), first.stats.frameMs);
+    EXPECT_EQ(stats["passes"].size(), first.stats.passes.size());
+    EXPECT_GT(stats["resident_bytes"].get<std::uint64_t>(), 0u);
 
     session.setCamera(orbitCamera(camera0, 1, 3));
     const Frame turned = session.render();

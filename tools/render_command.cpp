@@ -214,13 +214,6 @@ std::vector<std::string> outputPaths(const RenderOptions& options)
     return paths;
 }
 
-nlohmann::json passesJson(const std::vector<PassTime>& passes)
-{
-    nlohmann::json out = nlohmann::json::array();
-    for (const PassTime& p : passes)
-        out.push_back({{"name", p.name}, {"ms", p.ms}});
-    return out;
-}
 
 }  // namespace
 
@@ -270,30 +263,13 @@ int render(const RenderOptions& options)
     // 4. Stats, atomically; frame 0's figures at the top level as without --orbit.
     const FrameStats& steady = frame0.stats;
     if (!options.statsPath.empty()) {
-        nlohmann::json stats = {
-            {"technique", session.scene().technique},
-            {"device", session.device().listing().name},
-            {"device_description", session.device().description()},
-            {"scene", useDefault ? std::string("default") : options.scene},
-            {"width", session.scene().image.width},
-            {"height", session.scene().image.height},
-            {"frame_ms", steady.frameMs},
-            {"compile_ms", session.device().compileMs()},
-            {"first_frame_ms", firstFrameMs},
-            {"load_ms", session.data().loadMs},
-            {"passes", passesJson(steady.passes)},
-            {"samples", steady.samples},
-            {"resident_bytes", session.renderer().residentBytes()},
-        };
-        if (!session.isMesh())
-            stats["voxels"] = session.data().volume.voxelCount();
+        nlohmann::json stats = session.stats(frame0);
+        stats["scene"] = useDefault ? std::string("default") : options.scene;
+        stats["first_frame_ms"] = firstFrameMs;
         if (options.orbit > 0) {
             stats["orbit"] = options.orbit;
             stats["frames"] = frames;
         }
-        for (const auto& [key, value] : steady.extra.items())
-            if (!stats.contains(key))
-                stats[key] = value;
         writeFileAtomically(options.statsPath, stats.dump(2) + "\n");
     }
 
