@@ -1,9 +1,9 @@
 // host/session.cpp — clvr::Session: one scene's data, device and renderer kept across frames.
 #include "host/session.h"
 
-#include "host/errors.h"
-#include "host/mesh_io.h"
-#include "host/volume_io.h"
+#include "host/runtime/errors.h"
+#include "host/io/mesh_io.h"
+#include "host/io/volume_io.h"
 
 #include <chrono>
 #include <cmath>

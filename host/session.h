@@ -3,13 +3,13 @@
 // `clvr bench` are thin layers over it; a cluster layer or a language binding calls the same.
 #pragma once
 
-#include "host/camera.h"
-#include "host/device.h"
-#include "host/image.h"
-#include "host/mesh.h"
+#include "host/model/camera.h"
+#include "host/runtime/device.h"
+#include "host/model/image.h"
+#include "host/model/mesh.h"
 #include "host/render/renderer.h"
-#include "host/scene.h"
-#include "host/volume.h"
+#include "host/model/scene.h"
+#include "host/model/volume.h"
 
 #include <nlohmann/json.hpp>
 

@@ -1,10 +1,10 @@
-// tests/parallel_test.cpp — the thread budget of host/parallel.h: runOnThreads keeps to it, results do not
+// tests/parallel_test.cpp — the thread budget of host/runtime/parallel.h: runOnThreads keeps to it, results do not
 // depend on it, and bad values are InputErrors.
-#include "host/parallel.h"
+#include "host/runtime/parallel.h"
 
-#include "host/errors.h"
-#include "host/generators.h"
-#include "host/gradient_volume.h"
+#include "host/runtime/errors.h"
+#include "host/io/generators.h"
+#include "host/optics/gradient_volume.h"
 
 #include <gtest/gtest.h>
 

@@ -2,8 +2,8 @@
 // between frames equal to a fresh Session with that camera.
 #include "host/session.h"
 
-#include "host/errors.h"
-#include "tests/test_util.h"
+#include "host/runtime/errors.h"
+#include "tests/support/test_util.h"
 
 #include <gtest/gtest.h>
 

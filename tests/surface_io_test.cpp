@@ -1,12 +1,12 @@
-// tests/surface_io_test.cpp — host/surface_io.h against tetgenio's own readers (same points, polygons,
+// tests/surface_io_test.cpp — host/io/surface_io.h against tetgenio's own readers (same points, polygons,
 // holes and numbering, so TetGen makes the same mesh), and TetGen silenced without touching stdout:
 // meshing and reading clip surfaces print nothing.
-#include "host/surface_io.h"
+#include "host/io/surface_io.h"
 
-#include "host/clip_mesh.h"
-#include "host/errors.h"
-#include "host/tetgen_mesher.h"
-#include "tests/test_util.h"
+#include "host/optics/clip_mesh.h"
+#include "host/runtime/errors.h"
+#include "host/io/tetgen_mesher.h"
+#include "tests/support/test_util.h"
 
 #include <tetgen.h>
 

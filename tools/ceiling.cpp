@@ -2,7 +2,7 @@
 // slice3d_fused, line for line in float, over rows on std::threads.
 #include "tools/ceiling.h"
 
-#include "host/parallel.h"
+#include "host/runtime/parallel.h"
 
 #include <algorithm>
 #include <atomic>

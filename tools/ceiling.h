@@ -3,14 +3,14 @@
 // piecewise-linear transfer-function lookup, alpha = 1 - exp(-tau Delta), "over" compositing) as a
 // plain C++ loop, multithreaded with std::thread over rows. clvr bench reports clvr's samples/s as
 // a fraction of this loop's (docs/benchmarks.md). Not part of the library; tests/bench_test.cpp
-// checks its image against host/reference_integral.h.
+// checks its image against host/reference/reference_integral.h.
 #pragma once
 
-#include "host/camera.h"
-#include "host/image.h"
-#include "host/render/slice3d.h"
-#include "host/transfer_function.h"
-#include "host/volume.h"
+#include "host/model/camera.h"
+#include "host/model/image.h"
+#include "host/render/grid/slice3d.h"
+#include "host/model/transfer_function.h"
+#include "host/model/volume.h"
 
 #include <glm/glm.hpp>
 
@@ -34,7 +34,7 @@ struct CeilingResult {
 class Ceiling {
 public:
     Ceiling(const Volume& volume, const TransferFunction& tf, const CeilingScene& scene);
-    // Renders with `threads` threads taking rows from a shared counter (<= 0: the thread budget, host/parallel.h).
+    // Renders with `threads` threads taking rows from a shared counter (<= 0: the thread budget, host/runtime/parallel.h).
     CeilingResult render(int threads = 0) const;
     // The slices, as slice3d plans them (planSlices).
     const SlicePlan& plan() const { return plan_; }

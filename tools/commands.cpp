@@ -2,9 +2,9 @@
 // tools/render_command.cpp, bench in tools/bench.cpp. docs/cli.md documents every option.
 #include "tools/commands.h"
 
-#include "host/device.h"
-#include "host/errors.h"
-#include "host/parallel.h"
+#include "host/runtime/device.h"
+#include "host/runtime/errors.h"
+#include "host/runtime/parallel.h"
 #include "host/render/renderer.h"
 #if __has_include("tools/bench.h")  // tools/bench.{h,cpp} land separately; without them no `bench`
 #include "tools/bench.h"
@@ -53,7 +53,7 @@ std::string techniqueList()
     return out;
 }
 
-// The thread budget (host/parallel.h): --threads, else $CLVR_THREADS, else one per hardware thread (and
+// The thread budget (host/runtime/parallel.h): --threads, else $CLVR_THREADS, else one per hardware thread (and
 // PoCL left to its own default). Set before the first OpenCL call, so that PoCL's CPU device reads it.
 void applyThreadBudget(const std::string& threadsOption)
 {

@@ -1,0 +1,13 @@
+// host/runtime/file_io.h — file checks shared by the data readers: each failure is one InputError naming the file.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+
+namespace clvr {
+
+// The size of the regular file at `path`; InputError "<path>: no such file", "... is a directory, not a
+// file" or "... cannot read (...)".
+std::uint64_t fileSize(const std::filesystem::path& path);
+
+}  // namespace clvr
