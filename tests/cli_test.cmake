@@ -231,8 +231,8 @@ expect_error(2 ${out} "default scene: options.brick_budget: 100 bytes is less th
 expect_error(2 ${out} "CLVR_DEVICE_MEMORY_LIMIT"
   ${CMAKE_COMMAND} -E env CLVR_DEVICE_MEMORY_LIMIT=lots ${CLVR} render -o ${out} ${SMALL})
 
-# A clip mesh and a mesh surface read through TetGen's readers (which print "Opening FILE." on stdout):
-# clvr's stdout is its own one line.
+# A clip mesh and a mesh surface in TetGen's formats (read by clvr; TetGen's own readers would print
+# "Opening FILE." on stdout): clvr's stdout is its own one line.
 function(expect_one_stdout_line scene)
   execute_process(COMMAND ${CLVR} render ${SRC}/data/scenes/${scene}.json -o ${WORK}/${scene}.png ${SMALL} ${ARGN}
                   RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 300)
@@ -242,3 +242,75 @@ function(expect_one_stdout_line scene)
 endfunction()
 expect_one_stdout_line(engine-clip-torus --set options.slices=16)
 expect_one_stdout_line(torus)
+
+# --- --orbit: 3 frames in one process; frame 0 is the plain render bit for bit, frame 1 differs.
+set(TINY ${SMALL} "--set" "volume={\"generator\":\"marschner-lobb\",\"dims\":[16,16,16]}")
+file(MAKE_DIRECTORY "${WORK}/frames")
+expect_run(0 "^wrote .*plain.png \\(64x64, slice3d" ${CLVR} render -o ${WORK}/plain.png ${TINY})
+expect_run(0 "^wrote .*f%03d.png: 3 frames \\(64x64, slice3d, [0-9.]+ ms/frame\\)\n$"
+  ${CLVR} render -o ${WORK}/frames/f%03d.png ${TINY} --orbit 3 --stats ${WORK}/orbit-stats.json)
+foreach(k 000 001 002)
+  expect_png(${WORK}/frames/f${k}.png 64 64)
+endforeach()
+file(SHA256 "${WORK}/plain.png" plainHash)
+file(SHA256 "${WORK}/frames/f000.png" frame0Hash)
+file(SHA256 "${WORK}/frames/f001.png" frame1Hash)
+if(NOT plainHash STREQUAL frame0Hash)
+  message(FATAL_ERROR "--orbit frame 0 differs from the plain render")
+endif()
+if(plainHash STREQUAL frame1Hash)
+  message(FATAL_ERROR "--orbit frame 1 equals frame 0: the camera did not turn")
+endif()
+file(READ "${WORK}/orbit-stats.json" orbitStats)
+string(JSON nframes LENGTH "${orbitStats}" frames)
+string(JSON frame2ms GET "${orbitStats}" frames 2 frame_ms)
+string(JSON frame2out GET "${orbitStats}" frames 2 output)
+string(JSON orbitN GET "${orbitStats}" orbit)
+if(NOT nframes EQUAL 3 OR NOT orbitN EQUAL 3 OR NOT frame2out MATCHES "f002.png$" OR NOT frame2ms GREATER 0)
+  message(FATAL_ERROR "orbit-stats.json: want 3 frames with times and outputs:\n${orbitStats}")
+endif()
+# --single-frame renders once: the same image.
+expect_run(0 "^wrote .*single.png" ${CLVR} render -o ${WORK}/single.png ${TINY} --single-frame)
+file(SHA256 "${WORK}/single.png" singleHash)
+if(NOT singleHash STREQUAL plainHash)
+  message(FATAL_ERROR "--single-frame differs from the default (first + steady frame) render")
+endif()
+
+# Bad patterns: exit 2, one line, and no frame file at all.
+file(REMOVE_RECURSE "${WORK}/frames")
+file(MAKE_DIRECTORY "${WORK}/frames")
+foreach(pattern "f.png" "f%d%d.png" "f%s.png" "f%03.png" "f%ld.png" "f%d%.png")
+  expect_error(2 "${WORK}/frames/f0.png" "exactly one integer conversion"
+    ${CLVR} render -o "${WORK}/frames/${pattern}" ${TINY} --orbit 2)
+  file(GLOB written "${WORK}/frames/*")
+  if(written)
+    message(FATAL_ERROR "--orbit with pattern ${pattern} left files: ${written}")
+  endif()
+endforeach()
+expect_error(2 "${WORK}/frames/f0.jpg" "f0.jpg: unsupported image format" ${CLVR} render -o "${WORK}/frames/f%d.jpg" ${TINY} --orbit 2)
+expect_error(2 "${WORK}/frames/f0.png" "directory .*no-dir-0 does not exist"
+  ${CLVR} render -o "${WORK}/frames/no-dir-%d/f.png" ${TINY} --orbit 2)
+expect_error(2 "${WORK}/frames/f0.png" "--orbit" ${CLVR} render -o "${WORK}/frames/f%d.png" ${TINY} --orbit 0)
+file(GLOB written "${WORK}/frames/*")
+if(written)
+  message(FATAL_ERROR "a failed --orbit left files: ${written}")
+endif()
+
+# --- the thread budget: --threads 1 (and CLVR_THREADS=1) renders the same image; PoCL runs one compute
+# unit unless POCL_CPU_MAX_CU_NUM says otherwise; bad values are bad input.
+expect_run(0 "^wrote .*threads1.png" ${CLVR} render -o ${WORK}/threads1.png ${TINY} --threads 1)
+file(SHA256 "${WORK}/threads1.png" threadsHash)
+if(NOT threadsHash STREQUAL plainHash)
+  message(FATAL_ERROR "--threads 1 changed the image")
+endif()
+expect_run(0 "\\* [0-9]+: [^\n]*, 1 compute units" ${CLVR} info --threads 1)
+expect_run(0 "\\* [0-9]+: [^\n]*, 1 compute units" ${CMAKE_COMMAND} -E env CLVR_THREADS=1 ${CLVR} info)
+cmake_host_system_information(RESULT cores QUERY NUMBER_OF_LOGICAL_CORES)
+if(cores GREATER_EQUAL 2)  # the user's own PoCL setting wins over --threads (PoCL 3.1 reads this name)
+  expect_run(0 "\\* [0-9]+: [^\n]*, 2 compute units"
+    ${CMAKE_COMMAND} -E env POCL_MAX_PTHREAD_COUNT=2 ${CLVR} info --threads 1)
+endif()
+expect_error(2 ${out} "--threads: want a whole number of threads" ${CLVR} render -o ${out} ${TINY} --threads 0)
+expect_error(2 ${out} "--threads: want a whole number of threads" ${CLVR} render -o ${out} ${TINY} --threads x)
+expect_error(2 ${out} "CLVR_THREADS: want a whole number of threads"
+  ${CMAKE_COMMAND} -E env CLVR_THREADS=-3 ${CLVR} render -o ${out} ${TINY})

@@ -154,7 +154,7 @@ TEST(ClipMesh, ReadsObjAndAsciiAndBinaryStlWithPlacement)
     EXPECT_EQ(readBinary.points.size(), 8u);
     EXPECT_NEAR(signedVolume(readBinary), 8.0, 1e-12);
     test::writeFile(dir / "cut-binary.stl", binary.substr(0, binary.size() - 10));  // neither binary nor ASCII
-    expectInputError([&] { readSurface(dir / "cut-binary.stl"); }, "cut-binary.stl: TetGen's reader could not read a surface");
+    expectInputError([&] { readSurface(dir / "cut-binary.stl"); }, "cut-binary.stl: 0 vertices, not a positive multiple of 3");
 
     test::writeFile(dir / "bad.obj", "v 0 0 0\nv 1 0 0\nf 1 2 3\n");
     expectInputError([&] { readSurface(dir / "bad.obj"); }, "bad.obj:3: face index 3 names no vertex read so far (2)");

@@ -1,5 +1,6 @@
-// tools/bench.cpp — `clvr bench` (DESIGN.md, "How results are judged": speed and peers). Steady-state
-// frames with the data already on the device, compilation reported apart, median of several frames;
+// tools/bench.cpp — `clvr bench` (DESIGN.md, "How results are judged": speed and peers), over
+// clvr::Session (host/session.h) on one device shared by every scene. Steady-state frames with the data
+// already on the device, compilation reported apart, median of several frames;
 // the ceiling loop (tools/ceiling.h) and VTK (tools/peer_vtk.py, tools/peer_vtk_unstructured.py for
 // meshes) on the same scene in the same run.
 #include "tools/bench.h"
@@ -9,7 +10,9 @@
 #include "host/io/image_io.h"
 #include "host/model/mesh.h"
 #include "host/render/renderer.h"
+#include "host/runtime/parallel.h"
 #include "host/model/scene.h"
+#include "host/session.h"
 #include "host/io/volume_io.h"
 #include "tools/bench_mesh.h"
 #include "tools/ceiling.h"
@@ -232,47 +235,40 @@ nlohmann::json runMeshPeer(const fs::path& peerScene, int frames, const fs::path
 
 // One tetrahedral-mesh scene: load (or TetGen, cached), set-up, a first frame, steady frames; the
 // figures of seeds/001 Tables 2-3 (tools/bench_mesh.h); with --peer, VTK on the same tetrahedra.
-nlohmann::json benchMeshScene(Device& device, const fs::path& scenePath, Scene scene, const BenchOptions& options,
-                              int frames, const fs::path& prefix)
+nlohmann::json benchMeshScene(Device& device, const fs::path& scenePath, const Scene& sceneIn,
+                              const BenchOptions& options, int frames, const fs::path& prefix)
 {
     const std::string name = scenePath.stem().string();
+    const Scene& scene = sceneIn;
     std::cout << name << " (" << scene.technique << ", " << scene.image.width << "x" << scene.image.height << ", "
               << scene.transferFunction.points().size() - 1 << " transfer-function segments)\n" << std::flush;
     const fs::path cacheDir = options.meshCache.empty() ? defaultMeshCacheDir() : fs::path(options.meshCache);
-    auto t0 = Clock::now();
-    const TetMesh mesh = loadBenchMesh(scene, name, cacheDir, [](const std::string& line) {
+    SceneData data;
+    const auto t0 = Clock::now();
+    data.mesh = loadBenchMesh(scene, name, cacheDir, [](const std::string& line) {
         std::cout << "  " << line << '\n' << std::flush;
     });
-    const double loadMs = msSince(t0);
-    if (!scene.camera)  // as clvr render: the whole mesh in view; the peer gets the same camera
-        scene.camera = fitCamera(mesh.boundsMin(), mesh.boundsMax());
+    data.loadMs = msSince(t0);
+    const double loadMs = data.loadMs;
 
+    // As clvr render: a camera fitted to the whole mesh when the scene has none; the peer gets the same.
     const double compile0 = device.compileMs();
-    t0 = Clock::now();
-    std::unique_ptr<Renderer> renderer;
-    try {
-        renderer = makeMeshRenderer(device, scene, mesh);
-    } catch (const DeviceError&) {
-        throw;
-    } catch (const InputError& e) {  // technique or options (a mode not built yet): name the scene
-        throw InputError(scenePath.string() + ": " + e.what());
-    }
-    const double setupMs = msSince(t0);
-    FrameStats firstStats;
-    t0 = Clock::now();
-    renderer->render(firstStats);
-    const double firstFrameMs = msSince(t0);
+    Session session(device, scene, std::move(data), scenePath.string());
+    const TetMesh& mesh = session.data().mesh;
+    const Renderer* renderer = &session.renderer();
+    const double setupMs = session.setupMs();
+    const double firstFrameMs = session.render().wallMs;
     const double compileMs = device.compileMs() - compile0;
 
     std::vector<double> ms, statsMs;
     FrameStats stats;
     Image4f image;
     for (int i = 0; i < frames; ++i) {
-        stats = FrameStats{};
-        t0 = Clock::now();
-        image = renderer->render(stats);
-        ms.push_back(msSince(t0));
-        statsMs.push_back(stats.frameMs);
+        Frame frame = session.render();
+        ms.push_back(frame.wallMs);
+        statsMs.push_back(frame.stats.frameMs);
+        stats = std::move(frame.stats);
+        image = std::move(frame.image);
     }
     const Spread s = spread(ms);
     const MeshFigures f = meshFigures(stats.extra, s.median);
@@ -289,7 +285,7 @@ nlohmann::json benchMeshScene(Device& device, const fs::path& scenePath, Scene s
                         {"points", mesh.points.size()},
                         {"tf_control_points", scene.transferFunction.points().size()},
                         {"tf_segments", scene.transferFunction.points().size() - 1},
-                        {"camera", cameraJson(*scene.camera)},
+                        {"camera", cameraJson(session.camera())},
                         {"load_average", loadAverage()},
                         {"load_ms", loadMs},
                         {"setup_ms", setupMs},
@@ -332,7 +328,7 @@ nlohmann::json benchMeshScene(Device& device, const fs::path& scenePath, Scene s
 
     if (options.peer) {
         const fs::path peerScene = prefix.string() + ".peer.json", peerMesh = prefix.string() + ".mesh.vtk";
-        writePeerMeshScene(scene, mesh, *scene.camera, peerMesh, peerScene);
+        writePeerMeshScene(session.scene(), mesh, session.camera(), peerMesh, peerScene);
         nlohmann::json peer = runMeshPeer(peerScene, options.peerFrames > 0 ? options.peerFrames : frames, clvrPng,
                                           prefix);
         if (peer.contains("frame_ms")) {
@@ -467,6 +463,7 @@ int bench(const BenchOptions& options)
                          {"device_compute_units", device.listing().computeUnits},
                          {"cpu", cpuModel()},
                          {"cores", std::thread::hardware_concurrency()},
+                         {"thread_budget", threadBudget()},
                          {"date", utcNow()},
                          {"load_average_start", loadAverage()},
                          {"pocl_cache_dir", poclCache ? poclCache : "default (~/.cache/pocl)"}};
@@ -488,17 +485,13 @@ int bench(const BenchOptions& options)
             continue;
         }
         anyVolume = true;
-        const Volume volume = loadVolume(scene.volume, scene.baseDir);
-        const Camera camera = scene.camera ? *scene.camera : fitCamera(volume.boundsMin(), volume.boundsMax());
-
         const double compile0 = device.compileMs();
-        auto t0 = Clock::now();
-        const std::unique_ptr<Renderer> renderer = makeRenderer(device, scene, volume);
-        const double setupMs = msSince(t0);
-        FrameStats firstStats;
-        t0 = Clock::now();
-        renderer->render(firstStats);
-        const double firstFrameMs = msSince(t0);
+        Session session(device, scene, loadSceneData(scene), scenePath.string());
+        const Volume& volume = session.data().volume;
+        const Camera& camera = session.camera();
+        const Renderer* renderer = &session.renderer();
+        const double setupMs = session.setupMs();
+        const double firstFrameMs = session.render().wallMs;
         const double compileMs = device.compileMs() - compile0;
 
         // The ceiling's first frame warms its caches; then clvr and ceiling frames alternate.
@@ -507,7 +500,7 @@ int bench(const BenchOptions& options)
             scene.technique == slice3dTechnique().name && parseSlice3dOptions(scene.options).path == Slice3dOptions::Path::Fused
                 ? makeCeiling(scene, volume, camera)
                 : nullptr;
-        const int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+        const int threads = threadBudget();
         CeilingResult ceilingResult;
         if (ceiling)
             ceilingResult = ceiling->render(threads);
@@ -516,13 +509,13 @@ int bench(const BenchOptions& options)
         FrameStats stats;
         Image4f image;
         for (int i = 0; i < frames; ++i) {
-            stats = FrameStats{};
-            t0 = Clock::now();
-            image = renderer->render(stats);
-            ms.push_back(msSince(t0));
-            statsMs.push_back(stats.frameMs);
+            Frame frame = session.render();
+            ms.push_back(frame.wallMs);
+            statsMs.push_back(frame.stats.frameMs);
+            stats = std::move(frame.stats);
+            image = std::move(frame.image);
             if (ceiling) {
-                t0 = Clock::now();
+                const auto t0 = Clock::now();
                 ceilingResult = ceiling->render(threads);
                 ceilingMs.push_back(msSince(t0));
             }

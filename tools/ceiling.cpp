@@ -2,6 +2,8 @@
 // slice3d_fused, line for line in float, over rows on std::threads.
 #include "tools/ceiling.h"
 
+#include "host/runtime/parallel.h"
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -23,7 +25,7 @@ Ceiling::Ceiling(const Volume& volume, const TransferFunction& tf, const Ceiling
 CeilingResult Ceiling::render(int threads) const
 {
     if (threads <= 0)
-        threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+        threads = threadBudget();
     CeilingResult result;
     result.image = Image4f(scene_.width, scene_.height);
     std::atomic<int> nextRow{0};

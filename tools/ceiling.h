@@ -34,7 +34,7 @@ struct CeilingResult {
 class Ceiling {
 public:
     Ceiling(const Volume& volume, const TransferFunction& tf, const CeilingScene& scene);
-    // Renders with `threads` threads taking rows from a shared counter (<= 0: hardware_concurrency()).
+    // Renders with `threads` threads taking rows from a shared counter (<= 0: the thread budget, host/runtime/parallel.h).
     CeilingResult render(int threads = 0) const;
     // The slices, as slice3d plans them (planSlices).
     const SlicePlan& plan() const { return plan_; }

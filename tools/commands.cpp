@@ -4,6 +4,7 @@
 
 #include "host/runtime/device.h"
 #include "host/runtime/errors.h"
+#include "host/runtime/parallel.h"
 #include "host/render/renderer.h"
 #if __has_include("tools/bench.h")  // tools/bench.{h,cpp} land separately; without them no `bench`
 #include "tools/bench.h"
@@ -15,6 +16,7 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <cstdlib>
 #include <iostream>
 
 namespace clvr::tools {
@@ -81,6 +83,20 @@ int listTechniques(const std::string& name)
     return 0;
 }
 
+// The thread budget (host/runtime/parallel.h): --threads, else $CLVR_THREADS, else one per hardware thread (and
+// PoCL left to its own default). Set before the first OpenCL call, so that PoCL's CPU device reads it.
+void applyThreadBudget(const std::string& threadsOption)
+{
+    const char* env = std::getenv("CLVR_THREADS");
+    if (!threadsOption.empty())
+        setThreadBudget(parseThreadCount(threadsOption, "--threads"));
+    else if (env && *env)
+        setThreadBudget(parseThreadCount(env, "CLVR_THREADS"));
+    else
+        return;
+    passThreadBudgetToPocl();
+}
+
 }  // namespace
 
 // `clvr mesh` (tools/mesh_command.cpp).
@@ -117,6 +133,16 @@ int run(int argc, char** argv)
         ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
     render->add_option("--device", renderOptions.deviceSpec, deviceHelp);
     render->add_option("--stats", renderOptions.statsPath, "write per-pass times and counts as JSON to this file");
+    render->add_option("--orbit", renderOptions.orbit,
+                       "render N frames, frame k with the camera rotated by k*360/N degrees about view-up through "
+                       "the focal point; -o is then a printf pattern with one integer conversion, e.g. f%03d.png")
+        ->check(CLI::Range(1, 100000));
+    render->add_flag("--single-frame", renderOptions.singleFrame,
+                     "render once (by default a first frame and a steady frame are rendered; frame_ms is the steady one)");
+    std::string threads;
+    const std::string threadsHelp =
+        "host threads and PoCL compute units to use (default: $CLVR_THREADS, else all cores; docs/cli.md)";
+    render->add_option("--threads", threads, threadsHelp);
     render->footer("techniques: " + techniqueList() + " (clvr techniques lists their options)");
 
     std::string techniqueName;
@@ -127,6 +153,7 @@ int run(int argc, char** argv)
     std::string infoDevice;
     CLI::App* infoCommand = app.add_subcommand("info", "list OpenCL platforms and devices and say which one is used");
     infoCommand->add_option("--device", infoDevice, deviceHelp);
+    infoCommand->add_option("--threads", threads, threadsHelp);
 
 #if CLVR_HAVE_BENCH
     BenchOptions benchOptions;
@@ -154,6 +181,7 @@ int run(int argc, char** argv)
                              "override a value of every scene, path=json (e.g. options.integration=\"full\")");
     benchCommand->add_option("--unset", benchOptions.unsets,
                              "remove a key of every scene before --set, dotted.path (e.g. options)");
+    benchCommand->add_option("--threads", threads, threadsHelp);
     benchCommand->add_option("--mesh-cache", benchOptions.meshCache,
                              "folder for TetGen meshes of surface scenes (default: bench-data beside clvr)");
 #endif
@@ -177,6 +205,7 @@ int run(int argc, char** argv)
     } catch (const CLI::ParseError& e) {
         throw InputError("command line: " + oneLine(e.what()) + " (see clvr --help)");
     }
+    applyThreadBudget(threads);
     if (*render)
         return tools::render(renderOptions);
     if (*infoCommand)

@@ -18,11 +18,14 @@ struct RenderOptions {
     std::vector<std::string> unsets;     // --unset path, applied before the overrides
     std::string deviceSpec;              // --device (else $CLVR_DEVICE, else the first CPU device)
     std::string statsPath;               // --stats: JSON with times and counts; empty: none
+    int orbit = 0;                       // --orbit N: N frames about view-up, `output` a %d pattern; 0: one image
+    bool singleFrame = false;            // --single-frame: render once (no separate steady frame)
 };
 
-// Renders one image: checks the output paths, loads the scene and its data, opens the device, renders
-// a first frame (compiles kernels) and a steady frame, writes the image (and the stats) atomically
-// and prints one line to stdout. Returns 0; throws InputError / DeviceError / BuildError.
+// Renders one image (or --orbit N frames) through clvr::Session: checks every output path, loads the
+// scene and its data, opens the device, renders a first frame (compiles kernels) and, unless
+// --single-frame, a steady frame; then each further orbit frame once; writes the images (and the stats)
+// atomically and prints one line to stdout. Returns 0; throws InputError / DeviceError / BuildError.
 int render(const RenderOptions& options);
 
 }  // namespace clvr::tools

@@ -1,16 +1,14 @@
-// tools/render_command.cpp — `clvr render`: scene -> volume -> device -> renderer -> image (+ stats).
-// Every check that can fail on bad input runs before the device is opened; outputs are written to a
+// tools/render_command.cpp — `clvr render`: the command line over clvr::Session (host/session.h): one
+// image, or with --orbit N a camera path of N frames, plus stats. Every check that can fail on bad input runs before the device is opened; outputs are written to a
 // temporary file and renamed into place, so a failure never leaves a partial file (DESIGN.md).
 #include "tools/commands.h"
 
 #include "host/runtime/device.h"
 #include "host/runtime/errors.h"
 #include "host/io/image_io.h"
-#include "host/io/mesh_io.h"
 #include "host/render/renderer.h"
 #include "host/model/scene.h"
-#include "host/model/volume.h"
-#include "host/io/volume_io.h"
+#include "host/session.h"
 
 #include <nlohmann/json.hpp>
 
@@ -22,11 +20,13 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <mutex>
+#include <set>
 #include <sstream>
 #include <stop_token>
 #include <thread>
@@ -96,22 +96,23 @@ void writeFileAtomically(const std::string& path, const std::string& text)
 }
 
 // "\rclvr: rendering slice3d 512x512 ... 2.3 s" on stderr every 0.5 s once a render has taken a
-// second, only when stderr is a terminal; the line is cleared when the guard goes out of scope
-// (also while an exception unwinds, so the error line that main() prints stands alone).
+// second, only when stderr is a terminal; setLabel() changes the text (frame k of N); the line is
+// cleared when the guard goes out of scope (also while an exception unwinds, so the error line that
+// main() prints stands alone).
 class ProgressLine {
 public:
-    explicit ProgressLine(std::string label)
+    explicit ProgressLine(std::string text) : label_(std::move(text))
     {
         if (!::isatty(2))
             return;
-        thread_ = std::jthread([this, label = std::move(label), t0 = Clock::now()](std::stop_token stop) {
+        thread_ = std::jthread([this, t0 = Clock::now()](std::stop_token stop) {
             std::mutex m;
             std::condition_variable_any cv;
             std::unique_lock lock(m);
             const auto never = [] { return false; };  // wake only on timeout or stop
             cv.wait_for(lock, stop, std::chrono::seconds(1), never);
             while (!stop.stop_requested()) {
-                std::fprintf(stderr, "\rclvr: %s ... %.1f s", label.c_str(), msSince(t0) / 1000.0);
+                std::fprintf(stderr, "\r\033[Kclvr: %s ... %.1f s", label().c_str(), msSince(t0) / 1000.0);
                 std::fflush(stderr);
                 printed_ = true;
                 cv.wait_for(lock, stop, std::chrono::milliseconds(500), never);
@@ -132,110 +133,153 @@ public:
     ProgressLine(const ProgressLine&) = delete;
     ProgressLine& operator=(const ProgressLine&) = delete;
 
+    void setLabel(std::string label)
+    {
+        const std::lock_guard lock(labelMutex_);
+        label_ = std::move(label);
+    }
+
 private:
+    std::string label()
+    {
+        const std::lock_guard lock(labelMutex_);
+        return label_;
+    }
+
+    std::mutex labelMutex_;
+    std::string label_;
     std::atomic<bool> printed_{false};
-    std::jthread thread_;
+    std::jthread thread_;  // last: stopped and joined before the label goes
 };
 
-nlohmann::json passesJson(const std::vector<PassTime>& passes)
+// The --orbit output pattern: printf-style with exactly one integer conversion (%d, %i or %u, with flags,
+// width and precision, e.g. %03d), "%%" for a literal percent sign. InputError otherwise.
+void checkFramePattern(const std::string& pattern)
 {
-    nlohmann::json out = nlohmann::json::array();
-    for (const PassTime& p : passes)
-        out.push_back({{"name", p.name}, {"ms", p.ms}});
+    const std::string bad = pattern + ": --orbit needs an output pattern with exactly one integer conversion "
+                                      "such as %03d (and %% for a percent sign)";
+    int conversions = 0;
+    for (std::size_t i = 0; i < pattern.size(); ++i) {
+        if (pattern[i] != '%')
+            continue;
+        if (++i < pattern.size() && pattern[i] == '%')
+            continue;
+        while (i < pattern.size() && std::strchr("-+ #0", pattern[i]) && pattern[i] != '\0')
+            ++i;
+        while (i < pattern.size() && std::isdigit(static_cast<unsigned char>(pattern[i])))
+            ++i;
+        if (i < pattern.size() && pattern[i] == '.')
+            for (++i; i < pattern.size() && std::isdigit(static_cast<unsigned char>(pattern[i]));)
+                ++i;
+        if (i >= pattern.size() || !std::strchr("diu", pattern[i]) || pattern[i] == '\0')
+            throw InputError(bad);
+        ++conversions;
+    }
+    if (conversions != 1)
+        throw InputError(bad);
+}
+
+// Frame k's file name from a pattern checkFramePattern accepted.
+std::string framePath(const std::string& pattern, int k)
+{
+    const int size = std::snprintf(nullptr, 0, pattern.c_str(), k);
+    std::string out(static_cast<std::size_t>(size) + 1, '\0');
+    std::snprintf(out.data(), out.size(), pattern.c_str(), k);
+    out.resize(static_cast<std::size_t>(size));
     return out;
 }
+
+// The image files the command writes: one, or one per orbit frame; each checked (format, writable
+// folder, a name of its own) before anything is rendered.
+std::vector<std::string> outputPaths(const RenderOptions& options)
+{
+    std::vector<std::string> paths;
+    if (options.orbit == 0) {
+        paths.push_back(options.output);
+    } else {
+        checkFramePattern(options.output);
+        for (int k = 0; k < options.orbit; ++k)
+            paths.push_back(framePath(options.output, k));
+    }
+    for (const std::string& path : paths) {
+        const std::string ext = lowerExtension(path);
+        if (ext != ".png" && ext != ".exr")
+            throw InputError(path + ": unsupported image format \"" + ext + "\" (use .png or .exr)");
+        checkWritable(path, "output");
+    }
+    std::set<std::string> seen;
+    for (const std::string& path : paths)
+        if (!seen.insert(path).second)
+            throw InputError(options.output + ": two frames would both be written to " + path);
+    return paths;
+}
+
 
 }  // namespace
 
 int render(const RenderOptions& options)
 {
-    // 1. Outputs: a known format and a writable folder, before anything expensive happens.
-    const std::string ext = lowerExtension(options.output);
-    if (ext != ".png" && ext != ".exr")
-        throw InputError(options.output + ": unsupported image format \"" + ext + "\" (use .png or .exr)");
-    checkWritable(options.output, "output");
+    // 1. Outputs: a known format and a writable folder for every file, before anything expensive happens.
+    if (options.orbit < 0)
+        throw InputError("--orbit: the frame count must be at least 1, got " + std::to_string(options.orbit));
+    const std::vector<std::string> outputs = outputPaths(options);
     if (!options.statsPath.empty())
         checkWritable(options.statsPath, "--stats");
 
-    // 2. Scene and data: every InputError names its file.
+    // 2. Scene, data, device and renderer (Session): every InputError names its file.
     const bool useDefault = options.scene.empty() || options.scene == "default";
     const std::string sceneLabel = useDefault ? "default scene" : options.scene;
     Scene scene = useDefault ? defaultScene(options.overrides, options.unsets)
                              : loadScene(options.scene, options.overrides, options.unsets);
-    const Clock::time_point loadStart = Clock::now();
-    Volume volume;
-    if (!scene.volume.is_null())
-        volume = loadVolume(scene.volume, scene.baseDir);
-    TetMesh mesh;
-    if (!scene.mesh.is_null())
-        mesh = loadMesh(scene.mesh, scene.baseDir);
-    const double loadMs = msSince(loadStart);
-    if (!scene.camera && !scene.volume.is_null())
-        scene.camera = fitCamera(volume.boundsMin(), volume.boundsMax());
-    if (!scene.camera && !scene.mesh.is_null())
-        scene.camera = fitCamera(mesh.boundsMin(), mesh.boundsMax());
-
-    // 3. Device, set-up (upload, kernel builds) and a first frame; then one steady frame.
-    Device device(options.deviceSpec);
     const std::string size = std::to_string(scene.image.width) + "x" + std::to_string(scene.image.height);
-    FrameStats first, steady;
-    double firstFrameMs = 0.0;
-    Image4f image;
-    std::unique_ptr<Renderer> renderer;
-    {
-        ProgressLine progress("rendering " + scene.technique + " " + size);
-        const Clock::time_point t0 = Clock::now();
-        try {
-            renderer = scene.mesh.is_null() ? makeRenderer(device, scene, volume)
-                                            : makeMeshRenderer(device, scene, mesh);
-        } catch (const DeviceError&) {
-            throw;
-        } catch (const InputError& e) {  // technique or options: say which scene they came from
-            throw InputError(sceneLabel + ": " + e.what());
-        }
-        image = renderer->render(first);
-        firstFrameMs = msSince(t0);
-        device.takePassTimes();
-        const Clock::time_point t1 = Clock::now();
-        image = renderer->render(steady);
-        if (steady.frameMs <= 0.0)
-            steady.frameMs = msSince(t1);
-        if (steady.passes.empty())
-            steady.passes = device.takePassTimes();
-    }
-    if (image.width() != scene.image.width || image.height() != scene.image.height)
-        throw DeviceError("the renderer returned a " + std::to_string(image.width()) + "x" +
-                          std::to_string(image.height()) + " image for a " + size + " scene");
+    const std::string label = "rendering " + scene.technique + " " + size;
+    const int frameCount = static_cast<int>(outputs.size());
+    auto progress =
+        std::make_unique<ProgressLine>(frameCount > 1 ? label + ", frame 1 of " + std::to_string(frameCount) : label);
+    Session session(std::move(scene), sceneLabel, options.deviceSpec);
+    const Camera camera0 = session.camera();
 
-    // 4. Outputs, each atomically.
-    writeImage(options.output, image);
+    // 3. Frame 0: a first frame (finishes lazy set-up) and a steady one, or with --single-frame the first
+    // only; then each orbit frame once, on a renderer set up for its camera; images written as they come.
+    double firstFrameMs = session.setupMs();
+    Frame frame0 = session.render();
+    firstFrameMs += frame0.wallMs;
+    if (!options.singleFrame)
+        frame0 = session.render();
+    writeImage(outputs[0], frame0.image);
+    nlohmann::json frames = nlohmann::json::array();
+    frames.push_back({{"index", 0}, {"output", outputs[0]}, {"frame_ms", frame0.stats.frameMs},
+                      {"setup_ms", session.setupMs()}});
+    for (int k = 1; k < frameCount; ++k) {
+        progress->setLabel(label + ", frame " + std::to_string(k + 1) + " of " + std::to_string(frameCount));
+        session.setCamera(orbitCamera(camera0, k, frameCount));
+        const Frame frame = session.render();
+        writeImage(outputs[static_cast<std::size_t>(k)], frame.image);
+        frames.push_back({{"index", k}, {"output", outputs[static_cast<std::size_t>(k)]},
+                          {"frame_ms", frame.stats.frameMs}, {"setup_ms", session.setupMs()}});
+    }
+
+    progress.reset();  // the line is cleared before the summary
+
+    // 4. Stats, atomically; frame 0's figures at the top level as without --orbit.
+    const FrameStats& steady = frame0.stats;
     if (!options.statsPath.empty()) {
-        nlohmann::json stats = {
-            {"technique", scene.technique},
-            {"device", device.listing().name},
-            {"device_description", device.description()},
-            {"scene", useDefault ? std::string("default") : options.scene},
-            {"width", scene.image.width},
-            {"height", scene.image.height},
-            {"frame_ms", steady.frameMs},
-            {"compile_ms", device.compileMs()},
-            {"first_frame_ms", firstFrameMs},
-            {"load_ms", loadMs},
-            {"passes", passesJson(steady.passes)},
-            {"samples", steady.samples},
-            {"resident_bytes", renderer->residentBytes()},
-        };
-        if (!scene.volume.is_null())
-            stats["voxels"] = volume.voxelCount();
-        for (const auto& [key, value] : steady.extra.items())
-            if (!stats.contains(key))
-                stats[key] = value;
+        nlohmann::json stats = session.stats(frame0);
+        stats["scene"] = useDefault ? std::string("default") : options.scene;
+        stats["first_frame_ms"] = firstFrameMs;
+        if (options.orbit > 0) {
+            stats["orbit"] = options.orbit;
+            stats["frames"] = frames;
+        }
         writeFileAtomically(options.statsPath, stats.dump(2) + "\n");
     }
 
     std::ostringstream line;
-    line << "wrote " << options.output << " (" << size << ", " << scene.technique << ", " << std::fixed
-         << std::setprecision(1) << steady.frameMs << " ms/frame)";
+    line << "wrote " << options.output;
+    if (options.orbit > 0)
+        line << ": " << frameCount << " frames";
+    line << " (" << size << ", " << session.scene().technique << ", " << std::fixed << std::setprecision(1)
+         << steady.frameMs << " ms/frame)";
     std::cout << line.str() << std::endl;
     return 0;
 }

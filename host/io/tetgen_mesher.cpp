@@ -1,10 +1,11 @@
-// host/io/tetgen_mesher.cpp — TetGen as a library: the surface is loaded with tetgenio's own readers,
-// tetrahedralized with "p" always on, and the output copied into a TetMesh.
+// host/io/tetgen_mesher.cpp — TetGen as a library: the surface is read by clvr (host/io/surface_io.h: what
+// tetgenio's printing readers would load) into a tetgenio, tetrahedralized with "p" always on and "Q"
+// (TetGen's own quiet switch), and the output copied into a TetMesh. Nothing is printed.
 #include "host/io/tetgen_mesher.h"
 
 #include "host/runtime/errors.h"
-#include "host/runtime/file_io.h"
 #include "host/io/generators.h"
+#include "host/io/surface_io.h"
 #include "host/io/volume_io.h"
 
 #include <tetgen.h>
@@ -12,7 +13,6 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <memory>
 #include <sstream>
 #include <vector>
 
@@ -29,7 +29,67 @@ std::string lower(std::string s)
     return s;
 }
 
-// tetgenio's readers take a writable char*.
+// Copies `plc` into `io` as tetgenio::load_off / load_stl / load_poly would have filled it; the arrays are
+// allocated with new[], which tetgenio's destructor frees.
+void toTetgenio(const Plc& plc, tetgenio& io)
+{
+    io.firstnumber = plc.firstNumber;
+    io.numberofpoints = static_cast<int>(plc.points.size());
+    io.pointlist = new REAL[3 * plc.points.size()];
+    for (std::size_t i = 0; i < plc.points.size(); ++i)
+        for (int a = 0; a < 3; ++a)
+            io.pointlist[3 * i + a] = plc.points[i][a];
+    if (!plc.pointMarkers.empty()) {
+        io.pointmarkerlist = new int[plc.pointMarkers.size()];
+        std::copy(plc.pointMarkers.begin(), plc.pointMarkers.end(), io.pointmarkerlist);
+    }
+    io.numberoffacets = static_cast<int>(plc.facets.size());
+    io.facetlist = new tetgenio::facet[plc.facets.size()];
+    if (plc.facetMarkers)
+        io.facetmarkerlist = new int[plc.facets.size()];
+    for (std::size_t f = 0; f < plc.facets.size(); ++f) {
+        const PlcFacet& in = plc.facets[f];
+        tetgenio::facet& out = io.facetlist[f];
+        tetgenio::init(&out);
+        out.numberofpolygons = static_cast<int>(in.polygons.size());
+        out.polygonlist = new tetgenio::polygon[in.polygons.size()];
+        for (std::size_t p = 0; p < in.polygons.size(); ++p) {
+            tetgenio::polygon& poly = out.polygonlist[p];
+            tetgenio::init(&poly);
+            poly.numberofvertices = static_cast<int>(in.polygons[p].size());
+            poly.vertexlist = new int[in.polygons[p].size()];
+            std::copy(in.polygons[p].begin(), in.polygons[p].end(), poly.vertexlist);
+        }
+        if (!in.holes.empty()) {
+            out.numberofholes = static_cast<int>(in.holes.size());
+            out.holelist = new REAL[3 * in.holes.size()];
+            for (std::size_t h = 0; h < in.holes.size(); ++h)
+                for (int a = 0; a < 3; ++a)
+                    out.holelist[3 * h + a] = in.holes[h][a];
+        }
+        if (plc.facetMarkers)
+            io.facetmarkerlist[f] = in.marker;
+    }
+    if (!plc.holes.empty()) {
+        io.numberofholes = static_cast<int>(plc.holes.size());
+        io.holelist = new REAL[3 * plc.holes.size()];
+        for (std::size_t h = 0; h < plc.holes.size(); ++h)
+            for (int a = 0; a < 3; ++a)
+                io.holelist[3 * h + a] = plc.holes[h][a];
+    }
+    if (!plc.regions.empty()) {
+        io.numberofregions = static_cast<int>(plc.regions.size());
+        io.regionlist = new REAL[5 * plc.regions.size()];
+        for (std::size_t r = 0; r < plc.regions.size(); ++r) {
+            const PlcRegion& region = plc.regions[r];
+            REAL* out = io.regionlist + 5 * r;
+            out[0] = region.point.x, out[1] = region.point.y, out[2] = region.point.z;
+            out[3] = region.attribute, out[4] = region.maxVolume;
+        }
+    }
+}
+
+// tetgenio's calls take a writable char*.
 std::vector<char> cString(const std::string& s)
 {
     std::vector<char> v(s.begin(), s.end());
@@ -98,26 +158,13 @@ TetMesh meshSurface(const fs::path& surface, const MesherOptions& options)
                              ": neither a generator (marschner-lobb, sphere, blobs) nor a .nrrd/.nhdr volume");
     }
     const std::string ext = lower(surface.extension().string());
-    tetgenio in, out;
-    bool loaded = false;
-    auto quiet = std::make_unique<QuietStdout>();  // TetGen's readers print "Opening FILE."
-    if (ext == ".poly" || ext == ".smesh") {
-        fs::path base = surface;
-        base.replace_extension();
-        auto name = cString(base.string());
-        loaded = in.load_plc(name.data(), static_cast<int>(tetgenbehavior::POLY));
-    } else if (ext == ".off") {
-        auto name = cString(surface.string());
-        loaded = in.load_off(name.data());
-    } else if (ext == ".stl") {
-        auto name = cString(surface.string());
-        loaded = in.load_stl(name.data());
-    } else {
+    if (ext != ".poly" && ext != ".smesh" && ext != ".off" && ext != ".stl")
         throw InputError(surface.string() + ": unknown surface format \"" + ext + "\" (.poly, .smesh, .off, .stl)");
-    }
-    quiet.reset();
-    if (!loaded || in.numberofpoints == 0 || in.numberoffacets == 0)
-        throw InputError(surface.string() + ": TetGen could not read a surface from it");
+    const Plc plc = readPlc(surface);
+    if (plc.points.empty() || plc.facets.empty())
+        throw InputError(surface.string() + ": no surface in it (no points or no facets)");
+    tetgenio in, out;
+    toTetgenio(plc, in);
 
     // TetGen asserts (aborts) on flat input: refuse it here.
     glm::dvec3 lo(in.pointlist[0], in.pointlist[1], in.pointlist[2]), hi = lo;

@@ -1,12 +1,10 @@
-// host/optics/clip_mesh.cpp — clip surfaces: the scene's "mesh" spec, the readers (tetgenio for .off/.stl, a
-// small one for .obj and binary .stl), the generators, the closedness check, and ray parity for the CPU reference.
+// host/optics/clip_mesh.cpp — clip surfaces: the scene's "mesh" spec, the readers (host/io/surface_io.h for .off
+// and ASCII .stl, as TetGen reads them; small ones here for .obj and binary .stl), the generators, the closedness check, and ray parity for the CPU reference.
 #include "host/optics/clip_mesh.h"
 
 #include "host/runtime/errors.h"
 #include "host/model/json_values.h"
-#include "host/runtime/file_io.h"
-
-#include <tetgen.h>
+#include "host/io/surface_io.h"
 
 #include <nlohmann/json.hpp>
 
@@ -32,14 +30,6 @@ std::string lower(std::string s)
     for (char& c : s)
         c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     return s;
-}
-
-// tetgenio's readers take a writable char*.
-std::vector<char> cString(const std::string& s)
-{
-    std::vector<char> v(s.begin(), s.end());
-    v.push_back('\0');
-    return v;
 }
 
 // Adds the fan of a polygon (indices into mesh.points).
@@ -142,37 +132,22 @@ ClipMesh readBinaryStl(const fs::path& path, std::uint32_t count)
     return mesh;
 }
 
-ClipMesh readWithTetgen(const fs::path& path, const std::string& ext)
+// .off and ASCII .stl: read as TetGen reads them (host/io/surface_io.h), polygons fanned into triangles.
+ClipMesh readPlcSurface(const fs::path& path)
 {
-    tetgenio in;
-    auto name = cString(path.string());
-    bool loaded = false;
-    {
-        const QuietStdout quiet;  // TetGen prints "Opening FILE."
-        loaded = ext == ".off" ? in.load_off(name.data()) : in.load_stl(name.data());
-    }
-    if (!loaded || in.numberofpoints == 0 || in.numberoffacets == 0)
-        throw InputError(path.string() + ": TetGen's reader could not read a surface from it");
+    const Plc plc = readPlc(path);
+    if (plc.points.empty() || plc.facets.empty())
+        throw InputError(path.string() + ": could not read a surface from it (no points or no faces)");
     ClipMesh mesh;
     mesh.source = path.string();
-    mesh.points.resize(static_cast<std::size_t>(in.numberofpoints));
-    for (std::size_t i = 0; i < mesh.points.size(); ++i)
-        mesh.points[i] = {in.pointlist[3 * i], in.pointlist[3 * i + 1], in.pointlist[3 * i + 2]};
-    for (int f = 0; f < in.numberoffacets; ++f) {
-        const tetgenio::facet& facet = in.facetlist[f];
-        for (int p = 0; p < facet.numberofpolygons; ++p) {
-            const tetgenio::polygon& poly = facet.polygonlist[p];
+    mesh.points = plc.points;
+    for (const PlcFacet& facet : plc.facets)
+        for (const std::vector<int>& corners : facet.polygons) {
             std::vector<std::uint32_t> polygon;
-            for (int k = 0; k < poly.numberofvertices; ++k) {
-                const int index = poly.vertexlist[k] - in.firstnumber;
-                if (index < 0 || index >= in.numberofpoints)
-                    throw InputError(path.string() + ": facet " + std::to_string(f) + " names point " +
-                                     std::to_string(poly.vertexlist[k]) + ", which does not exist");
-                polygon.push_back(static_cast<std::uint32_t>(index));
-            }
+            for (int c : corners)  // readPlc has checked every corner against the point count
+                polygon.push_back(static_cast<std::uint32_t>(c - plc.firstNumber));
             addPolygon(mesh, polygon);
         }
-    }
     return mesh;
 }
 
@@ -284,7 +259,7 @@ ClipMesh readSurface(const fs::path& path)
     if (ext == ".stl" && isBinaryStl(path, count))
         return readBinaryStl(path, count);
     if (ext == ".off" || ext == ".stl")
-        return readWithTetgen(path, ext);
+        return readPlcSurface(path);
     throw InputError(path.string() + ": unknown surface format \"" + ext + "\" (.off, .stl, .obj)");
 }
 

@@ -51,7 +51,7 @@ ClipMeshSpec parseClipMeshSpec(const nlohmann::json& spec, const std::string& ke
 ClipMesh loadClipMesh(const ClipMeshSpec& spec, const std::filesystem::path& baseDir);
 
 // A triangle surface as the file holds it (polygons fanned into triangles), not yet checked.
-// .off and ASCII .stl through tetgenio (load_off / load_stl); binary .stl (which tetgenio does not
+// .off and ASCII .stl as tetgenio's load_off / load_stl read them (host/io/surface_io.h); binary .stl (which tetgenio does not
 // read) and .obj ("v x y z", "f a b c ..." with a, a/t, a/t/n or a//n, 1-based or negative; other
 // statements ignored) by clvr.
 ClipMesh readSurface(const std::filesystem::path& path);

@@ -45,7 +45,7 @@ struct ReferenceOptions {
     // First level: segments of at most min(spacing) / initialStepsPerVoxel along the chord.
     int initialStepsPerVoxel = 2;
     int maxSegmentsPerRay = 1 << 20;
-    int threads = 2;                     // std::thread workers over rows (<= 0: hardware_concurrency)
+    int threads = 2;                     // std::thread workers over rows (<= 0: the thread budget; at most it)
     ReferenceStats* stats = nullptr;     // filled when not null
     // When set, only these sub-intervals of a ray's chord [t0, t1] count (in increasing order, within
     // [t0, t1]): each is integrated (and converged) on its own and the pieces are composited front to

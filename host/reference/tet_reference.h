@@ -70,7 +70,7 @@ struct TetReferenceStats {
 };
 
 struct TetReferenceOptions {
-    int threads = 2;                      // std::thread workers over rows (<= 0: hardware_concurrency)
+    int threads = 2;                      // std::thread workers over rows (<= 0: the thread budget; at most it)
     TetReferenceStats* stats = nullptr;   // filled when not null
 };
 

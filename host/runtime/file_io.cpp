@@ -3,10 +3,6 @@
 
 #include "host/runtime/errors.h"
 
-#include <cstdio>
-#include <fcntl.h>
-#include <unistd.h>
-
 namespace clvr {
 
 std::uint64_t fileSize(const std::filesystem::path& path)
@@ -22,32 +18,6 @@ std::uint64_t fileSize(const std::filesystem::path& path)
     if (ec)
         throw InputError(path.string() + ": cannot read (" + ec.message() + ")");
     return size;
-}
-
-QuietStdout::QuietStdout()
-{
-    std::fflush(stdout);
-    saved_ = dup(STDOUT_FILENO);
-    const int devNull = open("/dev/null", O_WRONLY | O_CLOEXEC);
-    if (saved_ < 0 || devNull < 0) {  // cannot silence: leave stdout as it is
-        if (devNull >= 0)
-            close(devNull);
-        if (saved_ >= 0)
-            close(saved_);
-        saved_ = -1;
-        return;
-    }
-    dup2(devNull, STDOUT_FILENO);
-    close(devNull);
-}
-
-QuietStdout::~QuietStdout()
-{
-    if (saved_ < 0)
-        return;
-    std::fflush(stdout);
-    dup2(saved_, STDOUT_FILENO);
-    close(saved_);
 }
 
 }  // namespace clvr

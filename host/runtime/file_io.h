@@ -10,18 +10,4 @@ namespace clvr {
 // file" or "... cannot read (...)".
 std::uint64_t fileSize(const std::filesystem::path& path);
 
-// Sends the process's standard output (file descriptor 1) to /dev/null while alive, and back after.
-// Library readers that print progress there (TetGen's load_* print "Opening FILE.") would otherwise
-// mix into clvr's own output, which scripts read. Not for use from several threads at once.
-class QuietStdout {
-public:
-    QuietStdout();
-    ~QuietStdout();
-    QuietStdout(const QuietStdout&) = delete;
-    QuietStdout& operator=(const QuietStdout&) = delete;
-
-private:
-    int saved_ = -1;
-};
-
 }  // namespace clvr

@@ -1,13 +1,34 @@
-// host/runtime/parallel.h — running one worker function on several host threads (CPU references, ceiling loop).
+// host/runtime/parallel.h — the process-wide thread budget and running one worker function on several host
+// threads (CPU references, harc's face sort, the ceiling loop).
 #pragma once
 
 #include <functional>
+#include <string>
 
 namespace clvr {
 
-// Runs `worker` on `threads` threads (<= 0: one per hardware thread), at most `maxUseful` of them and at
-// least one, the calling thread included; returns when all have returned. Workers share their work
-// through their own means (an atomic row counter, say).
-void runOnThreads(int threads, int maxUseful, const std::function<void()>& worker);
+// The most host threads any parallel loop of the library uses: setThreadBudget's value, else one per
+// hardware thread. Process-wide, like the CPU itself; read by runOnThreads.
+int threadBudget();
+
+// Sets the budget (>= 1, else InputError). clvr sets it from --threads or $CLVR_THREADS before any
+// OpenCL call, together with passThreadBudgetToPocl().
+void setThreadBudget(int threads);
+
+// A thread count as the user wrote it (`what` names where: "--threads", "CLVR_THREADS"): a whole
+// number in 1..4096, else InputError "<what>: ...".
+int parseThreadCount(const std::string& text, const std::string& what);
+
+// Sets PoCL's CPU compute-unit count (POCL_MAX_PTHREAD_COUNT, read by PoCL 3.1, and POCL_CPU_MAX_CU_NUM,
+// its later name; read once when PoCL's platform initialises) to threadBudget(), unless the environment
+// already has either; returns whether it did. Only effective before the first OpenCL call of the process.
+// docs/cli.md says what was measured.
+bool passThreadBudgetToPocl();
+
+// Runs `worker` on `threads` threads (<= 0: the thread budget), at most the budget, at most
+// `maxUseful` of them and at least one, the calling thread included; returns when all have returned.
+// Workers share their work through their own means (an atomic row counter, say). Returns the number
+// of threads it used.
+int runOnThreads(int threads, int maxUseful, const std::function<void()>& worker);
 
 }  // namespace clvr

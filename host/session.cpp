@@ -1,0 +1,151 @@
+// host/session.cpp — clvr::Session: one scene's data, device and renderer kept across frames.
+#include "host/session.h"
+
+#include "host/runtime/errors.h"
+#include "host/io/mesh_io.h"
+#include "host/io/volume_io.h"
+
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <utility>
+
+namespace clvr {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double msSince(Clock::time_point t0)
+{
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+// The scene's camera, or one that fits its data's bounds (as clvr render always did).
+Camera sceneCamera(const Scene& scene, const SceneData& data)
+{
+    if (scene.camera)
+        return *scene.camera;
+    if (!scene.mesh.is_null())
+        return fitCamera(data.mesh.boundsMin(), data.mesh.boundsMax());
+    return fitCamera(data.volume.boundsMin(), data.volume.boundsMax());
+}
+
+// Rodrigues' rotation of v by `angle` radians about the unit axis k.
+glm::dvec3 rotate(const glm::dvec3& v, const glm::dvec3& k, double angle)
+{
+    const double c = std::cos(angle), s = std::sin(angle);
+    return v * c + glm::cross(k, v) * s + k * (glm::dot(k, v) * (1.0 - c));
+}
+
+}  // namespace
+
+SceneData loadSceneData(const Scene& scene)
+{
+    const Clock::time_point t0 = Clock::now();
+    SceneData data;
+    if (!scene.volume.is_null())
+        data.volume = loadVolume(scene.volume, scene.baseDir);
+    if (!scene.mesh.is_null())
+        data.mesh = loadMesh(scene.mesh, scene.baseDir);
+    data.loadMs = msSince(t0);
+    return data;
+}
+
+Camera orbitCamera(const Camera& camera, int k, int n)
+{
+    if (n < 1)
+        throw InputError("orbit: the frame count must be at least 1, got " + std::to_string(n));
+    if (k % n == 0)
+        return camera;
+    const glm::dvec3 axis = glm::normalize(camera.viewUp);
+    const double angle = 2.0 * std::numbers::pi * static_cast<double>(k % n) / static_cast<double>(n);
+    Camera out = camera;
+    out.position = camera.focalPoint + rotate(camera.position - camera.focalPoint, axis, angle);
+    return out;
+}
+
+Session::Session(Scene scene, std::string label, const std::string& deviceSpec)
+    : scene_(std::move(scene)), label_(std::move(label))
+{
+    data_ = loadSceneData(scene_);  // bad data is an InputError before any device is opened
+    scene_.camera = sceneCamera(scene_, data_);
+    ownedDevice_ = std::make_unique<Device>(deviceSpec);
+    device_ = ownedDevice_.get();
+    makeRenderer();
+}
+
+Session::Session(Device& device, Scene scene, SceneData data, std::string label)
+    : device_(&device), scene_(std::move(scene)), data_(std::move(data)), label_(std::move(label))
+{
+    scene_.camera = sceneCamera(scene_, data_);
+    makeRenderer();
+}
+
+void Session::makeRenderer()
+{
+    renderer_.reset();  // the old renderer's device buffers go before the new one's are allocated
+    const Clock::time_point t0 = Clock::now();
+    try {
+        renderer_ = isMesh() ? makeMeshRenderer(*device_, scene_, data_.mesh)
+                             : clvr::makeRenderer(*device_, scene_, data_.volume);
+    } catch (const DeviceError&) {
+        throw;
+    } catch (const InputError& e) {  // technique or options: say which scene they came from
+        throw InputError(label_ + ": " + e.what());
+    }
+    setupMs_ = msSince(t0);
+}
+
+Frame Session::render()
+{
+    Frame frame;
+    device_->takePassTimes();  // set-up launches (uploads, tables) are not this frame's
+    const Clock::time_point t0 = Clock::now();
+    frame.image = renderer_->render(frame.stats);
+    frame.wallMs = msSince(t0);
+    if (frame.stats.frameMs <= 0.0)
+        frame.stats.frameMs = frame.wallMs;
+    if (frame.stats.passes.empty())
+        frame.stats.passes = device_->takePassTimes();
+    if (frame.image.width() != scene_.image.width || frame.image.height() != scene_.image.height)
+        throw DeviceError("the renderer returned a " + std::to_string(frame.image.width()) + "x" +
+                          std::to_string(frame.image.height()) + " image for a " +
+                          std::to_string(scene_.image.width) + "x" + std::to_string(scene_.image.height) +
+                          " scene");
+    return frame;
+}
+
+nlohmann::json Session::stats(const Frame& frame) const
+{
+    nlohmann::json passes = nlohmann::json::array();
+    for (const PassTime& p : frame.stats.passes)
+        passes.push_back({{"name", p.name}, {"ms", p.ms}});
+    nlohmann::json out = {
+        {"technique", scene_.technique},
+        {"device", device_->listing().name},
+        {"device_description", device_->description()},
+        {"width", scene_.image.width},
+        {"height", scene_.image.height},
+        {"frame_ms", frame.stats.frameMs},
+        {"compile_ms", device_->compileMs()},
+        {"load_ms", data_.loadMs},
+        {"passes", passes},
+        {"samples", frame.stats.samples},
+        {"resident_bytes", renderer_->residentBytes()},
+    };
+    if (!isMesh())
+        out["voxels"] = data_.volume.voxelCount();
+    for (const auto& [key, value] : frame.stats.extra.items())
+        if (!out.contains(key))
+            out[key] = value;
+    return out;
+}
+
+void Session::setCamera(const Camera& camera)
+{
+    camera.validate();
+    scene_.camera = camera;
+    makeRenderer();
+}
+
+}  // namespace clvr
