@@ -4,6 +4,7 @@
 // raster.cl itself, so that the fragment program is checked in the context it runs in.
 // The host has validated everything; this file only does arithmetic.
 #include "clip_texture.h"
+#include "ray.h"
 #include "transfer_function.h"
 #include "reflectance_map.h"
 #ifndef CLVR_STACK2D_FRAGMENT
@@ -16,8 +17,7 @@
  * thickness along the stack axis in world units, first, count, 0): count 0 for one slice per quad,
  * else the quad stands for slices first .. first + count - 1 of the table in buffer[3] (several
  * slices per polygon, below). All but (u, v) are constant over a quad.
- * uniforms: 0..3 camera position, forward, right, up; 4 (tan(view_angle / 2) or parallel_scale,
- * aspect, 1 if parallel, 0); 5 (image width, height, tf_count, 0); 6 the stack axis as a unit vector;
+ * uniforms: 0..4 the camera in ClCamera's order (kernels/ray.h); 5 (image width, height, tf_count, 0); 6 the stack axis as a unit vector;
  * 7 (texture width, height, channels, 0) of one slice; 8 (reflectance map n, 1 if shaded, 0, 0);
  * 9 the unit vector towards the eye (-forward); 10 (data minimum, 1 if iso-surface, ambient, diffuse);
  * 11 (surface color, 1 if gradient-shaded); 12 (unit vector towards the light, 1 / (data range)):
@@ -126,10 +126,9 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
 
     /* The pixel's ray (host/camera.cpp's PixelRays): from the camera through the pixel center, or for
      * a parallel camera from the pixel's point on the image plane along forward. */
-    const float2 ndc = (float2)(f->window.x / u[5].x * 2.0f - 1.0f, 1.0f - f->window.y / u[5].y * 2.0f);
-    const float3 offset = (ndc.x * u[4].x * u[4].y) * u[2].xyz + (ndc.y * u[4].x) * u[3].xyz;
-    const bool parallel = u[4].z != 0.0f;
-    const float3 d = parallel ? u[1].xyz : u[1].xyz + offset;
+    const ClCamera cam = clvr_ray_camera(u);
+    float3 origin, d;
+    clvr_ray_offset_first(clvr_ray_offset(clvr_ray_ndc(f->window, u[5].xy), cam), cam, &origin, &d);
     /* a fragment's ray meets the quad's plane, so cos_theta > 0; the floor only keeps tau = 0 times
      * an infinite Delta (a plane seen exactly edge-on, rounded) from giving NaN */
     const float cos_theta = fmax(fabs(dot(d, u[6].xyz)) / length(d), 1e-20f);
@@ -157,7 +156,6 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
      * are composited back to front inside the fragment — "over" is associative, so the blended
      * result is that of one quad per slice. Iso-surfaces keep the front-most sample at or above the
      * iso-value (alpha reference u[17].x), as the alpha test and the drawing order would. */
-    const float3 origin = parallel ? u[0].xyz + offset : u[0].xyz;
     const float da = dot(d, u[6].xyz), oa = dot(origin, u[6].xyz);
     global const float4* table = (global const float4*)r->buffer[3];
     const int first = (int)round(f->attr[1].y);

@@ -9,7 +9,7 @@
 #include "host/render/options_util.h"
 #include "host/gradient_volume.h"
 #include "host/reflectance_map.h"
-#include "host/render/slice3d.h"  // packTransferFunction
+#include "host/render/transfer_function_upload.h"
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
 #include "raster/texture.h"
@@ -97,8 +97,8 @@ private:
     std::optional<ClipTexture> clipTexture_;
     glm::dmat4 clipCoordinates_{1.0};
     std::vector<raster::Texture> stacks_;  // x, y, z: all three stay resident, as on the paper's boards
-    cl::Buffer tf_, map_;
-    std::size_t tfBytes_ = 0;
+    TransferFunctionUpload tf_;
+    cl::Buffer map_;
     std::uint64_t residentBytes_ = 0;
     std::unique_ptr<raster::Framebuffer> framebuffer_;
     raster::FragmentProgram fragmentProgram_;
@@ -252,7 +252,7 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
         fragmentProgram_.uniforms.push_back(glm::vec4(static_cast<float>(table.size() * 4), 0.0f, 0.0f, 0.0f));  // 22
     }
     fragmentProgram_.uniforms[5].z = static_cast<float>(scene.transferFunction.points().size());
-    fragmentProgram_.buffers[1] = tf_;
+    fragmentProgram_.buffers[1] = tf_.buffer();
 }
 
 // Uniforms 19..21: the rows of world -> clip-texture coordinates (the several-slices path maps the
@@ -279,14 +279,8 @@ void Stack2dRenderer::setClipPlacement(const glm::dvec3& offset, const glm::dmat
 
 void Stack2dRenderer::setTransferFunction(const TransferFunction& tf)
 {
-    std::vector<float> packed = packTransferFunction(tf);
-    if (packed.empty())
-        packed.push_back(0.0f);  // an iso-surface scene without a transfer function: never read
-    residentBytes_ -= tfBytes_;
-    tfBytes_ = packed.size() * sizeof(float);
-    residentBytes_ += tfBytes_;
-    tf_ = device_.upload("stack2d transfer function", packed);
-    fragmentProgram_.buffers[1] = tf_;
+    tf_.replace(device_, "stack2d transfer function", tf, residentBytes_);
+    fragmentProgram_.buffers[1] = tf_.buffer();
     if (fragmentProgram_.uniforms.size() > 5)  // not yet during construction, which sets them itself
         fragmentProgram_.uniforms[5].z = static_cast<float>(tf.points().size());
     if (iso_ && fragmentProgram_.uniforms.size() > 11 && !tf.points().empty()) {  // the surface color
