@@ -9,6 +9,7 @@
 #include "ray.h"
 #include "slice3d_params.h"
 #include "spherical_params.h"
+#include "stack2d_params.h"
 
 /* out[0] = the number of entries n, out[1 .. n] the entries. */
 kernel void params_layout_probe(global uint* out)

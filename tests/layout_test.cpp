@@ -13,6 +13,7 @@
 #include "kernels/ray.h"
 #include "kernels/slice3d_params.h"
 #include "kernels/spherical_params.h"
+#include "kernels/stack2d_params.h"
 #include "kernels/texture.h"
 
 #include <gtest/gtest.h>
@@ -123,7 +124,9 @@ TEST(Layout, EveryParamsStructFitsTheKernelArgumentSpace)
     EXPECT_EQ(sizeof(ClSlice3dUniforms), 160u);
     EXPECT_EQ(sizeof(ClIso3dUniforms), 112u);
     EXPECT_EQ(sizeof(ClHarcEntryUniforms), 96u);
-    for (const std::size_t bytes : {sizeof(ClSlice3dUniforms), sizeof(ClIso3dUniforms), sizeof(ClHarcEntryUniforms)})
+    EXPECT_EQ(sizeof(ClStack2dUniforms), 368u);
+    for (const std::size_t bytes : {sizeof(ClSlice3dUniforms), sizeof(ClIso3dUniforms), sizeof(ClHarcEntryUniforms),
+                                    sizeof(ClStack2dUniforms)})
         EXPECT_LE(bytes, CLVR_MAX_UNIFORMS * sizeof(cl_float4));
 }
 
