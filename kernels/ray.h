@@ -39,18 +39,6 @@ typedef struct {
 
 #ifdef __OPENCL_C_VERSION__
 
-/* The camera of a fragment program: five consecutive uniforms, in ClCamera's order. */
-ClCamera clvr_ray_camera(constant float4* u)
-{
-    ClCamera cam;
-    cam.position = u[0];
-    cam.forward = u[1];
-    cam.right = u[2];
-    cam.up = u[3];
-    cam.params = u[4];
-    return cam;
-}
-
 /* Normalized device coordinates of window position w (pixel (x, row) has its centre at
  * (x + 0.5, row + 0.5)), y up: row 0 is the top of the image. size = (width, height). */
 float2 clvr_ray_ndc(const float2 w, const float2 size)

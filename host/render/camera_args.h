@@ -10,7 +10,6 @@
 
 #include <glm/glm.hpp>
 
-#include <array>
 #include <cmath>
 
 namespace clvr {
@@ -31,15 +30,6 @@ inline ClCamera toClCamera(const Camera& camera, int width, int height, const gl
     cl.up = pack(camera.up());
     cl.params = cl_float4{{static_cast<float>(scale), static_cast<float>(aspect), camera.parallel ? 1.0f : 0.0f, 0.0f}};
     return cl;
-}
-
-// The same five float4s as fragment-program uniforms (kernels/ray.h's clvr_ray_camera reads them).
-inline std::array<glm::vec4, 5> cameraVectors(const Camera& camera, int width, int height,
-                                              const glm::dvec3& shift = glm::dvec3(0.0))
-{
-    const ClCamera cl = toClCamera(camera, width, height, shift);
-    auto vec = [](const cl_float4& v) { return glm::vec4(v.s[0], v.s[1], v.s[2], v.s[3]); };
-    return {vec(cl.position), vec(cl.forward), vec(cl.right), vec(cl.up), vec(cl.params)};
 }
 
 }  // namespace clvr

@@ -26,7 +26,9 @@ std::vector<float> packTransferFunction(const TransferFunction& tf)
 
 void TransferFunctionUpload::upload(Device& device, const std::string& what, const TransferFunction& tf)
 {
-    const std::vector<float> packed = packTransferFunction(tf);
+    std::vector<float> packed = packTransferFunction(tf);
+    if (packed.empty())
+        packed.push_back(0.0f);  // an iso-surface scene without a transfer function: never read
     buffer_ = device.upload(what, packed);
     count_ = static_cast<int>(tf.points().size());
     bytes_ = packed.size() * sizeof(float);

@@ -23,7 +23,7 @@ std::vector<float> packTransferFunction(const TransferFunction& tf);
 class TransferFunctionUpload {
 public:
     // Packs and uploads tf into a buffer named `what` (Device::upload). An empty transfer function
-    // (iso-surface scenes may have none) gets a buffer no kernel reads and 0 bytes.
+    // (iso-surface scenes may have none) becomes one float that no kernel reads (4 bytes).
     void upload(Device& device, const std::string& what, const TransferFunction& tf);
 
     const cl::Buffer& buffer() const { return buffer_; }
