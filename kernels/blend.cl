@@ -24,7 +24,9 @@ kernel void blend_render(global float4* out, global uint* samples, global uint* 
     CLVR_GUARD_2D(p.width, p.height);
     const int x = (int)get_global_id(0), y = (int)get_global_id(1);
     const int4 dims = p.dims;
-    const float depth0 = p.depth0, delta_s = p.delta_s;
+    const float depth0 = p.depth0, delta_s = p.delta_s, threshold = p.threshold;
+    const int tf_count = p.tf_count, map_n = p.map_n, shade_on = p.shade_on;
+    const float3 to_eye = p.to_eye.xyz;
     const float2 size = (float2)((float)p.width, (float)p.height);
     const float2 s = clvr_ray_offset(clvr_ray_ndc(clvr_ray_pixel_centre(x, y), size), p.camera);
     float3 o, d;
@@ -43,13 +45,13 @@ kernel void blend_render(global float4* out, global uint* samples, global uint* 
             continue;
         ++taken;
         const float4 v = clvr_trilinear4(volume, dims, g);
-        const float4 ct = clvr_tf_eval(tf, p.tf_count, v.w);
+        const float4 ct = clvr_tf_eval(tf, tf_count, v.w);
         const float alpha = 1.0f - exp2(ct.w * neg_delta_log2e);
-        if (alpha <= p.threshold) { /* written clear: blending it changes nothing */
+        if (alpha <= threshold) { /* written clear: blending it changes nothing */
             ++below;
             continue;
         }
-        const float3 shade = p.shade_on ? clvr_reflectance(map, p.map_n, v.xyz, p.to_eye.xyz) : (float3)(1.0f);
+        const float3 shade = shade_on ? clvr_reflectance(map, map_n, v.xyz, to_eye) : (float3)(1.0f);
         c = (ct.xyz * shade) * alpha + (1.0f - alpha) * c;
         alpha_acc = alpha + (1.0f - alpha) * alpha_acc;
     }

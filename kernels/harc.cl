@@ -177,7 +177,9 @@ kernel void harc_render(global float4* out, global uint* stats, global const flo
     CLVR_GUARD_2D(params.width, params.height);
     const int x = (int)get_global_id(0), y = (int)get_global_id(1);
     const int p = y * params.width + x;
-    const int tf_count = params.tf_count, psi_n = params.psi_n;
+    const int tf_count = params.tf_count, psi_n = params.psi_n, integration = params.integration;
+    const uint max_steps = params.max_steps;
+    const float ert_alpha = params.ert_alpha;
     const float2 size = (float2)((float)params.width, (float)params.height);
     float3 e, d;
     const float2 offset = clvr_ray_offset(clvr_ray_ndc(clvr_ray_pixel_centre(x, y), size), params.camera);
@@ -198,7 +200,7 @@ kernel void harc_render(global float4* out, global uint* stats, global const flo
         int t = entry.y >> 2;
         int entry_face = entry.y & 3;
         for (;;) {
-            if (steps >= params.max_steps) {
+            if (steps >= max_steps) {
                 bounded = 1;
                 break;
             }
@@ -229,20 +231,20 @@ kernel void harc_render(global float4* out, global uint* stats, global const flo
             const float lambda_exit = lambda + step;
             const float s_f = dot(grad.xyz, pos) + grad.w;                       /* Eq. 6 */
             const float s_b = dot(grad.xyz, e + lambda_exit * d) + grad.w;
-            if (params.integration == HARC_INTEGRATION_FULL) {
+            if (integration == HARC_INTEGRATION_FULL) {
                 /* The whole segment at once: no split at control points (the table has them inside). */
                 const float4 c =
                     harc_full_lookup(full_table, params.full_ns, params.full_nl, params.full_params, s_f, s_b, step);
                 color += transmittance * c.xyz;
                 transmittance *= 1.0f - c.w;
                 ++pieces;
-            } else if (params.integration == HARC_INTEGRATION_AVERAGE) {
+            } else if (integration == HARC_INTEGRATION_AVERAGE) {
                 harc_segment_average(tf, tf_count, s_f, s_b, step, &color, &transmittance);
                 ++pieces;
             } else {
                 pieces += (uint)harc_segment(tf, tf_count, psi, psi_n, s_f, s_b, step, &color, &transmittance);
             }
-            if (1.0f - transmittance >= params.ert_alpha) {  /* early ray termination (off: ert_alpha = 2) */
+            if (1.0f - transmittance >= ert_alpha) {  /* early ray termination (off: ert_alpha = 2) */
                 k = end;
                 break;
             }

@@ -26,7 +26,11 @@ kernel void planes_render(global float4* out, global uint* samples, global uint*
 {
     CLVR_GUARD_2D(p.width, p.height);
     const int x = (int)get_global_id(0), y = (int)get_global_id(1);
+    /* the values the sample loop reads, as locals */
     const int4 dims = p.dims;
+    const float3 grid_origin = p.grid_origin.xyz, inv_spacing = p.inv_spacing.xyz, to_eye = p.to_eye.xyz;
+    const int tf_count = p.tf_count, map_n = p.map_n, shade_on = p.shade_on;
+    const float ert_alpha = p.ert_alpha, threshold = p.threshold;
     /* The ray through the pixel center, origin o and unit direction d (kernels/ray.h). */
     const float2 size = (float2)((float)p.width, (float)p.height);
     float3 o, d;
@@ -61,19 +65,19 @@ kernel void planes_render(global float4* out, global uint* samples, global uint*
         for (int k = 0; k < count; ++k) {
             const float3 q = o + (t0 + ((float)k + 0.5f) * h) * d;
             /* inside the box by construction; the clamp absorbs float rounding at its faces */
-            const float3 g = clamp((q - p.grid_origin.xyz) * p.inv_spacing.xyz, (float3)(0.0f), last);
+            const float3 g = clamp((q - grid_origin) * inv_spacing, (float3)(0.0f), last);
             const float4 s = clvr_trilinear4(volume, dims, g);
-            const float4 ct = clvr_tf_eval(tf, p.tf_count, s.w);
+            const float4 ct = clvr_tf_eval(tf, tf_count, s.w);
             ++taken;
             const float alpha = 1.0f - exp2(ct.w * neg_h_log2e);
-            if (alpha <= p.threshold) { /* the paper's low-opacity skip: no shading, no compositing */
+            if (alpha <= threshold) { /* the paper's low-opacity skip: no shading, no compositing */
                 ++below;
                 continue;
             }
-            const float3 shade = p.shade_on ? clvr_reflectance(map, p.map_n, s.xyz, p.to_eye.xyz) : (float3)(1.0f);
+            const float3 shade = shade_on ? clvr_reflectance(map, map_n, s.xyz, to_eye) : (float3)(1.0f);
             c += (transmittance * alpha) * (ct.xyz * shade);
             transmittance *= 1.0f - alpha;
-            if (1.0f - transmittance >= p.ert_alpha) {
+            if (1.0f - transmittance >= ert_alpha) {
                 stopped = 1;
                 break;
             }

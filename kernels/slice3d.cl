@@ -116,7 +116,9 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
     CLVR_GUARD_2D(p.width, p.height);
     const int x = (int)get_global_id(0), y = (int)get_global_id(1);
     const int4 dims = p.dims;
-    const float depth0 = p.depth0, delta_s = p.delta_s;
+    const float depth0 = p.depth0, delta_s = p.delta_s, ert_alpha = p.ert_alpha;
+    const int tf_count = p.tf_count, skip = p.skip;
+    const int4 bdims = p.brick_dims;
     /* The pixel's ray as origin o + z * d, z the eye depth along forward (dot(d, forward) = 1), so the
      * ray's point on the slice at depth z is o + z d and a slice spacing deltaS is a ray length
      * deltaS * |d| (= deltaS / cos(theta)). */
@@ -170,9 +172,9 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
             const float3 g = slice3d_point(go, gd, depth0, delta_s, k);
             if (!clvr_grid_inside(g, dims))
                 continue;
-            if (p.skip) {
+            if (skip) {
                 const int4 b = slice3d_brick(g, dims);
-                const int space_b = slice3d_space(space, p.brick_dims, b);
+                const int space_b = slice3d_space(space, bdims, b);
                 if (space_b != 0) {
                     const int run_end = slice3d_empty_run(go, gd, inv_gd, depth0, delta_s, k, 1, k_hi, dims, b,
                                                           space_b - 1);
@@ -186,11 +188,11 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
             if (!clvr_clip_keep(clip_texels, p.clip_tex, uo + (depth0 + (float)k * delta_s) * ud, p.clip_inverse))
                 continue;
 #endif
-            const float4 ct = clvr_tf_eval(tf, p.tf_count, SLICE3D_TRILINEAR(volume, dims, g));
+            const float4 ct = clvr_tf_eval(tf, tf_count, SLICE3D_TRILINEAR(volume, dims, g));
             const float alpha = 1.0f - exp2(ct.w * neg_delta_log2e);
             c += (transmittance * alpha) * ct.xyz;
             transmittance *= 1.0f - alpha;
-            if (1.0f - transmittance >= p.ert_alpha)
+            if (1.0f - transmittance >= ert_alpha)
                 break;
         }
         alpha_acc = 1.0f - transmittance;
@@ -199,9 +201,9 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
             const float3 g = slice3d_point(go, gd, depth0, delta_s, k);
             if (!clvr_grid_inside(g, dims))
                 continue;
-            if (p.skip) {
+            if (skip) {
                 const int4 b = slice3d_brick(g, dims);
-                const int space_b = slice3d_space(space, p.brick_dims, b);
+                const int space_b = slice3d_space(space, bdims, b);
                 if (space_b != 0) {
                     const int run_end = slice3d_empty_run(go, gd, inv_gd, depth0, delta_s, k, -1, k_lo, dims, b,
                                                           space_b - 1);
@@ -215,7 +217,7 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
             if (!clvr_clip_keep(clip_texels, p.clip_tex, uo + (depth0 + (float)k * delta_s) * ud, p.clip_inverse))
                 continue;
 #endif
-            const float4 ct = clvr_tf_eval(tf, p.tf_count, SLICE3D_TRILINEAR(volume, dims, g));
+            const float4 ct = clvr_tf_eval(tf, tf_count, SLICE3D_TRILINEAR(volume, dims, g));
             const float alpha = 1.0f - exp2(ct.w * neg_delta_log2e);
             c = ct.xyz * alpha + (1.0f - alpha) * c;
             alpha_acc = alpha + (1.0f - alpha) * alpha_acc;
