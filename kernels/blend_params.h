@@ -1,5 +1,5 @@
 /* kernels/blend_params.h — the scalar arguments of kernels/blend.cl's blend_render as one struct,
- * shared by host (host/render/blend.cpp) and device, passed by value; buffers stay separate
+ * shared by host (host/render/grid/blend.cpp) and device, passed by value; buffers stay separate
  * arguments. Sizes and offsets are probed on the device by tests/layout_test.cpp. */
 #ifndef CLVR_BLEND_PARAMS_H
 #define CLVR_BLEND_PARAMS_H

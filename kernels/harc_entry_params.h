@@ -1,5 +1,5 @@
 /* kernels/harc_entry_params.h — the uniforms of kernels/harc_entry.cl's fragment program as one struct,
- * shared by host (host/render/harc_entry.cpp, through host/render/fragment_uniforms.h) and device
+ * shared by host (host/render/tet/harc_entry.cpp, through host/render/fragment_uniforms.h) and device
  * (read through r->uniforms). float4 fields only. Probed by tests/layout_test.cpp. */
 #ifndef CLVR_HARC_ENTRY_PARAMS_H
 #define CLVR_HARC_ENTRY_PARAMS_H

@@ -1,5 +1,5 @@
 /* kernels/harc_params.h — the scalar arguments of kernels/harc.cl's harc_render as one struct, shared
- * by host (host/render/harc.cpp) and device, passed by value; buffers stay separate arguments. Sizes
+ * by host (host/render/tet/harc.cpp) and device, passed by value; buffers stay separate arguments. Sizes
  * and offsets are probed on the device by tests/layout_test.cpp. */
 #ifndef CLVR_HARC_PARAMS_H
 #define CLVR_HARC_PARAMS_H

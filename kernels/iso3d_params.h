@@ -1,5 +1,5 @@
 /* kernels/iso3d_params.h — the uniforms of kernels/iso3d.cl's fragment program as one struct, shared
- * by host (host/render/iso3d.cpp, through host/render/fragment_uniforms.h) and device (read through
+ * by host (host/render/grid/iso3d.cpp, through host/render/fragment_uniforms.h) and device (read through
  * r->uniforms). float4 fields only. Sizes and offsets are probed on the device by tests/layout_test.cpp. */
 #ifndef CLVR_ISO3D_PARAMS_H
 #define CLVR_ISO3D_PARAMS_H

@@ -15,7 +15,7 @@
 
 /* One work-item per pixel. The chord [t0, t1] of the ray inside the box [lo, hi] (t0 >= 0) is cut into
  * count = ceil((t1 - t0) / step) equal segments of length h <= step; sample k sits at the middle of
- * segment k (the midpoint rule of host/reference_integral.h's first level). Per sample:
+ * segment k (the midpoint rule of host/reference/reference_integral.h's first level). Per sample:
  * alpha = 1 - exp(-tau h); if alpha <= threshold the sample is skipped before shading (counted in
  * skipped[]); else c += T alpha C shade, T *= 1 - alpha, and the ray stops once 1 - T >= ert_alpha
  * (counted in terminated[]). shade_on = 0: shade 1 (unshaded, the integral slice3d approximates).

@@ -1,5 +1,5 @@
 /* kernels/planes_params.h — the scalar arguments of kernels/planes.cl's planes_render as one struct,
- * shared by host (host/render/planes.cpp) and device, passed by value; buffers stay separate
+ * shared by host (host/render/grid/planes.cpp) and device, passed by value; buffers stay separate
  * arguments. Sizes and offsets are probed on the device by tests/layout_test.cpp. */
 #ifndef CLVR_PLANES_PARAMS_H
 #define CLVR_PLANES_PARAMS_H

@@ -1,5 +1,5 @@
 /* kernels/ray.h — pixel -> ray for the cameras of DESIGN.md (perspective and parallel; rays through
- * pixel centres; image row 0 at the top), as host/camera.cpp's PixelRays::at computes them in double.
+ * pixel centres; image row 0 at the top), as host/model/camera.cpp's PixelRays::at computes them in double.
  * Compiled as OpenCL C (the ray functions) and as C++ (the ClCamera layout only; the host packs it in
  * host/render/camera_args.h). Sizes and offsets are probed on the device by tests/layout_test.cpp.
  *
@@ -84,7 +84,7 @@ float clvr_ray_stretch(const float2 s, const ClCamera cam)
     return sqrt(1.0f + s.x * s.x + s.y * s.y);
 }
 
-/* The ray o + t d with |d| = 1 (t the distance along the ray), host/camera.cpp's Camera::ray. */
+/* The ray o + t d with |d| = 1 (t the distance along the ray), host/model/camera.cpp's Camera::ray. */
 void clvr_ray_unit(const float2 s, const ClCamera cam, float3* o, float3* d)
 {
     clvr_ray_depth(s, cam, o, d);

@@ -1,6 +1,6 @@
 /* kernels/slice3d_params.h — the scalar arguments of kernels/slice3d.cl's fused kernel as one struct
  * (passed by value; buffers stay separate arguments), and the uniforms of its fragment program as
- * another (float4 fields only, read through r->uniforms), shared by host (host/render/slice3d.cpp)
+ * another (float4 fields only, read through r->uniforms), shared by host (host/render/grid/slice3d.cpp)
  * and device. Sizes and offsets are probed on the device by tests/layout_test.cpp. */
 #ifndef CLVR_SLICE3D_PARAMS_H
 #define CLVR_SLICE3D_PARAMS_H

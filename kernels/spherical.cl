@@ -1,5 +1,5 @@
 // kernels/spherical.cl — the per-shell pixel pass of the spherical technique (seeds/000 §2.2,
-// host/render/spherical.h, docs/spherical.md). The frame buffer `coords` holds, per pixel, the
+// host/render/grid/spherical.h, docs/spherical.md). The frame buffer `coords` holds, per pixel, the
 // sphere's interpolated normalized spherical coordinates after the pixel transfer b + s·CM·p, which
 // also mapped them to texture coordinates; `stencil` marks the pixels the shell covered. Per covered
 // pixel: the φ coordinate wraps (GL_REPEAT of the periodic axis), the pixel texture fetch of the

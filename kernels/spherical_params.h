@@ -1,5 +1,5 @@
 /* kernels/spherical_params.h — the scalar arguments of kernels/spherical.cl's spherical_shell as one
- * struct, shared by host (host/render/spherical.cpp) and device, passed by value; buffers stay
+ * struct, shared by host (host/render/grid/spherical.cpp) and device, passed by value; buffers stay
  * separate arguments. Sizes and offsets are probed on the device by tests/layout_test.cpp. */
 #ifndef CLVR_SPHERICAL_PARAMS_H
 #define CLVR_SPHERICAL_PARAMS_H

@@ -1,5 +1,5 @@
 // kernels/stack2d.cl — fragment program of the 2D texture stacks (seeds/003_e49ee09fcdafadac.txt;
-// host/render/stack2d.cpp, docs/stack2d.md). The host appends this file, with CLVR_STACK2D_FRAGMENT
+// host/render/grid/stack2d.cpp, docs/stack2d.md). The host appends this file, with CLVR_STACK2D_FRAGMENT
 // defined, after kernels/raster.cl; compiled on its own (the offline syntax test) it pulls in
 // raster.cl itself, so that the fragment program is checked in the context it runs in.
 // The host has validated everything; this file only does arithmetic.
@@ -22,18 +22,18 @@
  * polygon: axis_b, axis_c, box, uv_box, alpha_ref; clip textures: clip_tex, clip_row, clip_offset).
  * buffer[0] the stack (slices one after another, x
  * fastest): 1 channel, the value, returned as (v, v, v, v); or, shaded, 4 channels (gradient, value)
- * from host/gradient_volume.h. buffer[1] the transfer function (transfer_function.h); buffer[2] the
+ * from host/optics/gradient_volume.h. buffer[1] the transfer function (transfer_function.h); buffer[2] the
  * reflectance map (reflectance_map.h), shaded only; buffer[3] the slice table (float4 per slice:
  * world coordinate on the axis, lower, weight, thickness), several slices per polygon only, followed
  * by the clip texture's texels (clip textures, below: u->clip_*, attr[2]).
  * Sample: bilinear in each slice; an intermediate slice lerps two bilinear samples, the paper's
  * register-combiner step, which makes the sample (and the gradient) trilinear. Classified after
  * interpolation; shaded, the color is C times the map's shade of the interpolated gradient (the
- * model of host/reflectance_map.h, as planes and blend; tau is not shaded);
+ * model of host/optics/reflectance_map.h, as planes and blend; tau is not shaded);
  * alpha = 1 - exp(-tau Delta) with Delta the ray's length through the slab, thickness / |cos| of
  * the angle between the pixel's ray and the axis. Output premultiplied (C alpha, alpha). */
 
-/* Clip texture (seeds/003, "Clipping with arbitrary clipping geometry"; host/clip_texture.h, as
+/* Clip texture (seeds/003, "Clipping with arbitrary clipping geometry"; host/optics/clip_texture.h, as
  * slice3d): with CLVR_STACK2D_CLIP_TEXTURE defined, a second, one-channel texture (negative inside,
  * linear filtering, clamp to edge) decides per sample whether it is drawn. u->clip_tex (width,
  * height, depth, 1 if inverse), u->clip_row the rows of world -> clip-texture coordinates
@@ -122,7 +122,7 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
     const ClTexture slice = stack2d_slice_texture(u);
     const bool iso = u->iso.y != 0.0f;
 
-    /* The pixel's ray (host/camera.cpp's PixelRays): from the camera through the pixel center, or for
+    /* The pixel's ray (host/model/camera.cpp's PixelRays): from the camera through the pixel center, or for
      * a parallel camera from the pixel's point on the image plane along forward. */
     const ClCamera cam = u->camera;
     float3 origin, d;

@@ -1,5 +1,5 @@
 /* kernels/stack2d_params.h — the uniforms of kernels/stack2d.cl's fragment program as one struct,
- * shared by host (host/render/stack2d.cpp, through host/render/fragment_uniforms.h) and device (read
+ * shared by host (host/render/grid/stack2d.cpp, through host/render/fragment_uniforms.h) and device (read
  * through r->uniforms). float4 fields only. Sizes and offsets are probed on the device by
  * tests/layout_test.cpp. Fields of a mode that is off stay 0. */
 #ifndef CLVR_STACK2D_PARAMS_H

@@ -1,6 +1,6 @@
 /* kernels/transfer_function.h — the piecewise-linear transfer function of DESIGN.md on the device:
  * control points (s, r, g, b, tau), evaluated exactly from its control points (no table; float
- * rounding only), the end points' values held outside [s_0, s_{n-1}] as host/transfer_function.h
+ * rounding only), the end points' values held outside [s_0, s_{n-1}] as host/model/transfer_function.h
  * does. OpenCL C 1.2.
  * Layout of the float buffer (host: packTransferFunction in host/render/transfer_function_upload.h), m = n rounded
  * up to a multiple of 4 (vload4 alignment):

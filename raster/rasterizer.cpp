@@ -2,7 +2,7 @@
 // double precision, then snapped to the subpixel grid), and the one ordered fragment launch.
 #include "raster/rasterizer.h"
 
-#include "host/errors.h"
+#include "host/runtime/errors.h"
 
 #include <algorithm>
 #include <cmath>

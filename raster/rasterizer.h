@@ -4,7 +4,7 @@
 // its tile's list in that order, so blending is exactly ordered and two runs give identical bits.
 #pragma once
 
-#include "host/device.h"
+#include "host/runtime/device.h"
 #include "raster/fragment_state.h"
 #include "raster/framebuffer.h"
 

@@ -1,8 +1,8 @@
-// tests/ray_test.cpp — kernels/ray.h against host/camera.cpp's PixelRays (double precision): every
+// tests/ray_test.cpp — kernels/ray.h against host/model/camera.cpp's PixelRays (double precision): every
 // pixel of an odd-sized image, both cameras, each of the three forms the kernels use.
-#include "host/camera.h"
+#include "host/model/camera.h"
 #include "host/render/camera_args.h"
-#include "tests/test_util.h"
+#include "tests/support/test_util.h"
 
 #include <gtest/gtest.h>
 

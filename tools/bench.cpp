@@ -4,13 +4,13 @@
 // meshes) on the same scene in the same run.
 #include "tools/bench.h"
 
-#include "host/device.h"
-#include "host/errors.h"
-#include "host/image_io.h"
-#include "host/mesh.h"
+#include "host/runtime/device.h"
+#include "host/runtime/errors.h"
+#include "host/io/image_io.h"
+#include "host/model/mesh.h"
 #include "host/render/renderer.h"
-#include "host/scene.h"
-#include "host/volume_io.h"
+#include "host/model/scene.h"
+#include "host/io/volume_io.h"
 #include "tools/bench_mesh.h"
 #include "tools/ceiling.h"
 

@@ -1,10 +1,10 @@
 // host/render/camera_args.h — the camera as every kernel and fragment program takes it: ClCamera of
 // kernels/ray.h, position, forward, right, up and (scale, aspect, 1 if parallel, 0), with scale =
 // tan(view_angle / 2) (perspective) or parallel_scale (parallel). kernels/ray.h turns a pixel into
-// host/camera.cpp's PixelRays::at ray from it. The one place where a camera is packed for the device.
+// host/model/camera.cpp's PixelRays::at ray from it. The one place where a camera is packed for the device.
 #pragma once
 
-#include "host/camera.h"
+#include "host/model/camera.h"
 
 #include "kernels/ray.h"
 

@@ -3,7 +3,7 @@
 // the slicing techniques (slice3d, iso3d, blend).
 #pragma once
 
-#include "host/camera.h"
+#include "host/model/camera.h"
 
 #include <glm/glm.hpp>
 

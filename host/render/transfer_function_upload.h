@@ -3,8 +3,8 @@
 // Every technique that classifies on the device keeps one TransferFunctionUpload.
 #pragma once
 
-#include "host/device.h"
-#include "host/transfer_function.h"
+#include "host/runtime/device.h"
+#include "host/model/transfer_function.h"
 
 #include <CL/opencl.hpp>
 
