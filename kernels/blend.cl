@@ -4,7 +4,9 @@
 // rest written clear), and the shaded slice blended "over" into the frame. The paper's two buffers (slice
 // of shaded samples, frame buffer) are fused here: one work-item per pixel walks all slices.
 // The host has validated everything; this file only does arithmetic.
+#include "blend_params.h"
 #include "clvr_common.h"
+#include "ray.h"
 #include "reflectance_map.h"
 #include "transfer_function.h"
 #include "volume_sampling.h"
@@ -15,48 +17,46 @@
  * delta = delta_s |d|. Slices from the farthest (slice_count - 1) to the nearest; only samples inside the
  * grid count (samples[]). alpha = 1 - exp(-tau delta); alpha <= threshold: clear (skipped[], not shaded);
  * else c = C shade alpha + (1 - alpha) c, A = alpha + (1 - alpha) A. Pixel c + (1 - A) background, A. */
-kernel void blend_render(global float4* out, global uint* samples, global uint* skipped, const int width,
-                         const int height, global const float4* volume, const int4 dims, const float4 grid_origin,
-                         const float4 inv_spacing, global const float* tf, const int tf_count,
-                         global const float4* map, const int map_n, const int shade_on, const float4 to_eye,
-                         const float4 cam_position, const float4 cam_forward, const float4 cam_right,
-                         const float4 cam_up, const float4 cam_params, const float depth0, const float delta_s,
-                         const int slice_count, const float threshold, const float4 background)
+kernel void blend_render(global float4* out, global uint* samples, global uint* skipped,
+                         global const float4* volume, global const float* tf, global const float4* map,
+                         const ClBlendParams p)
 {
-    CLVR_GUARD_2D(width, height);
+    CLVR_GUARD_2D(p.width, p.height);
     const int x = (int)get_global_id(0), y = (int)get_global_id(1);
-    const float ndc_x = ((float)x + 0.5f) / (float)width * 2.0f - 1.0f;
-    const float ndc_y = 1.0f - ((float)y + 0.5f) / (float)height * 2.0f;
-    const float sx = ndc_x * cam_params.x * cam_params.y, sy = ndc_y * cam_params.x;
-    const int parallel = cam_params.z != 0.0f;
-    const float3 o = parallel ? cam_position.xyz + sx * cam_right.xyz + sy * cam_up.xyz : cam_position.xyz;
-    const float3 d = parallel ? cam_forward.xyz : cam_forward.xyz + sx * cam_right.xyz + sy * cam_up.xyz;
-    const float delta = delta_s * (parallel ? 1.0f : sqrt(1.0f + sx * sx + sy * sy));
+    const int4 dims = p.dims;
+    const float depth0 = p.depth0, delta_s = p.delta_s, threshold = p.threshold;
+    const int tf_count = p.tf_count, map_n = p.map_n, shade_on = p.shade_on;
+    const float3 to_eye = p.to_eye.xyz;
+    const float2 size = (float2)((float)p.width, (float)p.height);
+    const float2 s = clvr_ray_offset(clvr_ray_ndc(clvr_ray_pixel_centre(x, y), size), p.camera);
+    float3 o, d;
+    clvr_ray_depth(s, p.camera, &o, &d);
+    const float delta = delta_s * clvr_ray_stretch(s, p.camera);
     const float neg_delta_log2e = -delta * M_LOG2E_F; /* exp(-tau delta) = exp2(tau * this) */
-    const float3 go = (o - grid_origin.xyz) * inv_spacing.xyz; /* grid coordinates */
-    const float3 gd = d * inv_spacing.xyz;
+    const float3 go = (o - p.grid_origin.xyz) * p.inv_spacing.xyz; /* grid coordinates */
+    const float3 gd = d * p.inv_spacing.xyz;
 
     float3 c = (float3)(0.0f);
     float alpha_acc = 0.0f;
     uint taken = 0, below = 0;
-    for (int k = slice_count - 1; k >= 0; --k) {
+    for (int k = p.slice_count - 1; k >= 0; --k) {
         const float3 g = go + (depth0 + ((float)k + 0.5f) * delta_s) * gd;
         if (!clvr_grid_inside(g, dims))
             continue;
         ++taken;
-        const float4 s = clvr_trilinear4(volume, dims, g);
-        const float4 ct = clvr_tf_eval(tf, tf_count, s.w);
+        const float4 v = clvr_trilinear4(volume, dims, g);
+        const float4 ct = clvr_tf_eval(tf, tf_count, v.w);
         const float alpha = 1.0f - exp2(ct.w * neg_delta_log2e);
         if (alpha <= threshold) { /* written clear: blending it changes nothing */
             ++below;
             continue;
         }
-        const float3 shade = shade_on ? clvr_reflectance(map, map_n, s.xyz, to_eye.xyz) : (float3)(1.0f);
+        const float3 shade = shade_on ? clvr_reflectance(map, map_n, v.xyz, to_eye) : (float3)(1.0f);
         c = (ct.xyz * shade) * alpha + (1.0f - alpha) * c;
         alpha_acc = alpha + (1.0f - alpha) * alpha_acc;
     }
-    const int i = y * width + x;
-    out[i] = (float4)(c + (1.0f - alpha_acc) * background.xyz, alpha_acc);
+    const int i = y * p.width + x;
+    out[i] = (float4)(c + (1.0f - alpha_acc) * p.background.xyz, alpha_acc);
     samples[i] = taken;
     skipped[i] = below;
 }

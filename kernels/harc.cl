@@ -8,6 +8,8 @@
 // sorted by depth (host/render/tet/harc.cpp); after the ray leaves the mesh it re-enters at the next one.
 // The host has validated everything; this file only does arithmetic.
 #include "clvr_common.h"
+#include "harc_params.h"
+#include "ray.h"
 
 /* Per tetrahedron, 5 float4 = 80 bytes (Table 1 of seeds/001 uses 96), host/render/tet/harc.h:
  *   [0..2] barycentric planes (h_i, k_i), i = 0, 1, 2: b_i(x) = dot(h_i, x) + k_i is 1 at vertex i and
@@ -163,34 +165,25 @@ float4 harc_full_lookup(global const float4* table, const int ns, const int nl, 
 }
 
 /* One work-item per pixel. entries[offsets[p] .. offsets[p+1]) are the boundary front-face crossings
- * of pixel p's ray, sorted by ray parameter: (λ as float bits, tet * 4 + face). Camera: position,
- * forward, right, up (orthonormal, relative to the mesh's shifted origin); params: x = tan(view_angle
- * / 2) or parallel_scale, y = aspect, z = 1 for a parallel camera. Ray e + λ d, |d| = 1, as
- * host/model/camera.cpp's Camera::ray. stats[p] = (steps, 1 if the step bound stopped the ray, pieces).
- * integration: HARC_INTEGRATION_*; full_table, full_ns, full_nl, full_params: harc_full_lookup's table
- * (a one-element dummy unless integration is full). Out: (I + T background, 1 - T). */
-kernel void harc_render(global float4* out, global uint* stats, const int width, const int height,
-                        global const float4* tets, global const uint* offsets, global const int2* entries,
-                        global const float* tf, const int tf_count, global const float* psi, const int psi_n,
-                        const float4 cam_position, const float4 cam_forward, const float4 cam_right,
-                        const float4 cam_up, const float4 cam_params, const uint max_steps, const int integration,
-                        const float ert_alpha, const float4 background, global const float4* full_table,
-                        const int full_ns, const int full_nl, const float4 full_params)
+ * of pixel p's ray, sorted by ray parameter: (λ as float bits, tet * 4 + face). params.camera is
+ * relative to the mesh's shifted origin. Ray e + λ d, |d| = 1 (kernels/ray.h's clvr_ray_unit, as
+ * host/model/camera.cpp's Camera::ray). stats[p] = (steps, 1 if the step bound stopped the ray, pieces).
+ * integration: HARC_INTEGRATION_*; full_table, full_ns, full_nl, full_params: harc_full_lookup's
+ * table (a one-element dummy unless integration is full). Out: (I + T background, 1 - T). */
+kernel void harc_render(global float4* out, global uint* stats, global const float4* tets,
+                        global const uint* offsets, global const int2* entries, global const float* tf,
+                        global const float* psi, global const float4* full_table, const ClHarcParams params)
 {
-    CLVR_GUARD_2D(width, height);
+    CLVR_GUARD_2D(params.width, params.height);
     const int x = (int)get_global_id(0), y = (int)get_global_id(1);
-    const int p = y * width + x;
-    const float ndc_x = ((float)x + 0.5f) / (float)width * 2.0f - 1.0f;
-    const float ndc_y = 1.0f - ((float)y + 0.5f) / (float)height * 2.0f;
-    const float sx = ndc_x * cam_params.x * cam_params.y, sy = ndc_y * cam_params.x;
+    const int p = y * params.width + x;
+    const int tf_count = params.tf_count, psi_n = params.psi_n, integration = params.integration;
+    const uint max_steps = params.max_steps;
+    const float ert_alpha = params.ert_alpha;
+    const float2 size = (float2)((float)params.width, (float)params.height);
     float3 e, d;
-    if (cam_params.z != 0.0f) {
-        e = cam_position.xyz + sx * cam_right.xyz + sy * cam_up.xyz;
-        d = cam_forward.xyz;
-    } else {
-        e = cam_position.xyz;
-        d = normalize(cam_forward.xyz + sx * cam_right.xyz + sy * cam_up.xyz);
-    }
+    const float2 offset = clvr_ray_offset(clvr_ray_ndc(clvr_ray_pixel_centre(x, y), size), params.camera);
+    clvr_ray_unit(offset, params.camera, &e, &d);
 
     float3 color = (float3)(0.0f);
     float transmittance = 1.0f;
@@ -240,7 +233,8 @@ kernel void harc_render(global float4* out, global uint* stats, const int width,
             const float s_b = dot(grad.xyz, e + lambda_exit * d) + grad.w;
             if (integration == HARC_INTEGRATION_FULL) {
                 /* The whole segment at once: no split at control points (the table has them inside). */
-                const float4 c = harc_full_lookup(full_table, full_ns, full_nl, full_params, s_f, s_b, step);
+                const float4 c =
+                    harc_full_lookup(full_table, params.full_ns, params.full_nl, params.full_params, s_f, s_b, step);
                 color += transmittance * c.xyz;
                 transmittance *= 1.0f - c.w;
                 ++pieces;
@@ -266,7 +260,7 @@ kernel void harc_render(global float4* out, global uint* stats, const int width,
         if (k >= end)
             break;
     }
-    out[p] = (float4)(color + transmittance * background.xyz, 1.0f - transmittance);
+    out[p] = (float4)(color + transmittance * params.background.xyz, 1.0f - transmittance);
     stats[3 * p + 0] = steps;
     stats[3 * p + 1] = bounded;
     stats[3 * p + 2] = pieces;

@@ -4,12 +4,11 @@
 // nearest face that the ray enters through (decided here from the face's plane) whose ray parameter λ
 // lies beyond the previous layer's survives.
 #ifdef CLVR_HARC_ENTRY_FRAGMENT
+#include "harc_entry_params.h"
 
 /* attr[0] = (position relative to the mesh origin, 0), perspective-correct; attr[1] = (code & 0xffff,
  * code >> 16, 0, 0), the same at the three corners (code = tet * 4 + face).
- * uniforms (camera relative to the mesh origin, as kernels/harc.cl's harc_render takes it):
- *   0 position, 1 forward, 2 right, 3 up, 4 params (tan(view_angle/2) or parallel_scale, aspect,
- *   1 if parallel else 0), 5 (width, height).
+ * uniforms: ClHarcEntryUniforms (kernels/harc_entry_params.h).
  * buffer[0] = the previous layer's λ per pixel (-1e30 before the first); buffer[1] = the tetrahedra in
  * kernels/harc.cl's 80-byte layout.
  * λ is the parameter of harc_render's ray e + λ d through this pixel's center where it crosses the
@@ -18,19 +17,11 @@
  * Output: (λ, code & 0xffff, code >> 16, 1), exact integers in float. */
 int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* color)
 {
-    constant float4* u = r->uniforms;
-    const int width = (int)u[5].x, height = (int)u[5].y;
-    const float ndc_x = f->window.x / (float)width * 2.0f - 1.0f;
-    const float ndc_y = 1.0f - f->window.y / (float)height * 2.0f;
-    const float sx = ndc_x * u[4].x * u[4].y, sy = ndc_y * u[4].x;
+    constant ClHarcEntryUniforms* u = (constant ClHarcEntryUniforms*)r->uniforms;
+    const int width = (int)u->size.x;
+    const ClCamera cam = u->camera;
     float3 e, d;
-    if (u[4].z != 0.0f) {
-        e = u[0].xyz + sx * u[2].xyz + sy * u[3].xyz;
-        d = u[1].xyz;
-    } else {
-        e = u[0].xyz;
-        d = normalize(u[1].xyz + sx * u[2].xyz + sy * u[3].xyz);
-    }
+    clvr_ray_unit(clvr_ray_offset(clvr_ray_ndc(f->window, u->size.xy), cam), cam, &e, &d);
     const int code = (int)rint(f->attr[1].x) | ((int)rint(f->attr[1].y) << 16);
     global const float4* tet = (global const float4*)r->buffer[1] + (size_t)(code >> 2) * 5;
     const int face = code & 3;

@@ -28,6 +28,8 @@ kernel void iso3d_finish(global float4* color, global const float* depth, const 
 
 #else
 
+#include "iso3d_params.h"
+
 /* Trilinear RGBA at grid coordinates g (checked inside by the caller), the four channels of each
  * grid point interleaved: the 3D texture of the paper's gradient shading, filtered as one texture. */
 float4 iso3d_trilinear4(global const float* v, const int4 dims, const float3 g)
@@ -49,9 +51,10 @@ float4 iso3d_trilinear4(global const float* v, const int4 dims, const float3 g)
     return c0 + fz * (c1 - c0);
 }
 
-/* attr[0] = world position on the slice (perspective-correct). uniforms: 0 grid origin, 1 1 / spacing,
- * 2 dims, 4 the brick's first grid point, 5 its box's exclusive upper end (grid units), 6 its dims,
- * 3 (value_lo, 1 / (value_hi - value_lo), positions, flip): the value range mapped onto alpha's [0,1],
+/* attr[0] = world position on the slice (perspective-correct). uniforms: ClIso3dUniforms
+ * (kernels/iso3d_params.h): grid origin, 1 / spacing, dims; the brick's first grid point, its box's
+ * exclusive upper end (grid units), its dims; value_map = (value_lo, 1 / (value_hi - value_lo),
+ * positions, flip): the value range mapped onto alpha's [0,1],
  * positions != 0 for gradientless shading, and flip != 0 for Figure 7's interior pass (the normal turned
  * round: encoded 1 - rgb). buffer[0]: RGBA volume (or the brick's part of it), per grid point (0.5 N + 0.5, value)
  * with N the unit normal (iso3d.h). Output: (0.5 N + 0.5 interpolated, normalized value), or with
@@ -59,22 +62,24 @@ float4 iso3d_trilinear4(global const float* v, const int4 dims, const float3 g)
  * coordinate (u, v, w) is assigned as RGB color value"); discarded outside the grid (empty there). */
 int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* color)
 {
-    constant float4* u = r->uniforms;
-    const int4 dims = convert_int4(u[2]);
-    const float3 g = (f->attr[0].xyz - u[0].xyz) * u[1].xyz;
+    constant ClIso3dUniforms* u = (constant ClIso3dUniforms*)r->uniforms;
+    const int4 dims = convert_int4(u->dims);
+    const float3 g = (f->attr[0].xyz - u->grid_origin.xyz) * u->inv_spacing.xyz;
     if (!clvr_grid_inside(g, dims))
         return 0;
     /* Bricking (§3.1): the fragment belongs to the brick whose half-open box [lo, hi) holds g (hi = n for
      * the last slab of an axis, so its far face is kept), which cuts every slice exactly between bricks.
      * The brick's texture is sampled at g - lo: exact in float (0 <= lo <= g, lo an integer), so the
      * cell and its weights are the unbricked ones, bit for bit. Unbricked: lo = 0, hi = n. */
-    const float3 lo = u[4].xyz;
-    if (g.x < lo.x || g.y < lo.y || g.z < lo.z || g.x >= u[5].x || g.y >= u[5].y || g.z >= u[5].z)
+    const float3 lo = u->brick_lo.xyz;
+    const float4 hi = u->brick_end;
+    if (g.x < lo.x || g.y < lo.y || g.z < lo.z || g.x >= hi.x || g.y >= hi.y || g.z >= hi.z)
         return 0;
-    const float4 t = iso3d_trilinear4(r->buffer[0], convert_int4(u[6]), g - lo);
-    const float3 n = u[3].w != 0.0f ? 1.0f - t.xyz : t.xyz;
-    const float3 rgb = u[3].z != 0.0f ? (g + 0.5f) / convert_float3(dims.xyz) : n;
-    *color = (float4)(rgb, (t.w - u[3].x) * u[3].y);
+    const float4 t = iso3d_trilinear4(r->buffer[0], convert_int4(u->brick_dims), g - lo);
+    const float4 m = u->value_map;
+    const float3 n = m.w != 0.0f ? 1.0f - t.xyz : t.xyz;
+    const float3 rgb = m.z != 0.0f ? (g + 0.5f) / convert_float3(dims.xyz) : n;
+    *color = (float4)(rgb, (t.w - m.x) * m.y);
     return 1;
 }
 

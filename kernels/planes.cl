@@ -8,27 +8,10 @@
 // fused in one work-item per pixel instead of pipelined row by row.
 // The host has validated everything; this file only does arithmetic.
 #include "clvr_common.h"
+#include "planes_params.h"
+#include "ray.h"
 #include "reflectance_map.h"
 #include "transfer_function.h"
-
-/* The ray through pixel center (x + 0.5, y + 0.5), row 0 at the top (host/model/camera.cpp's Camera::ray):
- * origin o and unit direction d. params: x = tan(view_angle / 2) or parallel_scale, y = aspect
- * (width / height), z = 1 for a parallel camera (o on the image plane through the position). */
-void planes_ray(const int x, const int y, const int width, const int height, const float4 position,
-                const float4 forward, const float4 right, const float4 up, const float4 params, float3* o,
-                float3* d)
-{
-    const float ndc_x = ((float)x + 0.5f) / (float)width * 2.0f - 1.0f;
-    const float ndc_y = 1.0f - ((float)y + 0.5f) / (float)height * 2.0f;
-    const float sx = ndc_x * params.x * params.y, sy = ndc_y * params.x;
-    if (params.z != 0.0f) {
-        *o = position.xyz + sx * right.xyz + sy * up.xyz;
-        *d = forward.xyz;
-    } else {
-        *o = position.xyz;
-        *d = normalize(forward.xyz + sx * right.xyz + sy * up.xyz);
-    }
-}
 
 /* One work-item per pixel. The chord [t0, t1] of the ray inside the box [lo, hi] (t0 >= 0) is cut into
  * count = ceil((t1 - t0) / step) equal segments of length h <= step; sample k sits at the middle of
@@ -38,26 +21,28 @@ void planes_ray(const int x, const int y, const int width, const int height, con
  * (counted in terminated[]). shade_on = 0: shade 1 (unshaded, the integral slice3d approximates).
  * The pixel is c + T background, 1 - T. samples[] counts the samples classified. */
 kernel void planes_render(global float4* out, global uint* samples, global uint* skipped, global uchar* terminated,
-                          const int width, const int height, global const float4* volume, const int4 dims,
-                          const float4 grid_origin, const float4 inv_spacing, const float4 box_lo,
-                          const float4 box_hi, global const float* tf, const int tf_count,
-                          global const float4* map, const int map_n, const int shade_on, const float4 to_eye,
-                          const float4 cam_position, const float4 cam_forward, const float4 cam_right,
-                          const float4 cam_up, const float4 cam_params, const float step, const float ert_alpha,
-                          const float threshold, const float4 background)
+                          global const float4* volume, global const float* tf, global const float4* map,
+                          const ClPlanesParams p)
 {
-    CLVR_GUARD_2D(width, height);
+    CLVR_GUARD_2D(p.width, p.height);
     const int x = (int)get_global_id(0), y = (int)get_global_id(1);
+    /* the values the sample loop reads, as locals */
+    const int4 dims = p.dims;
+    const float3 grid_origin = p.grid_origin.xyz, inv_spacing = p.inv_spacing.xyz, to_eye = p.to_eye.xyz;
+    const int tf_count = p.tf_count, map_n = p.map_n, shade_on = p.shade_on;
+    const float ert_alpha = p.ert_alpha, threshold = p.threshold;
+    /* The ray through the pixel center, origin o and unit direction d (kernels/ray.h). */
+    const float2 size = (float2)((float)p.width, (float)p.height);
     float3 o, d;
-    planes_ray(x, y, width, height, cam_position, cam_forward, cam_right, cam_up, cam_params, &o, &d);
+    clvr_ray_unit(clvr_ray_offset(clvr_ray_ndc(clvr_ray_pixel_centre(x, y), size), p.camera), p.camera, &o, &d);
 
     /* Slab test against the box: t0 >= 0 keeps only what lies in front of the camera. */
     float t0 = 0.0f, t1 = INFINITY;
     for (int a = 0; a < 3; ++a) {
         const float oa = a == 0 ? o.x : (a == 1 ? o.y : o.z);
         const float da = a == 0 ? d.x : (a == 1 ? d.y : d.z);
-        const float lo = a == 0 ? box_lo.x : (a == 1 ? box_lo.y : box_lo.z);
-        const float hi = a == 0 ? box_hi.x : (a == 1 ? box_hi.y : box_hi.z);
+        const float lo = a == 0 ? p.box_lo.x : (a == 1 ? p.box_lo.y : p.box_lo.z);
+        const float hi = a == 0 ? p.box_hi.x : (a == 1 ? p.box_hi.y : p.box_hi.z);
         if (da == 0.0f) {
             if (oa < lo || oa > hi)
                 t1 = -INFINITY;
@@ -73,14 +58,14 @@ kernel void planes_render(global float4* out, global uint* samples, global uint*
     uint taken = 0, below = 0;
     uchar stopped = 0;
     if (t1 > t0) {
-        const int count = max(1, (int)ceil((t1 - t0) / step));
+        const int count = max(1, (int)ceil((t1 - t0) / p.step));
         const float h = (t1 - t0) / (float)count;
         const float neg_h_log2e = -h * M_LOG2E_F; /* exp(-tau h) = exp2(tau * this) */
         const float3 last = convert_float3(dims.xyz - 1);
         for (int k = 0; k < count; ++k) {
-            const float3 p = o + (t0 + ((float)k + 0.5f) * h) * d;
+            const float3 q = o + (t0 + ((float)k + 0.5f) * h) * d;
             /* inside the box by construction; the clamp absorbs float rounding at its faces */
-            const float3 g = clamp((p - grid_origin.xyz) * inv_spacing.xyz, (float3)(0.0f), last);
+            const float3 g = clamp((q - grid_origin) * inv_spacing, (float3)(0.0f), last);
             const float4 s = clvr_trilinear4(volume, dims, g);
             const float4 ct = clvr_tf_eval(tf, tf_count, s.w);
             ++taken;
@@ -89,7 +74,7 @@ kernel void planes_render(global float4* out, global uint* samples, global uint*
                 ++below;
                 continue;
             }
-            const float3 shade = shade_on ? clvr_reflectance(map, map_n, s.xyz, to_eye.xyz) : (float3)(1.0f);
+            const float3 shade = shade_on ? clvr_reflectance(map, map_n, s.xyz, to_eye) : (float3)(1.0f);
             c += (transmittance * alpha) * (ct.xyz * shade);
             transmittance *= 1.0f - alpha;
             if (1.0f - transmittance >= ert_alpha) {
@@ -98,8 +83,8 @@ kernel void planes_render(global float4* out, global uint* samples, global uint*
             }
         }
     }
-    const int i = y * width + x;
-    out[i] = (float4)(c + transmittance * background.xyz, 1.0f - transmittance);
+    const int i = y * p.width + x;
+    out[i] = (float4)(c + transmittance * p.background.xyz, 1.0f - transmittance);
     samples[i] = taken;
     skipped[i] = below;
     terminated[i] = stopped;

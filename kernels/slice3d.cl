@@ -8,42 +8,12 @@
 // The host has validated everything; this file only does arithmetic.
 #include "clvr_common.h"
 #include "clip_texture.h"
+#include "ray.h"
 #include "texture.h"
 #include "transfer_function.h"
 #include "volume_sampling.h"
 
-/* Normalized device coordinates of window position w (pixel center (x + 0.5, row + 0.5), row 0 at
- * the top), y up — host/model/camera.cpp's Camera::ray. */
-float2 slice3d_ndc(const float2 w, const int width, const int height)
-{
-    return (float2)(w.x / (float)width * 2.0f - 1.0f, 1.0f - w.y / (float)height * 2.0f);
-}
-
-/* The pixel's ray as origin o + z * d, z the eye depth along forward (dot(d, forward) = 1), so the
- * ray's point on the slice at depth z is o + z d and a slice spacing deltaS is a ray length
- * deltaS * |d| (= deltaS / cos(theta)). params: x = tan(view_angle / 2) or parallel_scale,
- * y = aspect (width / height), z = 1 for a parallel camera. */
-void slice3d_ray(const float2 ndc, const float4 position, const float4 forward, const float4 right,
-                 const float4 up, const float4 params, float3* o, float3* d)
-{
-    const float sx = ndc.x * params.x * params.y, sy = ndc.y * params.x;
-    if (params.z != 0.0f) {
-        *o = position.xyz + sx * right.xyz + sy * up.xyz;
-        *d = forward.xyz;
-    } else {
-        *o = position.xyz;
-        *d = forward.xyz + sx * right.xyz + sy * up.xyz;
-    }
-}
-
-/* |d| of slice3d_ray: 1 / cos(theta) for perspective (orthonormal frame), 1 for parallel. */
-float slice3d_stretch(const float2 ndc, const float4 params)
-{
-    if (params.z != 0.0f)
-        return 1.0f;
-    const float sx = ndc.x * params.x * params.y, sy = ndc.y * params.x;
-    return sqrt(1.0f + sx * sx + sy * sy);
-}
+#include "slice3d_params.h"
 
 #ifndef CLVR_SLICE3D_FRAGMENT
 
@@ -136,32 +106,34 @@ int slice3d_space(global const uchar* space, const int4 bdims, const int4 b)
  * c = C alpha + (1 - alpha) c (the paper's blending); front to back: c += T alpha C, T *= 1 - alpha,
  * stopping once 1 - T >= ert_alpha. alpha = 1 - exp(-tau Delta), computed as
  * 1 - exp2(tau * (-Delta log2 e)). The pixel is c + (1 - A) background, A. */
-kernel void slice3d_fused(global float4* out, global uint* samples, global uint* skipped, const int width,
-                          const int height, global const SLICE3D_VOXEL* volume, const int4 dims, const float4 grid_origin,
-                          const float4 inv_spacing, global const float* tf, const int tf_count,
-                          global const uchar* space, const int4 bdims, const int skip,
-                          const float4 cam_position, const float4 cam_forward, const float4 cam_right,
-                          const float4 cam_up, const float4 cam_params, const float depth0,
-                          const float delta_s, const int slice_count, const int front_to_back,
-                          const float ert_alpha, const float4 background
+kernel void slice3d_fused(global float4* out, global uint* samples, global uint* skipped,
+                          global const SLICE3D_VOXEL* volume, global const float* tf, global const uchar* space,
 #ifdef SLICE3D_CLIP_TEXTURE
-                          , global const float* clip_texels, const ClTexture clip_tex, const float4 clip_row0,
-                          const float4 clip_row1, const float4 clip_row2, const int clip_inverse
+                          global const float* clip_texels,
 #endif
-                          )
+                          const ClSlice3dParams p)
 {
-    CLVR_GUARD_2D(width, height);
+    CLVR_GUARD_2D(p.width, p.height);
     const int x = (int)get_global_id(0), y = (int)get_global_id(1);
-    const float2 ndc = slice3d_ndc((float2)((float)x + 0.5f, (float)y + 0.5f), width, height);
+    const int4 dims = p.dims;
+    const float depth0 = p.depth0, delta_s = p.delta_s, ert_alpha = p.ert_alpha;
+    const int tf_count = p.tf_count, skip = p.skip;
+    const int4 bdims = p.brick_dims;
+    /* The pixel's ray as origin o + z * d, z the eye depth along forward (dot(d, forward) = 1), so the
+     * ray's point on the slice at depth z is o + z d and a slice spacing deltaS is a ray length
+     * deltaS * |d| (= deltaS / cos(theta)). */
+    const float2 size = (float2)((float)p.width, (float)p.height);
+    const float2 s = clvr_ray_offset(clvr_ray_ndc(clvr_ray_pixel_centre(x, y), size), p.camera);
     float3 o, d;
-    slice3d_ray(ndc, cam_position, cam_forward, cam_right, cam_up, cam_params, &o, &d);
-    const float delta = delta_s * slice3d_stretch(ndc, cam_params);  /* ray length per slice */
+    clvr_ray_depth(s, p.camera, &o, &d);
+    const float delta = delta_s * clvr_ray_stretch(s, p.camera);  /* ray length per slice */
     const float neg_delta_log2e = -delta * M_LOG2E_F;                /* exp(-tau delta) = exp2(tau * this) */
-    const float3 go = (o - grid_origin.xyz) * inv_spacing.xyz;     /* grid coordinates */
-    const float3 gd = d * inv_spacing.xyz;
+    const float3 go = (o - p.grid_origin.xyz) * p.inv_spacing.xyz;     /* grid coordinates */
+    const float3 gd = d * p.inv_spacing.xyz;
     const float3 inv_gd = 1.0f / gd;  /* for empty-space runs only (inf where gd is 0, not used there) */
 #ifdef SLICE3D_CLIP_TEXTURE
     /* Clip-texture coordinates are affine in the world position, so along the ray u = uo + z ud. */
+    const float4 clip_row0 = p.clip_row[0], clip_row1 = p.clip_row[1], clip_row2 = p.clip_row[2];
     const float3 uo = (float3)(dot(clip_row0.xyz, o) + clip_row0.w, dot(clip_row1.xyz, o) + clip_row1.w,
                                dot(clip_row2.xyz, o) + clip_row2.w);
     const float3 ud = (float3)(dot(clip_row0.xyz, d), dot(clip_row1.xyz, d), dot(clip_row2.xyz, d));
@@ -186,7 +158,7 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
     }
     int k_lo = 0, k_hi = -1;
     if (zin <= zout) {
-        const float n = (float)slice_count;
+        const float n = (float)p.slice_count;
         k_lo = (int)clamp(ceil((zin - depth0) / delta_s) - 1.0f, 0.0f, n);
         k_hi = (int)clamp(floor((zout - depth0) / delta_s) + 1.0f, -1.0f, n - 1.0f);
     }
@@ -194,7 +166,7 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
     float3 c = (float3)(0.0f);
     float alpha_acc = 0.0f;
     uint taken = 0, stepped_over = 0;
-    if (front_to_back) {
+    if (p.front_to_back) {
         float transmittance = 1.0f;
         for (int k = k_lo; k <= k_hi; ++k) {
             const float3 g = slice3d_point(go, gd, depth0, delta_s, k);
@@ -213,7 +185,7 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
             }
             ++taken;
 #ifdef SLICE3D_CLIP_TEXTURE
-            if (!clvr_clip_keep(clip_texels, clip_tex, uo + (depth0 + (float)k * delta_s) * ud, clip_inverse))
+            if (!clvr_clip_keep(clip_texels, p.clip_tex, uo + (depth0 + (float)k * delta_s) * ud, p.clip_inverse))
                 continue;
 #endif
             const float4 ct = clvr_tf_eval(tf, tf_count, SLICE3D_TRILINEAR(volume, dims, g));
@@ -242,7 +214,7 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
             }
             ++taken;
 #ifdef SLICE3D_CLIP_TEXTURE
-            if (!clvr_clip_keep(clip_texels, clip_tex, uo + (depth0 + (float)k * delta_s) * ud, clip_inverse))
+            if (!clvr_clip_keep(clip_texels, p.clip_tex, uo + (depth0 + (float)k * delta_s) * ud, p.clip_inverse))
                 continue;
 #endif
             const float4 ct = clvr_tf_eval(tf, tf_count, SLICE3D_TRILINEAR(volume, dims, g));
@@ -251,8 +223,8 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
             alpha_acc = alpha + (1.0f - alpha) * alpha_acc;
         }
     }
-    const int i = y * width + x;
-    out[i] = (float4)(c + (1.0f - alpha_acc) * background.xyz, alpha_acc);
+    const int i = y * p.width + x;
+    out[i] = (float4)(c + (1.0f - alpha_acc) * p.background.xyz, alpha_acc);
     samples[i] = taken + stepped_over;
     skipped[i] = stepped_over;
 }
@@ -269,27 +241,27 @@ kernel void slice3d_over_background(global float4* color, const int count, const
 #else
 
 /* Fragment program of the pass-by-pass path (raster/rasterizer.h). attr[0] = world position on the
- * slice (perspective-correct). uniforms: 0..3 camera position, forward, right, up; 4 camera params
- * (see slice3d_ray); 5 (width, height, delta_s, tf_count); 6 grid origin; 7 1 / spacing;
- * 8 dims. buffer[0] volume values, buffer[1] transfer function (transfer_function.h layout).
- * With CLVR_SLICE3D_CLIP_TEXTURE: attr[1] clip-texture coordinates, uniform 9, buffer[2] its texels.
+ * slice (perspective-correct). uniforms: ClSlice3dUniforms (kernels/slice3d_params.h). buffer[0]
+ * volume values, buffer[1] transfer function (transfer_function.h layout).
+ * With CLVR_SLICE3D_CLIP_TEXTURE: attr[1] clip-texture coordinates, u->clip_tex, buffer[2] its texels.
  * Output: premultiplied (C alpha, alpha), blended by the draw state. */
 int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* color)
 {
-    constant float4* u = r->uniforms;
-    const int4 dims = convert_int4(u[8]);
-    const float3 g = (f->attr[0].xyz - u[6].xyz) * u[7].xyz;
+    constant ClSlice3dUniforms* u = (constant ClSlice3dUniforms*)r->uniforms;
+    const int4 dims = convert_int4(u->dims);
+    const float3 g = (f->attr[0].xyz - u->grid_origin.xyz) * u->inv_spacing.xyz;
     if (!clvr_grid_inside(g, dims))
         return 0;
 #ifdef CLVR_SLICE3D_CLIP_TEXTURE
     /* The second texture (multitexturing): attr[1] = clip-texture coordinates of the slice point;
-     * uniform 9 = (width, height, depth, inverse) of buffer[2], one channel, linear, clamp to edge. */
-    if (!clvr_clip_keep(r->buffer[2], clvr_clip_texture(u[9]), f->attr[1].xyz, (int)u[9].w))
+     * u->clip_tex = (width, height, depth, inverse) of buffer[2], one channel, linear, clamp to edge. */
+    if (!clvr_clip_keep(r->buffer[2], clvr_clip_texture(u->clip_tex), f->attr[1].xyz, (int)u->clip_tex.w))
         return 0;
 #endif
-    const float2 ndc = slice3d_ndc(f->window, (int)u[5].x, (int)u[5].y);
-    const float delta = u[5].z * slice3d_stretch(ndc, u[4]);
-    const float4 ct = clvr_tf_eval(r->buffer[1], (int)u[5].w, clvr_trilinear(r->buffer[0], dims, g));
+    const ClCamera cam = u->camera;
+    const float2 s = clvr_ray_offset(clvr_ray_ndc(f->window, u->frame.xy), cam);
+    const float delta = u->frame.z * clvr_ray_stretch(s, cam);
+    const float4 ct = clvr_tf_eval(r->buffer[1], (int)u->frame.w, clvr_trilinear(r->buffer[0], dims, g));
     const float alpha = 1.0f - exp(-ct.w * delta);
     *color = (float4)(ct.xyz * alpha, alpha);
     return 1;

@@ -1,14 +1,26 @@
-// tests/layout_test.cpp — the shared host/device layouts (kernels/raster_state.h, kernels/texture.h):
-// a kernel writes sizeof/offsetof of every Cl* struct as the device compiles it; the host compares.
+// tests/layout_test.cpp — the shared host/device layouts (kernels/raster_state.h, kernels/texture.h,
+// the kernel parameter structs of kernels/..._params.h and kernels/ray.h): a kernel writes
+// sizeof/offsetof of every Cl* struct as the device compiles it; the host compares.
 #include "raster/fragment_state.h"
 #include "raster/rasterizer.h"
 #include "tests/support/test_util.h"
 
+#include "kernels/blend_params.h"
+#include "kernels/harc_entry_params.h"
+#include "kernels/harc_params.h"
+#include "kernels/iso3d_params.h"
+#include "kernels/planes_params.h"
+#include "kernels/ray.h"
+#include "kernels/slice3d_params.h"
+#include "kernels/spherical_params.h"
+#include "kernels/stack2d_params.h"
 #include "kernels/texture.h"
 
 #include <gtest/gtest.h>
 
 #include <cstddef>
+#include <string>
+#include <vector>
 
 namespace {
 
@@ -47,6 +59,75 @@ TEST(Layout, DeviceAndHostAgreeOnEveryClStruct)
     for (std::size_t i = 0; i < std::size(want); ++i)
         EXPECT_EQ(got[i], want[i].second) << want[i].first << ": device " << got[i] << ", host " << want[i].second;
     EXPECT_EQ(got[std::size(want)], 0xffffffffu) << "the probe wrote more entries than the host checks";
+}
+
+// kernels/params_layout.h on the host: (what, sizeof or offsetof) in the list's order.
+struct LayoutEntry {
+    std::string what;
+    std::size_t bytes;
+};
+
+std::vector<LayoutEntry> hostParamsLayout()
+{
+    return {
+#define CLVR_LAYOUT_SIZE(T) {"sizeof(" #T ")", sizeof(T)},
+#define CLVR_LAYOUT_FIELD(T, f) {"offsetof(" #T ", " #f ")", offsetof(T, f)},
+#include "kernels/params_layout.h"
+#undef CLVR_LAYOUT_SIZE
+#undef CLVR_LAYOUT_FIELD
+    };
+}
+
+TEST(Layout, DeviceAndHostAgreeOnEveryParamsStruct)
+{
+    clvr::Device& device = clvr::test::device();
+    const std::vector<LayoutEntry> want = hostParamsLayout();
+    cl::Kernel k = device.kernel("layout_probe.cl", "params_layout_probe");
+    const std::vector<cl_uint> init(want.size() + 2, 0xffffffffu);
+    cl::Buffer out = device.upload("params layout probe", init, CL_MEM_READ_WRITE);
+    k.setArg(0, out);
+    device.launch("params layout probe", k, 1);
+    const std::vector<cl_uint> got = device.download<cl_uint>(out, init.size());
+    device.takePassTimes();
+
+    ASSERT_EQ(got[0], want.size()) << "entries written by the device";
+    for (std::size_t i = 0; i < want.size(); ++i)
+        EXPECT_EQ(got[i + 1], want[i].bytes) << want[i].what << ": device " << got[i + 1] << ", host " << want[i].bytes;
+    EXPECT_EQ(got[want.size() + 1], 0xffffffffu) << "the probe wrote past its entries";
+}
+
+// Each params struct travels as one by-value argument next to the kernel's buffers: the whole argument
+// list must fit CL_DEVICE_MAX_PARAMETER_SIZE (at least 1024 bytes in OpenCL 1.2; buffers count as
+// pointers).
+TEST(Layout, EveryParamsStructFitsTheKernelArgumentSpace)
+{
+    const std::size_t limit = clvr::test::device().device().getInfo<CL_DEVICE_MAX_PARAMETER_SIZE>();
+    const std::pair<const char*, std::size_t> argumentBytes[] = {
+        {"slice3d_fused", sizeof(ClSlice3dParams) + 7 * sizeof(void*)},
+        {"planes_render", sizeof(ClPlanesParams) + 7 * sizeof(void*)},
+        {"blend_render", sizeof(ClBlendParams) + 6 * sizeof(void*)},
+        {"harc_render", sizeof(ClHarcParams) + 8 * sizeof(void*)},
+        {"spherical_shell", sizeof(ClSphericalParams) + 5 * sizeof(void*)},
+    };
+    for (const auto& [kernel, bytes] : argumentBytes) {
+        EXPECT_LE(bytes, limit) << kernel;
+        EXPECT_LE(bytes, 1024u) << kernel << ": over OpenCL 1.2's guaranteed minimum";
+    }
+    // The sizes the headers document (a field added without its padding shows here first).
+    EXPECT_EQ(sizeof(ClCamera), 80u);
+    EXPECT_EQ(sizeof(ClSlice3dParams), 304u);
+    EXPECT_EQ(sizeof(ClPlanesParams), 224u);
+    EXPECT_EQ(sizeof(ClBlendParams), 208u);
+    EXPECT_EQ(sizeof(ClHarcParams), 160u);
+    EXPECT_EQ(sizeof(ClSphericalParams), 192u);
+    // Fragment-program uniforms: float4s only, within the raster stage's uniform count.
+    EXPECT_EQ(sizeof(ClSlice3dUniforms), 160u);
+    EXPECT_EQ(sizeof(ClIso3dUniforms), 112u);
+    EXPECT_EQ(sizeof(ClHarcEntryUniforms), 96u);
+    EXPECT_EQ(sizeof(ClStack2dUniforms), 368u);
+    for (const std::size_t bytes : {sizeof(ClSlice3dUniforms), sizeof(ClIso3dUniforms), sizeof(ClHarcEntryUniforms),
+                                    sizeof(ClStack2dUniforms)})
+        EXPECT_LE(bytes, CLVR_MAX_UNIFORMS * sizeof(cl_float4));
 }
 
 }  // namespace

@@ -7,7 +7,9 @@
 #include "host/render/options_util.h"
 #include "host/optics/gradient_volume.h"
 #include "host/optics/reflectance_map.h"
-#include "host/render/grid/slice3d.h"  // planSlices, packTransferFunction
+#include "host/render/slice_plan.h"
+#include "host/render/transfer_function_upload.h"
+#include "kernels/blend_params.h"
 
 #include <chrono>
 #include <cmath>
@@ -33,9 +35,8 @@ private:
     glm::dvec3 origin_, spacing_;
     Lighting lighting_;
     SlicePlan plan_;
-    int tfCount_ = 0;
-    std::size_t tfBytes_ = 0;
-    cl::Buffer volume_, tf_, map_, out_, samples_, skipped_;
+    TransferFunctionUpload tf_;
+    cl::Buffer volume_, map_, out_, samples_, skipped_;
     cl::Kernel kernel_;
     std::uint64_t residentBytes_ = 0;
 };
@@ -53,10 +54,8 @@ BlendRenderer::BlendRenderer(Device& device, const Scene& scene, const Volume& v
     camera_.validate();
     if (image_.width < 1 || image_.height < 1)
         throw InputError("image: width and height must be >= 1");
-    Slice3dOptions sliceOptions;  // the same slab planning as slice3d
-    sliceOptions.slices = options_.slices;
-    sliceOptions.sliceSpacing = options_.sliceSpacing;
-    plan_ = planSlices(camera_, volume.boundsMin(), volume.boundsMax(), sliceOptions);
+    // the same slab planning as slice3d
+    plan_ = planSlices(camera_, volume.boundsMin(), volume.boundsMax(), options_.slices, options_.sliceSpacing);
 
     const std::vector<glm::vec4> rgba = sobelGradientVolume(volume);
     volume_ = device_.upload("blend RGBA volume (gradient, value; float32)", rgba);
@@ -74,40 +73,36 @@ BlendRenderer::BlendRenderer(Device& device, const Scene& scene, const Volume& v
 
 void BlendRenderer::setTransferFunction(const TransferFunction& tf)
 {
-    const std::vector<float> packed = packTransferFunction(tf);
-    residentBytes_ -= tfBytes_;
-    tfBytes_ = packed.size() * sizeof(float);
-    residentBytes_ += tfBytes_;
-    tfCount_ = static_cast<int>(tf.points().size());
-    tf_ = device_.upload("blend transfer function", packed);
+    tf_.replace(device_, "blend transfer function", tf, residentBytes_);
 }
 
 Image4f BlendRenderer::render(FrameStats& stats)
 {
     const auto start = std::chrono::steady_clock::now();
+    ClBlendParams params{};
+    params.camera = toClCamera(camera_, image_.width, image_.height);
+    params.dims = cl_int4{{dims_.x, dims_.y, dims_.z, 0}};
+    params.grid_origin = toCl4(origin_);
+    params.inv_spacing = toCl4(1.0 / spacing_);
+    params.to_eye = toCl4(-camera_.forward());
+    params.background = toCl4(image_.background);
+    params.width = image_.width;
+    params.height = image_.height;
+    params.tf_count = tf_.count();
+    params.map_n = options_.reflectanceMapSize;
+    params.shade_on = lighting_.shaded() ? 1 : 0;
+    params.depth0 = static_cast<cl_float>(plan_.depthMin);
+    params.delta_s = static_cast<cl_float>(plan_.deltaS);
+    params.slice_count = plan_.count;
+    params.threshold = static_cast<cl_float>(options_.opacityThreshold);
     int a = 0;
     kernel_.setArg(a++, out_);
     kernel_.setArg(a++, samples_);
     kernel_.setArg(a++, skipped_);
-    kernel_.setArg(a++, static_cast<cl_int>(image_.width));
-    kernel_.setArg(a++, static_cast<cl_int>(image_.height));
     kernel_.setArg(a++, volume_);
-    kernel_.setArg(a++, cl_int4{{dims_.x, dims_.y, dims_.z, 0}});
-    kernel_.setArg(a++, toCl4(origin_));
-    kernel_.setArg(a++, toCl4(1.0 / spacing_));
-    kernel_.setArg(a++, tf_);
-    kernel_.setArg(a++, static_cast<cl_int>(tfCount_));
+    kernel_.setArg(a++, tf_.buffer());
     kernel_.setArg(a++, map_);
-    kernel_.setArg(a++, static_cast<cl_int>(options_.reflectanceMapSize));
-    kernel_.setArg(a++, static_cast<cl_int>(lighting_.shaded() ? 1 : 0));
-    kernel_.setArg(a++, toCl4(-camera_.forward()));
-    a = setCameraArgs(kernel_, a, camera_, image_.width, image_.height);
-    kernel_.setArg(a++, static_cast<cl_float>(plan_.depthMin));
-    kernel_.setArg(a++, static_cast<cl_float>(plan_.deltaS));
-    kernel_.setArg(a++, static_cast<cl_int>(plan_.count));
-    kernel_.setArg(a++, static_cast<cl_float>(options_.opacityThreshold));
-    kernel_.setArg(a++, cl_float4{{static_cast<float>(image_.background.r), static_cast<float>(image_.background.g),
-                                   static_cast<float>(image_.background.b), 0.0f}});
+    kernel_.setArg(a++, params);
     device_.launch("blend: shade slices, blend back to front", kernel_, image_.width, image_.height);
 
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;

@@ -7,7 +7,9 @@
 #include "host/runtime/errors.h"
 #include "host/render/options_util.h"
 #include "host/optics/gradient_volume.h"
-#include "host/render/grid/slice3d.h"  // planSlices, slicePolygon: the same slices as slice3d
+#include "host/render/fragment_uniforms.h"
+#include "host/render/slice_plan.h"  // planSlices, slicePolygon: the same slices as slice3d
+#include "kernels/iso3d_params.h"
 #include "raster/framebuffer.h"
 #include "raster/pixel_transfer.h"
 #include "raster/rasterizer.h"
@@ -48,6 +50,7 @@ private:
     std::uint64_t residentBytes_ = 0;
     std::unique_ptr<raster::Framebuffer> framebuffer_;
     raster::FragmentProgram fragmentProgram_;
+    ClIso3dUniforms fragmentUniforms_{};
     cl::Kernel finish_;
     // Gradientless shading: the scalar volume as a 3D texture (texel centers at the grid points) and
     // the shift Delta L in texture coordinates.
@@ -81,10 +84,7 @@ Iso3dRendererImpl::Iso3dRendererImpl(Device& device, const Scene& scene, const V
     iso_ = isoSurface(scene, camera_);
     if (image_.width < 1 || image_.height < 1)
         throw InputError("image: width and height must be >= 1");
-    Slice3dOptions sliceOptions;
-    sliceOptions.slices = options_.slices;
-    sliceOptions.sliceSpacing = options_.sliceSpacing;
-    plan_ = planSlices(camera_, lo_, hi_, sliceOptions);
+    plan_ = planSlices(camera_, lo_, hi_, options_.slices, options_.sliceSpacing);
 
     origin_ = volume.origin;
     spacing_ = volume.spacing;
@@ -155,15 +155,16 @@ Iso3dRendererImpl::Iso3dRendererImpl(Device& device, const Scene& scene, const V
     if (options_.interior && gradientless)
         badOption("interior", "works with \"gradient\" or \"none\" shading (the gradientless difference would need its "
                               "sign turned per pixel), and iso.shading is \"gradientless\"");
-    fragmentProgram_.uniforms = {
-        glm::vec4(glm::vec3(volume.origin), 0.0f),
-        glm::vec4(glm::vec3(1.0 / volume.spacing), 0.0f),
-        glm::vec4(volume.dims.x, volume.dims.y, volume.dims.z, 0.0f),
-        glm::vec4(valueLo, scale, gradientless ? 1.0f : 0.0f, 0.0f),
-        glm::vec4(0.0f),                                                   // the brick's first grid point ...
-        glm::vec4(volume.dims.x, volume.dims.y, volume.dims.z, 0.0f),      // ... the end of its box ...
-        glm::vec4(volume.dims.x, volume.dims.y, volume.dims.z, 0.0f),      // ... its dims: unbricked, all
-    };
+    const cl_float4 dims{{static_cast<float>(volume.dims.x), static_cast<float>(volume.dims.y),
+                          static_cast<float>(volume.dims.z), 0.0f}};
+    fragmentUniforms_.grid_origin = toCl4(volume.origin);
+    fragmentUniforms_.inv_spacing = toCl4(1.0 / volume.spacing);
+    fragmentUniforms_.dims = dims;
+    fragmentUniforms_.value_map = cl_float4{{valueLo, scale, gradientless ? 1.0f : 0.0f, 0.0f}};
+    fragmentUniforms_.brick_lo = cl_float4{{0.0f, 0.0f, 0.0f, 0.0f}};  // the brick's first grid point ...
+    fragmentUniforms_.brick_end = dims;                               // ... the end of its box ...
+    fragmentUniforms_.brick_dims = dims;                              // ... its dims: unbricked, all
+    fragmentProgram_.uniforms = fragmentUniforms(fragmentUniforms_);
     if (gradientless) {
         raster::TextureDesc desc;
         desc.width = volume.dims.x;
@@ -294,7 +295,9 @@ Image4f Iso3dRendererImpl::render(FrameStats& stats)
         interior.fragment.alpha.func = raster::CompareFunc::Less;
         interior.fragment.stencil.ref = 1;
         raster::FragmentProgram flipped = fragmentProgram_;
-        flipped.uniforms[3].w = 1.0f;
+        ClIso3dUniforms flip = fragmentUniforms_;
+        flip.value_map.s[3] = 1.0f;
+        flipped.uniforms = fragmentUniforms(flip);
         const raster::DrawStats d =
             raster::draw(device_, *framebuffer_, interior, raster::Topology::Triangles, vertices, flipped);
         drawStats.fragments += d.fragments;
@@ -373,6 +376,7 @@ raster::DrawStats Iso3dRendererImpl::drawBricks(const raster::DrawState& unbrick
     std::uint64_t uploads = 0, uploadBytes = 0;
     double uploadMs = 0.0;
     raster::FragmentProgram program = fragmentProgram_;
+    ClIso3dUniforms brick = fragmentUniforms_;
     for (const glm::ivec3& b : brickOrder(bricks_, camera_, origin_, spacing_)) {
         const glm::ivec3 lo = bricks_.lo(b), hi = bricks_.hi(b), n = bricks_.dims(b);
         const glm::dvec3 boxLo = origin_ + glm::dvec3(lo) * spacing_, boxHi = origin_ + glm::dvec3(hi) * spacing_;
@@ -424,9 +428,10 @@ raster::DrawStats Iso3dRendererImpl::drawBricks(const raster::DrawState& unbrick
         // Upper ends of the brick's half-open box in grid units; the last slab of an axis keeps its far face.
         const glm::vec4 end(hi.x == dims_.x - 1 ? dims_.x : hi.x, hi.y == dims_.y - 1 ? dims_.y : hi.y,
                             hi.z == dims_.z - 1 ? dims_.z : hi.z, 0.0f);
-        program.uniforms[4] = glm::vec4(lo.x, lo.y, lo.z, 0.0f);
-        program.uniforms[5] = end;
-        program.uniforms[6] = glm::vec4(n.x, n.y, n.z, 0.0f);
+        brick.brick_lo = cl_float4{{static_cast<float>(lo.x), static_cast<float>(lo.y), static_cast<float>(lo.z), 0.0f}};
+        brick.brick_end = cl_float4{{end.x, end.y, end.z, end.w}};
+        brick.brick_dims = cl_float4{{static_cast<float>(n.x), static_cast<float>(n.y), static_cast<float>(n.z), 0.0f}};
+        program.uniforms = fragmentUniforms(brick);
         const std::vector<raster::Vertex> part(vertices.begin() + static_cast<std::ptrdiff_t>(sliceFirst[kLo]),
                                                vertices.begin() + static_cast<std::ptrdiff_t>(sliceFirst[kHi + 1]));
         const raster::DrawStats d =

@@ -7,7 +7,8 @@
 #include "host/render/options_util.h"
 #include "host/optics/gradient_volume.h"
 #include "host/optics/reflectance_map.h"
-#include "host/render/grid/slice3d.h"  // packTransferFunction: the layout kernels/transfer_function.h reads
+#include "host/render/transfer_function_upload.h"
+#include "kernels/planes_params.h"
 
 #include <algorithm>
 #include <chrono>
@@ -35,10 +36,9 @@ private:
     glm::dvec3 origin_, spacing_, lo_, hi_;
     Lighting lighting_;
     glm::dvec3 toEye_;
-    int tfCount_ = 0;
-    std::size_t tfBytes_ = 0;
+    TransferFunctionUpload tf_;
     double gradientMs_ = 0.0, mapMs_ = 0.0;
-    cl::Buffer volume_, tf_, map_;
+    cl::Buffer volume_, map_;
     cl::Buffer out_, samples_, skipped_, terminated_;
     cl::Kernel kernel_;
     std::uint64_t residentBytes_ = 0;
@@ -93,41 +93,38 @@ PlanesRenderer::PlanesRenderer(Device& device, const Scene& scene, const Volume&
 void PlanesRenderer::setTransferFunction(const TransferFunction& tf)
 {
     // Classification happens per sample on the device: only the control points change.
-    const std::vector<float> packed = packTransferFunction(tf);
-    residentBytes_ -= tfBytes_;
-    tfBytes_ = packed.size() * sizeof(float);
-    residentBytes_ += tfBytes_;
-    tfCount_ = static_cast<int>(tf.points().size());
-    tf_ = device_.upload("planes transfer function", packed);
+    tf_.replace(device_, "planes transfer function", tf, residentBytes_);
 }
 
 Image4f PlanesRenderer::render(FrameStats& stats)
 {
     const auto start = std::chrono::steady_clock::now();
+    ClPlanesParams params{};
+    params.camera = toClCamera(camera_, image_.width, image_.height);
+    params.dims = cl_int4{{dims_.x, dims_.y, dims_.z, 0}};
+    params.grid_origin = toCl4(origin_);
+    params.inv_spacing = toCl4(1.0 / spacing_);
+    params.box_lo = toCl4(lo_);
+    params.box_hi = toCl4(hi_);
+    params.to_eye = toCl4(toEye_);
+    params.background = toCl4(image_.background);
+    params.width = image_.width;
+    params.height = image_.height;
+    params.tf_count = tf_.count();
+    params.map_n = options_.reflectanceMapSize;
+    params.shade_on = lighting_.shaded() ? 1 : 0;
+    params.step = static_cast<cl_float>(options_.sampleSpacing);
+    params.ert_alpha = static_cast<cl_float>(options_.earlyTermination);
+    params.threshold = static_cast<cl_float>(options_.opacityThreshold);
     int a = 0;
     kernel_.setArg(a++, out_);
     kernel_.setArg(a++, samples_);
     kernel_.setArg(a++, skipped_);
     kernel_.setArg(a++, terminated_);
-    kernel_.setArg(a++, static_cast<cl_int>(image_.width));
-    kernel_.setArg(a++, static_cast<cl_int>(image_.height));
     kernel_.setArg(a++, volume_);
-    kernel_.setArg(a++, cl_int4{{dims_.x, dims_.y, dims_.z, 0}});
-    kernel_.setArg(a++, toCl4(origin_));
-    kernel_.setArg(a++, toCl4(1.0 / spacing_));
-    kernel_.setArg(a++, toCl4(lo_));
-    kernel_.setArg(a++, toCl4(hi_));
-    kernel_.setArg(a++, tf_);
-    kernel_.setArg(a++, static_cast<cl_int>(tfCount_));
+    kernel_.setArg(a++, tf_.buffer());
     kernel_.setArg(a++, map_);
-    kernel_.setArg(a++, static_cast<cl_int>(options_.reflectanceMapSize));
-    kernel_.setArg(a++, static_cast<cl_int>(lighting_.shaded() ? 1 : 0));
-    kernel_.setArg(a++, toCl4(toEye_));
-    a = setCameraArgs(kernel_, a, camera_, image_.width, image_.height);
-    kernel_.setArg(a++, static_cast<cl_float>(options_.sampleSpacing));
-    kernel_.setArg(a++, static_cast<cl_float>(options_.earlyTermination));
-    kernel_.setArg(a++, static_cast<cl_float>(options_.opacityThreshold));
-    kernel_.setArg(a++, toCl4(image_.background));
+    kernel_.setArg(a++, params);
     device_.launch("planes: cast, shade, composite", kernel_, image_.width, image_.height);
 
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;

@@ -6,7 +6,10 @@
 #include "host/runtime/embedded_kernels.h"
 #include "host/runtime/errors.h"
 #include "host/render/camera_args.h"
+#include "host/render/fragment_uniforms.h"
 #include "host/render/options_util.h"
+#include "host/render/transfer_function_upload.h"
+#include "kernels/slice3d_params.h"
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
 #include "raster/texture.h"
@@ -41,9 +44,9 @@ private:
     ImageSpec image_;
     glm::ivec3 dims_;
     glm::dvec3 origin_, spacing_, lo_, hi_;
-    int tfCount_ = 0;
+    TransferFunctionUpload tf_;
     SlicePlan plan_;
-    cl::Buffer volume_, tf_;
+    cl::Buffer volume_;
     std::uint64_t residentBytes_ = 0;
     // Empty-space skipping (fused path).
     glm::ivec3 brickDims_{0};
@@ -58,6 +61,7 @@ private:
     // Pass-by-pass path.
     std::unique_ptr<raster::Framebuffer> framebuffer_;
     raster::FragmentProgram fragmentProgram_;
+    ClSlice3dUniforms fragmentUniforms_{};
     cl::Kernel overBackground_;
     // Clipping (raster path): the closed mesh and its farthest eye depth.
     std::optional<ClipMesh> clipMesh_;
@@ -122,10 +126,8 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
         volume_ = device_.upload("slice3d volume (float32)", volume.values);
         residentBytes_ = volume.values.size() * sizeof(float);
     }
-    const std::vector<float> tf = packTransferFunction(scene.transferFunction);
-    tfCount_ = static_cast<int>(scene.transferFunction.points().size());
-    tf_ = device_.upload("slice3d transfer function", tf);
-    residentBytes_ += tf.size() * sizeof(float);
+    tf_.upload(device_, "slice3d transfer function", scene.transferFunction);
+    residentBytes_ += tf_.bytes();
 
     if (clipTexture_) {
         clipTexels_ = std::make_unique<raster::Texture>(device_, clipTexture_->desc, clipTexture_->texels);
@@ -159,22 +161,22 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
         fragmentProgram_.source = std::string("#define CLVR_SLICE3D_FRAGMENT 1\n") +
                                   (clipTexture_ ? "#define CLVR_SLICE3D_CLIP_TEXTURE 1\n" : "") + std::string(source);
         fragmentProgram_.buffers[0] = volume_;
-        fragmentProgram_.buffers[1] = tf_;
+        fragmentProgram_.buffers[1] = tf_.buffer();
         const glm::dvec3 invSpacing = 1.0 / spacing_;
-        const std::array<glm::vec4, 5> cameraUniforms = cameraVectors(camera_, image_.width, image_.height);
-        fragmentProgram_.uniforms = {
-            cameraUniforms[0], cameraUniforms[1], cameraUniforms[2], cameraUniforms[3], cameraUniforms[4],
-            glm::vec4(image_.width, image_.height, static_cast<float>(plan_.deltaS), tfCount_),
-            glm::vec4(glm::vec3(origin_), 0.0f),
-            glm::vec4(glm::vec3(invSpacing), 0.0f),
-            glm::vec4(dims_.x, dims_.y, dims_.z, 0.0f),
-        };
-        if (clipTexture_) {  // the second texture: buffer 2, uniform 9, coordinates in attribute 1
+        fragmentUniforms_.camera = toClCamera(camera_, image_.width, image_.height);
+        fragmentUniforms_.frame = cl_float4{{static_cast<float>(image_.width), static_cast<float>(image_.height),
+                                             static_cast<float>(plan_.deltaS), static_cast<float>(tf_.count())}};
+        fragmentUniforms_.grid_origin = toCl4(origin_);
+        fragmentUniforms_.inv_spacing = toCl4(invSpacing);
+        fragmentUniforms_.dims = cl_float4{{static_cast<float>(dims_.x), static_cast<float>(dims_.y),
+                                            static_cast<float>(dims_.z), 0.0f}};
+        if (clipTexture_) {  // the second texture: buffer 2, u->clip_tex, coordinates in attribute 1
             fragmentProgram_.buffers[2] = clipTexels_->buffer();
             const glm::ivec3 n = clipTexture_->dims();
-            fragmentProgram_.uniforms.push_back(
-                glm::vec4(n.x, n.y, n.z, options_.clipTexture->inverse ? 1.0f : 0.0f));
+            fragmentUniforms_.clip_tex = cl_float4{{static_cast<float>(n.x), static_cast<float>(n.y),
+                                                    static_cast<float>(n.z), options_.clipTexture->inverse ? 1.0f : 0.0f}};
         }
+        fragmentProgram_.uniforms = fragmentUniforms(fragmentUniforms_);
     }
 }
 
@@ -214,11 +216,7 @@ Image4f Slice3dRenderer::render(FrameStats& stats)
 
 void Slice3dRenderer::setTransferFunction(const TransferFunction& tf)
 {
-    const std::vector<float> packed = packTransferFunction(tf);
-    residentBytes_ -= static_cast<std::uint64_t>(((tfCount_ + 3) / 4 * 4 + 8 * tfCount_) * sizeof(float));
-    tfCount_ = static_cast<int>(tf.points().size());
-    tf_ = device_.upload("slice3d transfer function", packed);
-    residentBytes_ += packed.size() * sizeof(float);
+    tf_.replace(device_, "slice3d transfer function", tf, residentBytes_);
     if (options_.path == Slice3dOptions::Path::Fused) {
         // Which bricks are empty depends on the transfer function: classify the kept min-max grid again.
         const auto t0 = std::chrono::steady_clock::now();
@@ -228,8 +226,9 @@ void Slice3dRenderer::setTransferFunction(const TransferFunction& tf)
         emptyBrickCount_ = static_cast<std::uint64_t>(std::count(flags.begin(), flags.end(), cl_uchar(1)));
         device_.queue().enqueueWriteBuffer(emptyBricks_, CL_TRUE, 0, radii.size(), radii.data());
     } else {
-        fragmentProgram_.buffers[1] = tf_;
-        fragmentProgram_.uniforms[5].w = static_cast<float>(tfCount_);
+        fragmentProgram_.buffers[1] = tf_.buffer();
+        fragmentUniforms_.frame.s[3] = static_cast<float>(tf_.count());
+        fragmentProgram_.uniforms = fragmentUniforms(fragmentUniforms_);
     }
 }
 
@@ -239,38 +238,40 @@ Image4f Slice3dRenderer::renderFused(FrameStats& stats)
     const bool frontToBack = options_.order == Slice3dOptions::Order::FrontToBack;
     // ERT threshold 1.0 means off: pass a value accumulated opacity can never reach.
     const float ert = options_.earlyTermination < 1.0 ? static_cast<float>(options_.earlyTermination) : 2.0f;
+    // Off when asked, or when no brick is empty (then the loop is the plain one).
+    const bool skip = options_.emptySpaceSkipping && emptyBrickCount_ > 0;
+    ClSlice3dParams params{};
+    params.camera = toClCamera(camera_, image_.width, image_.height);
+    params.dims = cl_int4{{dims_.x, dims_.y, dims_.z, 0}};
+    params.grid_origin = toCl4(origin_);
+    params.inv_spacing = toCl4(invSpacing);
+    params.brick_dims = cl_int4{{brickDims_.x, brickDims_.y, brickDims_.z, 0}};
+    params.background = toCl4(image_.background, 0.0);
+    params.width = image_.width;
+    params.height = image_.height;
+    params.tf_count = tf_.count();
+    params.skip = skip ? 1 : 0;
+    params.depth0 = static_cast<cl_float>(plan_.depth(0));
+    params.delta_s = static_cast<cl_float>(plan_.deltaS);
+    params.slice_count = plan_.count;
+    params.front_to_back = frontToBack ? 1 : 0;
+    params.ert_alpha = ert;
     int a = 0;
     fused_.setArg(a++, out_);
     fused_.setArg(a++, samples_);
     fused_.setArg(a++, skipped_);
-    fused_.setArg(a++, static_cast<cl_int>(image_.width));
-    fused_.setArg(a++, static_cast<cl_int>(image_.height));
     fused_.setArg(a++, volume_);
-    fused_.setArg(a++, cl_int4{{dims_.x, dims_.y, dims_.z, 0}});
-    fused_.setArg(a++, toCl4(origin_));
-    fused_.setArg(a++, toCl4(invSpacing));
-    fused_.setArg(a++, tf_);
-    fused_.setArg(a++, static_cast<cl_int>(tfCount_));
+    fused_.setArg(a++, tf_.buffer());
     fused_.setArg(a++, emptyBricks_);
-    fused_.setArg(a++, cl_int4{{brickDims_.x, brickDims_.y, brickDims_.z, 0}});
-    // Off when asked, or when no brick is empty (then the loop is the plain one).
-    const bool skip = options_.emptySpaceSkipping && emptyBrickCount_ > 0;
-    fused_.setArg(a++, static_cast<cl_int>(skip ? 1 : 0));
-    a = setCameraArgs(fused_, a, camera_, image_.width, image_.height);
-    fused_.setArg(a++, static_cast<cl_float>(plan_.depth(0)));
-    fused_.setArg(a++, static_cast<cl_float>(plan_.deltaS));
-    fused_.setArg(a++, static_cast<cl_int>(plan_.count));
-    fused_.setArg(a++, static_cast<cl_int>(frontToBack ? 1 : 0));
-    fused_.setArg(a++, static_cast<cl_float>(ert));
-    fused_.setArg(a++, toCl4(image_.background, 0.0));
     if (clipTexture_) {
         fused_.setArg(a++, clipTexels_->buffer());
-        fused_.setArg(a++, clipTexels_->toCl());
+        params.clip_tex = clipTexels_->toCl();
         for (int r = 0; r < 3; ++r)  // rows of the affine world -> texture coordinates map
-            fused_.setArg(a++, toCl4(glm::dvec3(clipCoordinates_[0][r], clipCoordinates_[1][r], clipCoordinates_[2][r]),
-                                     clipCoordinates_[3][r]));
-        fused_.setArg(a++, static_cast<cl_int>(options_.clipTexture->inverse ? 1 : 0));
+            params.clip_row[r] = toCl4(glm::dvec3(clipCoordinates_[0][r], clipCoordinates_[1][r], clipCoordinates_[2][r]),
+                                       clipCoordinates_[3][r]);
+        params.clip_inverse = options_.clipTexture->inverse ? 1 : 0;
     }
+    fused_.setArg(a++, params);
     device_.launch("slice3d: fused", fused_, image_.width, image_.height);
 
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
@@ -559,77 +560,7 @@ Slice3dOptions parseSlice3dOptions(const nlohmann::json& options)
 
 SlicePlan planSlices(const Camera& camera, const glm::dvec3& lo, const glm::dvec3& hi, const Slice3dOptions& options)
 {
-    const glm::dvec3 forward = camera.forward();
-    double dMin = std::numeric_limits<double>::infinity(), dMax = -dMin;
-    for (int c = 0; c < 8; ++c) {
-        const glm::dvec3 corner((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
-        const double d = glm::dot(forward, corner - camera.position);
-        dMin = std::min(dMin, d);
-        dMax = std::max(dMax, d);
-    }
-    SlicePlan plan;
-    plan.depthMin = std::max(dMin, 0.0);
-    plan.depthMax = dMax;
-    const double range = dMax - plan.depthMin;
-    if (!(range > 0.0))
-        return plan;  // behind the camera: no slices
-    if (options.sliceSpacing > 0.0) {
-        const double n = std::ceil(range / options.sliceSpacing);
-        if (n > kMaxSlices)
-            badOption("slice_spacing", std::to_string(options.sliceSpacing) + " gives " + std::to_string(n) +
-                                           " slices for this view, more than " + std::to_string(kMaxSlices));
-        plan.count = std::max(1, static_cast<int>(n));
-        plan.deltaS = options.sliceSpacing;
-    } else {
-        plan.count = options.slices;
-        plan.deltaS = range / options.slices;
-    }
-    return plan;
-}
-
-std::vector<glm::dvec3> slicePolygon(const glm::dvec3& lo, const glm::dvec3& hi, const glm::dvec3& normal,
-                                     double offset)
-{
-    std::vector<glm::dvec3> points;
-    auto corner = [&](int c) {
-        return glm::dvec3((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
-    };
-    const double scale = glm::length(hi - lo);
-    const double eps = 1e-12 * (scale + std::abs(offset));
-    // The 12 edges: corner pairs differing in one bit.
-    for (int c = 0; c < 8; ++c)
-        for (int bit = 1; bit < 8; bit <<= 1) {
-            if (c & bit)
-                continue;
-            const glm::dvec3 a = corner(c), b = corner(c | bit);
-            const double da = glm::dot(normal, a) - offset, db = glm::dot(normal, b) - offset;
-            if ((da > eps && db > eps) || (da < -eps && db < -eps))
-                continue;
-            glm::dvec3 p;
-            if (std::abs(da - db) <= eps)  // edge in the plane: both ends
-                continue;                  // (its ends are found by the adjacent edges)
-            p = a + (b - a) * glm::clamp(da / (da - db), 0.0, 1.0);
-            bool duplicate = false;
-            for (const glm::dvec3& q : points)
-                duplicate = duplicate || glm::length(p - q) <= 1e-9 * scale;
-            if (!duplicate)
-                points.push_back(p);
-        }
-    if (points.size() < 3)
-        return {};
-    glm::dvec3 centroid(0.0);
-    for (const glm::dvec3& p : points)
-        centroid += p;
-    centroid /= static_cast<double>(points.size());
-    // Plane basis (u, v) with u x v = normal.
-    const glm::dvec3 helper = std::abs(normal.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
-    const glm::dvec3 u = glm::normalize(glm::cross(helper, normal));
-    const glm::dvec3 v = glm::cross(normal, u);
-    std::sort(points.begin(), points.end(), [&](const glm::dvec3& a, const glm::dvec3& b) {
-        return std::atan2(glm::dot(a - centroid, v), glm::dot(a - centroid, u)) <
-               std::atan2(glm::dot(b - centroid, v), glm::dot(b - centroid, u));
-    });
-    return points;
+    return planSlices(camera, lo, hi, options.slices, options.sliceSpacing);
 }
 
 BrickGrid buildBrickGrid(const Volume& volume)
@@ -730,24 +661,6 @@ std::vector<cl_uchar> emptySpaceRadii(const glm::ivec3& brickDims, const std::ve
         space.swap(next);
     }
     return space;
-}
-
-std::vector<float> packTransferFunction(const TransferFunction& tf)
-{
-    const auto& points = tf.points();
-    const std::size_t n = points.size(), m = (n + 3) / 4 * 4;
-    std::vector<float> out(m + 8 * n, 0.0f);
-    auto value = [&](std::size_t i) { return glm::dvec4(points[i].color, points[i].tau); };
-    for (std::size_t i = 0; i < n; ++i) {
-        out[i] = static_cast<float>(points[i].s);
-        const glm::dvec4 slope =
-            i + 1 < n ? (value(i + 1) - value(i)) / (points[i + 1].s - points[i].s) : glm::dvec4(0.0);
-        for (int c = 0; c < 4; ++c) {
-            out[m + 4 * i + c] = static_cast<float>(value(i)[c]);
-            out[m + 4 * n + 4 * i + c] = static_cast<float>(slope[c]);
-        }
-    }
-    return out;
 }
 
 std::unique_ptr<Renderer> makeSlice3dRenderer(Device& device, const Scene& scene, const Volume& volume)

@@ -8,6 +8,7 @@
 #include "host/optics/clip_mesh.h"
 #include "host/optics/clip_texture.h"
 #include "host/render/renderer.h"
+#include "host/render/slice_plan.h"
 
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
@@ -50,25 +51,9 @@ TechniqueInfo slice3dTechnique();
 // for unknown keys, wrong types and values out of range.
 Slice3dOptions parseSlice3dOptions(const nlohmann::json& options);
 
-// Slice k (0 = nearest) lies on the plane dot(forward, p - position) = depthMin + (k + 0.5) * deltaS.
-struct SlicePlan {
-    double depthMin = 0.0;  // eye depth where the slab of slices begins (>= 0: nothing behind the camera)
-    double depthMax = 0.0;  // eye depth of the box's farthest corner
-    double deltaS = 0.0;    // slice spacing along forward, world units
-    int count = 0;          // 0 when the box is entirely behind the camera
-    double depth(int k) const { return depthMin + (k + 0.5) * deltaS; }
-};
-
-// Slices over the eye-depth range of the box [lo, hi] (its 8 corners, clipped at depth 0): `slices`
-// equal slabs, or slabs of `sliceSpacing` (count = ceil(range / spacing); InputError if > 65536).
+// Slices over the eye-depth range of the box [lo, hi] as options.slices and options.sliceSpacing ask
+// (planSlices of host/render/slice_plan.h).
 SlicePlan planSlices(const Camera& camera, const glm::dvec3& lo, const glm::dvec3& hi, const Slice3dOptions& options);
-
-// The cross-section of the box [lo, hi] with the plane dot(normal, p) = offset (normal unit length):
-// the plane cut with the 12 box edges, duplicates (plane through a corner) merged, 3 to 6 vertices
-// ordered by angle about their centroid in a plane basis (u, v) with u x v = normal. Empty when the
-// plane misses the box or only touches it in fewer than 3 distinct points.
-std::vector<glm::dvec3> slicePolygon(const glm::dvec3& lo, const glm::dvec3& hi, const glm::dvec3& normal,
-                                     double offset);
 
 // Empty-space skipping (docs/slice3d.md): bricks of B^3 cells, B = kBrickCells (= 2^SLICE3D_BRICK_SHIFT
 // in kernels/slice3d.cl; 4 measured faster than 8 on the engine); brick b covers the grid points
@@ -94,9 +79,6 @@ std::vector<cl_uchar> emptyBricks(const BrickGrid& grid, const TransferFunction&
 // r + 1 where every brick within Chebyshev distance r is empty (bricks outside the grid count as
 // empty), capped at 255; the kernel steps over that cube in one run.
 std::vector<cl_uchar> emptySpaceRadii(const glm::ivec3& brickDims, const std::vector<cl_uchar>& empty);
-
-// The transfer function as kernels/transfer_function.h lays it out.
-std::vector<float> packTransferFunction(const TransferFunction& tf);
 
 // Renderer for "slice3d". Uploads the volume as float32 (4 bytes per grid point) and the packed
 // transfer function; throws InputError for bad options and DeviceError when the volume does not fit.

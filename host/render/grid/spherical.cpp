@@ -3,8 +3,10 @@
 #include "host/render/grid/spherical.h"
 
 #include "host/runtime/errors.h"
+#include "host/render/camera_args.h"
 #include "host/render/options_util.h"
-#include "host/render/grid/slice3d.h"  // packTransferFunction
+#include "host/render/transfer_function_upload.h"
+#include "kernels/spherical_params.h"
 #include "raster/framebuffer.h"
 #include "raster/texture.h"
 
@@ -253,12 +255,7 @@ void SphericalRenderer::setTransferFunction(const TransferFunction& tf)
 {
     if (tf.points().empty())
         throw InputError("transfer_function: technique spherical needs one");
-    const std::vector<float> packed = packTransferFunction(tf);
-    residentBytes_ -= tfBytes_;
-    tfBytes_ = packed.size() * sizeof(float);
-    residentBytes_ += tfBytes_;
-    tf_ = device_.upload("spherical transfer function", packed);
-    tfCount_ = static_cast<int>(tf.points().size());
+    tf_.replace(device_, "spherical transfer function", tf, residentBytes_);
 }
 
 void SphericalRenderer::renderPass(std::size_t shellIndex, bool back)
@@ -289,31 +286,27 @@ void SphericalRenderer::renderPass(std::size_t shellIndex, bool back)
     raster::applyPixelTransfer(device_, *coords_, texturedTransfer_);
 
     // 3. Pixel texture, classification, slab opacity, blend (kernels/spherical.cl).
-    const double aspect = static_cast<double>(imageSpec_.width) / imageSpec_.height;
-    const double scale = camera_.parallel ? camera_.parallelScale : std::tan(glm::radians(camera_.viewAngle) * 0.5);
-    const cl_float2 phiWrap{{0.5f / dims_.x, (dims_.x - 1.0f) / dims_.x}};
     const bool radial = options_.opacity == SphericalOptions::Opacity::Radial;
+    ClSphericalParams params{};
+    params.camera = toClCamera(camera_, imageSpec_.width, imageSpec_.height);
+    params.tex = texture_->toCl();
+    // center.w: the next inner sphere's radius (-1: none), see clvr_spherical_slab_length.
+    params.center = f4(d.center, shellIndex > 0 ? shells_[shellIndex - 1].radius : -1.0);
+    params.slab = cl_float4{{static_cast<float>(shell.rLo), static_cast<float>(shell.rHi), back ? 1.0f : -1.0f,
+                             radial ? 1.0f : 0.0f}};
+    params.width = imageSpec_.width;
+    params.height = imageSpec_.height;
+    params.tf_count = tf_.count();
+    params.phi_s0 = 0.5f / dims_.x;
+    params.phi_period = (dims_.x - 1.0f) / dims_.x;
     cl::Kernel& k = shellKernel_;
     int a = 0;
     k.setArg(a++, coords_->color());
     k.setArg(a++, coords_->stencil());
     k.setArg(a++, image_->color());
-    k.setArg(a++, static_cast<cl_int>(imageSpec_.width));
-    k.setArg(a++, static_cast<cl_int>(imageSpec_.height));
     k.setArg(a++, texture_->buffer());
-    k.setArg(a++, texture_->toCl());
-    k.setArg(a++, phiWrap);
-    k.setArg(a++, tf_);
-    k.setArg(a++, static_cast<cl_int>(tfCount_));
-    k.setArg(a++, f4(camera_.position));
-    k.setArg(a++, f4(camera_.forward()));
-    k.setArg(a++, f4(camera_.right()));
-    k.setArg(a++, f4(camera_.up()));
-    k.setArg(a++, cl_float4{{static_cast<float>(scale), static_cast<float>(aspect), camera_.parallel ? 1.0f : 0.0f, 0.0f}});
-    // center.w: the next inner sphere's radius (-1: none), see clvr_spherical_slab_length.
-    k.setArg(a++, f4(d.center, shellIndex > 0 ? shells_[shellIndex - 1].radius : -1.0));
-    k.setArg(a++, cl_float4{{static_cast<float>(shell.rLo), static_cast<float>(shell.rHi), back ? 1.0f : -1.0f,
-                             radial ? 1.0f : 0.0f}});
+    k.setArg(a++, tf_.buffer());
+    k.setArg(a++, params);
     device_.launch("spherical: pixel texture, classify, blend", k, static_cast<std::size_t>(imageSpec_.width),
                    static_cast<std::size_t>(imageSpec_.height));
 }

@@ -11,6 +11,7 @@
 
 #include "host/model/camera.h"
 #include "host/render/renderer.h"
+#include "host/render/transfer_function_upload.h"
 #include "raster/pixel_transfer.h"
 #include "raster/rasterizer.h"
 
@@ -100,9 +101,8 @@ private:
     std::vector<Shell> shells_;
     raster::PixelTransfer texturedTransfer_;
     std::unique_ptr<raster::Texture> texture_;
-    cl::Buffer tf_;
-    int tfCount_ = 0;
-    std::uint64_t tfBytes_ = 0, residentBytes_ = 0;
+    TransferFunctionUpload tf_;
+    std::uint64_t residentBytes_ = 0;
     std::unique_ptr<raster::Framebuffer> coords_, image_;
     glm::dmat4 viewProjection_{1.0};
     cl::Kernel shellKernel_, overBackground_;

@@ -6,10 +6,12 @@
 #include "host/runtime/embedded_kernels.h"
 #include "host/runtime/errors.h"
 #include "host/render/camera_args.h"
+#include "host/render/fragment_uniforms.h"
 #include "host/render/options_util.h"
 #include "host/optics/gradient_volume.h"
 #include "host/optics/reflectance_map.h"
-#include "host/render/grid/slice3d.h"  // packTransferFunction
+#include "host/render/transfer_function_upload.h"
+#include "kernels/stack2d_params.h"
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
 #include "raster/texture.h"
@@ -24,6 +26,11 @@
 
 namespace clvr {
 namespace {
+
+cl_float4 cl4(float x, float y, float z, float w)
+{
+    return cl_float4{{x, y, z, w}};
+}
 
 // The most intermediate slices per stack interval; 64 already samples far finer than the data.
 constexpr int kMaxIntermediate = 64;
@@ -95,11 +102,12 @@ private:
     std::optional<ClipTexture> clipTexture_;
     glm::dmat4 clipCoordinates_{1.0};
     std::vector<raster::Texture> stacks_;  // x, y, z: all three stay resident, as on the paper's boards
-    cl::Buffer tf_, map_;
-    std::size_t tfBytes_ = 0;
+    TransferFunctionUpload tf_;
+    cl::Buffer map_;
     std::uint64_t residentBytes_ = 0;
     std::unique_ptr<raster::Framebuffer> framebuffer_;
     raster::FragmentProgram fragmentProgram_;
+    ClStack2dUniforms uniforms_{};  // fragmentProgram_.uniforms, by field
     cl::Kernel overBackground_, isoFinish_;
 };
 
@@ -177,27 +185,21 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
     fragmentProgram_.source = "#define CLVR_STACK2D_FRAGMENT 1\n" +
                               std::string(clipTexture_ ? "#define CLVR_STACK2D_CLIP_TEXTURE 1\n" : "") + std::string(source);
     fragmentProgram_.buffers[0] = stacks_[axis_].buffer();
-    glm::vec4 axisVector(0.0f);
-    axisVector[axis_] = 1.0f;
     const StackShape s = stackShape(axis_);
-    const std::array<glm::vec4, 5> cameraUniforms = cameraVectors(camera_, image_.width, image_.height);
-    fragmentProgram_.uniforms = {
-        cameraUniforms[0], cameraUniforms[1], cameraUniforms[2], cameraUniforms[3], cameraUniforms[4],
-        glm::vec4(image_.width, image_.height, 0.0f, 0.0f),  // z: tf_count, set with the transfer function
-        axisVector,
-        glm::vec4(dims_[s.b], dims_[s.c], channels, 0.0f),
-        glm::vec4(options_.reflectanceMapSize, lighting_.shaded() ? 1.0f : 0.0f, 0.0f, 0.0f),
-        glm::vec4(glm::vec3(-camera_.forward()), 0.0f),
-        glm::vec4(0.0f),  // 10..12: iso-surface mode
-        glm::vec4(0.0f),
-        glm::vec4(0.0f),
-    };
+    ClStack2dUniforms& u = uniforms_;  // fields of a mode that is off stay 0
+    u.camera = toClCamera(camera_, image_.width, image_.height);
+    u.frame = cl4(image_.width, image_.height, 0.0f, 0.0f);  // z: tf_count, set with the transfer function
+    u.axis.s[axis_] = 1.0f;
+    u.slice_tex = cl4(dims_[s.b], dims_[s.c], channels, 0.0f);
+    u.shading = cl4(options_.reflectanceMapSize, lighting_.shaded() ? 1.0f : 0.0f, 0.0f, 0.0f);
+    u.to_eye = toCl4(-camera_.forward());
     if (iso_) {
         const double range = iso_->dataMax > iso_->dataMin ? iso_->dataMax - iso_->dataMin : 1.0;
-        fragmentProgram_.uniforms[10] = glm::vec4(static_cast<float>(iso_->dataMin), 1.0f,
-                                                  static_cast<float>(iso_->ambient), static_cast<float>(iso_->diffuse));
-        fragmentProgram_.uniforms[11] = glm::vec4(glm::vec3(iso_->color), iso_->gradientShading ? 1.0f : 0.0f);
-        fragmentProgram_.uniforms[12] = glm::vec4(glm::vec3(iso_->light), static_cast<float>(1.0 / range));
+        u.iso = cl4(static_cast<float>(iso_->dataMin), 1.0f, static_cast<float>(iso_->ambient),
+                    static_cast<float>(iso_->diffuse));
+        u.surface = toCl4(iso_->color, iso_->gradientShading ? 1.0 : 0.0);
+        u.light = cl4(static_cast<float>(iso_->light.x), static_cast<float>(iso_->light.y),
+                      static_cast<float>(iso_->light.z), static_cast<float>(1.0 / range));
         isoFinish_ = device_.kernel("stack2d.cl", "stack2d_iso_finish");
     }
     fragmentProgram_.buffers[2] = map_;
@@ -223,40 +225,37 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
         fragmentProgram_.buffers[3] = sliceTable_;
     }
     if (options_.slicesPerPolygon > 1) {
-        glm::vec4 eb(0.0f), ec(0.0f);
-        eb[s.b] = 1.0f;
-        ec[s.c] = 1.0f;
         const double alphaRef =
             iso_ ? std::clamp((iso_->value - iso_->dataMin) / (iso_->dataMax > iso_->dataMin ? iso_->dataMax - iso_->dataMin : 1.0),
                               0.0, 1.0)
                  : 0.0;
-        fragmentProgram_.uniforms.push_back(eb);  // 13
-        fragmentProgram_.uniforms.push_back(ec);  // 14
-        fragmentProgram_.uniforms.push_back(glm::vec4(lo_[s.b], lo_[s.c], hi_[s.b], hi_[s.c]));  // 15
-        fragmentProgram_.uniforms.push_back(glm::vec4(0.5f / dims_[s.b], 0.5f / dims_[s.c], (dims_[s.b] - 0.5f) / dims_[s.b],
-                                                      (dims_[s.c] - 0.5f) / dims_[s.c]));  // 16, as the quads' corners
-        fragmentProgram_.uniforms.push_back(glm::vec4(static_cast<float>(alphaRef), 0.0f, 0.0f, 0.0f));  // 17
+        u.axis_b.s[s.b] = 1.0f;
+        u.axis_c.s[s.c] = 1.0f;
+        u.box = cl4(lo_[s.b], lo_[s.c], hi_[s.b], hi_[s.c]);
+        u.uv_box = cl4(0.5f / dims_[s.b], 0.5f / dims_[s.c], (dims_[s.b] - 0.5f) / dims_[s.b],
+                       (dims_[s.c] - 0.5f) / dims_[s.c]);  // as the quads' corners
+        u.alpha_ref = cl4(static_cast<float>(alphaRef), 0.0f, 0.0f, 0.0f);
     }
     if (clipTexture_) {
-        fragmentProgram_.uniforms.resize(18, glm::vec4(0.0f));  // 13..17 unused with one slice per quad
         const glm::ivec3 n = clipTexture_->dims();
-        fragmentProgram_.uniforms.push_back(glm::vec4(n.x, n.y, n.z, options_.clipTexture->inverse ? 1.0f : 0.0f));  // 18
-        fragmentProgram_.uniforms.resize(22, glm::vec4(0.0f));  // 19..21: setClipCoordinateUniforms
-        setClipCoordinateUniforms();
-        fragmentProgram_.uniforms.push_back(glm::vec4(static_cast<float>(table.size() * 4), 0.0f, 0.0f, 0.0f));  // 22
+        u.clip_tex = cl4(n.x, n.y, n.z, options_.clipTexture->inverse ? 1.0f : 0.0f);
+        u.clip_offset = cl4(static_cast<float>(table.size() * 4), 0.0f, 0.0f, 0.0f);
+        setClipCoordinateUniforms();  // u.clip_row
     }
-    fragmentProgram_.uniforms[5].z = static_cast<float>(scene.transferFunction.points().size());
-    fragmentProgram_.buffers[1] = tf_;
+    u.frame.s[2] = static_cast<float>(scene.transferFunction.points().size());
+    fragmentProgram_.uniforms = fragmentUniforms(u);
+    fragmentProgram_.buffers[1] = tf_.buffer();
 }
 
-// Uniforms 19..21: the rows of world -> clip-texture coordinates (the several-slices path maps the
-// ray's hit points with them; the one-slice path's vertices carry the mapped points, made per frame).
+// The uniforms' clip_row: the rows of world -> clip-texture coordinates (the several-slices path maps
+// the ray's hit points with them; the one-slice path's vertices carry the mapped points, made per frame).
 void Stack2dRenderer::setClipCoordinateUniforms()
 {
     for (int r = 0; r < 3; ++r)
-        fragmentProgram_.uniforms[19 + r] =
-            glm::vec4(static_cast<float>(clipCoordinates_[0][r]), static_cast<float>(clipCoordinates_[1][r]),
-                      static_cast<float>(clipCoordinates_[2][r]), static_cast<float>(clipCoordinates_[3][r]));
+        uniforms_.clip_row[r] =
+            cl4(static_cast<float>(clipCoordinates_[0][r]), static_cast<float>(clipCoordinates_[1][r]),
+                static_cast<float>(clipCoordinates_[2][r]), static_cast<float>(clipCoordinates_[3][r]));
+    fragmentProgram_.uniforms = fragmentUniforms(uniforms_);
 }
 
 void Stack2dRenderer::setClipPlacement(const glm::dvec3& offset, const glm::dmat3& matrix)
@@ -273,20 +272,16 @@ void Stack2dRenderer::setClipPlacement(const glm::dvec3& offset, const glm::dmat
 
 void Stack2dRenderer::setTransferFunction(const TransferFunction& tf)
 {
-    std::vector<float> packed = packTransferFunction(tf);
-    if (packed.empty())
-        packed.push_back(0.0f);  // an iso-surface scene without a transfer function: never read
-    residentBytes_ -= tfBytes_;
-    tfBytes_ = packed.size() * sizeof(float);
-    residentBytes_ += tfBytes_;
-    tf_ = device_.upload("stack2d transfer function", packed);
-    fragmentProgram_.buffers[1] = tf_;
-    if (fragmentProgram_.uniforms.size() > 5)  // not yet during construction, which sets them itself
-        fragmentProgram_.uniforms[5].z = static_cast<float>(tf.points().size());
-    if (iso_ && fragmentProgram_.uniforms.size() > 11 && !tf.points().empty()) {  // the surface color
+    tf_.replace(device_, "stack2d transfer function", tf, residentBytes_);
+    fragmentProgram_.buffers[1] = tf_.buffer();
+    if (fragmentProgram_.uniforms.empty())  // during construction, which sets them itself
+        return;
+    uniforms_.frame.s[2] = static_cast<float>(tf.points().size());
+    if (iso_ && !tf.points().empty()) {  // the surface color
         iso_->color = glm::dvec3(tf(iso_->value));
-        fragmentProgram_.uniforms[11] = glm::vec4(glm::vec3(iso_->color), fragmentProgram_.uniforms[11].w);
+        uniforms_.surface = toCl4(iso_->color, uniforms_.surface.s[3]);
     }
+    fragmentProgram_.uniforms = fragmentUniforms(uniforms_);
 }
 
 Image4f Stack2dRenderer::render(FrameStats& stats)

@@ -9,7 +9,8 @@
 #include "host/optics/preintegration_table.h"
 #include "host/optics/psi_table.h"
 #include "host/render/tet/harc_entry.h"
-#include "host/render/grid/slice3d.h"  // packTransferFunction: kernels/transfer_function.h's layout
+#include "host/render/transfer_function_upload.h"
+#include "kernels/harc_params.h"
 
 #include <algorithm>
 #include <array>
@@ -54,9 +55,9 @@ private:
     TetMesh mesh_;          // copies: the renderer outlives the caller's mesh
     TetTopology topology_;
     glm::dvec3 shift_{0.0};
-    int tfCount_ = 0;
+    TransferFunctionUpload tf_;
     std::uint64_t maxSteps_ = 0;
-    cl::Buffer tets_, tf_, psi_, out_, stats_;
+    cl::Buffer tets_, psi_, out_, stats_;
     cl::Kernel kernel_;
     std::unique_ptr<HarcRasterEntries> rasterEntries_;  // options_.entry == Raster
     std::uint64_t residentBytes_ = 0;
@@ -99,12 +100,10 @@ HarcRenderer::HarcRenderer(Device& device, const Scene& scene, const TetMesh& me
 
     const std::vector<cl_float4> tets = packHarcTets(mesh, topology, shift_);
     tets_ = device_.upload("harc tetrahedra (80 bytes each)", tets);
-    const std::vector<float> tf = packTransferFunction(scene.transferFunction);
-    tfCount_ = static_cast<int>(scene.transferFunction.points().size());
-    tf_ = device_.upload("harc transfer function", tf);
+    tf_.upload(device_, "harc transfer function", scene.transferFunction);
     const PsiTable& psi = psiTable();
     psi_ = device_.upload("harc psi table", psi.values);
-    residentBytes_ = tets.size() * sizeof(cl_float4) + tf.size() * sizeof(float) + psi.values.size() * sizeof(float);
+    residentBytes_ = tets.size() * sizeof(cl_float4) + tf_.bytes() + psi.values.size() * sizeof(float);
     meshScalarRange_ = mesh.scalarRange();
     fullLMax_ = longestTetEdge(mesh);
     if (!(fullLMax_ > 0.0))
@@ -149,11 +148,7 @@ void HarcRenderer::setTransferFunction(const TransferFunction& tf)
 
     // Partial pre-integration needs no table that depends on the transfer function: only the packed
     // control points change (the ψ table is the same for every transfer function).
-    const std::vector<float> packed = packTransferFunction(tf);
-    residentBytes_ -= static_cast<std::uint64_t>(((tfCount_ + 3) / 4 * 4 + 8 * tfCount_) * sizeof(float));
-    tfCount_ = static_cast<int>(tf.points().size());
-    tf_ = device_.upload("harc transfer function", packed);
-    residentBytes_ += packed.size() * sizeof(float);
+    tf_.replace(device_, "harc transfer function", tf, residentBytes_);
 }
 
 Image4f HarcRenderer::render(FrameStats& stats)
@@ -173,36 +168,37 @@ Image4f HarcRenderer::render(FrameStats& stats)
 
     const float ert = options_.earlyTermination < 1.0 ? static_cast<float>(options_.earlyTermination) : 2.0f;
     const cl_uint maxSteps = static_cast<cl_uint>(std::min<std::uint64_t>(maxSteps_, 0xffffffffu));
-    int a = 0;
-    kernel_.setArg(a++, out_);
-    kernel_.setArg(a++, stats_);
-    kernel_.setArg(a++, static_cast<cl_int>(image_.width));
-    kernel_.setArg(a++, static_cast<cl_int>(image_.height));
-    kernel_.setArg(a++, tets_);
-    kernel_.setArg(a++, offsets);
-    kernel_.setArg(a++, entryBuffer);
-    kernel_.setArg(a++, tf_);
-    kernel_.setArg(a++, static_cast<cl_int>(tfCount_));
-    kernel_.setArg(a++, psi_);
-    kernel_.setArg(a++, static_cast<cl_int>(psiTable().size));
-    a = setCameraArgs(kernel_, a, camera_, image_.width, image_.height, shift_);
-    kernel_.setArg(a++, maxSteps);
     const cl_int integration = options_.integration == HarcOptions::Integration::Average ? 1
                                : options_.integration == HarcOptions::Integration::Full  ? 2
                                                                                           : 0;
-    kernel_.setArg(a++, integration);  // HARC_INTEGRATION_* of kernels/harc.cl
-    kernel_.setArg(a++, static_cast<cl_float>(ert));
-    kernel_.setArg(a++, toCl4(image_.background));
     // The table's sample spacing as PreintegrationTable::lookup computes it (float), so host and device
     // interpolate alike.
     const int ns = options_.fullScalarSamples, nl = options_.fullLengthSamples;
-    const cl_float4 fullParams{{static_cast<float>(fullSLo_),
-                                static_cast<float>(ns - 1) / static_cast<float>(fullSHi_ - fullSLo_),
-                                static_cast<float>(nl - 1) / static_cast<float>(fullLMax_), 0.0f}};
+    ClHarcParams params{};
+    params.camera = toClCamera(camera_, image_.width, image_.height, shift_);
+    params.background = toCl4(image_.background);
+    params.full_params = cl_float4{{static_cast<float>(fullSLo_),
+                                    static_cast<float>(ns - 1) / static_cast<float>(fullSHi_ - fullSLo_),
+                                    static_cast<float>(nl - 1) / static_cast<float>(fullLMax_), 0.0f}};
+    params.width = image_.width;
+    params.height = image_.height;
+    params.tf_count = tf_.count();
+    params.psi_n = static_cast<cl_int>(psiTable().size);
+    params.max_steps = maxSteps;
+    params.integration = integration;  // HARC_INTEGRATION_* of kernels/harc.cl
+    params.ert_alpha = ert;
+    params.full_ns = ns;
+    params.full_nl = nl;
+    int a = 0;
+    kernel_.setArg(a++, out_);
+    kernel_.setArg(a++, stats_);
+    kernel_.setArg(a++, tets_);
+    kernel_.setArg(a++, offsets);
+    kernel_.setArg(a++, entryBuffer);
+    kernel_.setArg(a++, tf_.buffer());
+    kernel_.setArg(a++, psi_);
     kernel_.setArg(a++, full_);
-    kernel_.setArg(a++, static_cast<cl_int>(ns));
-    kernel_.setArg(a++, static_cast<cl_int>(nl));
-    kernel_.setArg(a++, fullParams);
+    kernel_.setArg(a++, params);
     device_.launch("harc: walk", kernel_, image_.width, image_.height);
 
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;

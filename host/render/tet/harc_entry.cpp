@@ -5,6 +5,8 @@
 #include "host/runtime/embedded_kernels.h"
 #include "host/runtime/errors.h"
 #include "host/render/camera_args.h"
+#include "host/render/fragment_uniforms.h"
+#include "kernels/harc_entry_params.h"
 
 #include <algorithm>
 #include <chrono>
@@ -94,9 +96,10 @@ HarcEntryLists HarcRasterEntries::build(const Camera& worldCamera, HarcRasterEnt
         vertices[i].attributes[0] = glm::vec4(corners_[i], 0.0f);
         vertices[i].attributes[1] = glm::vec4(static_cast<float>(code & 0xffff), static_cast<float>(code >> 16), 0.0f, 0.0f);
     }
-    const std::array<glm::vec4, 5> cameraUniforms = cameraVectors(camera, width_, height_);
-    program_.uniforms.assign(cameraUniforms.begin(), cameraUniforms.end());
-    program_.uniforms.push_back(glm::vec4(static_cast<float>(width_), static_cast<float>(height_), 0.0f, 0.0f));
+    ClHarcEntryUniforms uniforms{};
+    uniforms.camera = toClCamera(camera, width_, height_);
+    uniforms.size = cl_float4{{static_cast<float>(width_), static_cast<float>(height_), 0.0f, 0.0f}};
+    program_.uniforms = fragmentUniforms(uniforms);
     raster::DrawState state;
     state.fragment.depth.test = true;
     state.fragment.depth.func = raster::CompareFunc::Less;

@@ -1,0 +1,28 @@
+/* kernels/blend_params.h — the scalar arguments of kernels/blend.cl's blend_render as one struct,
+ * shared by host (host/render/grid/blend.cpp) and device, passed by value; buffers stay separate
+ * arguments. Sizes and offsets are probed on the device by tests/layout_test.cpp. */
+#ifndef CLVR_BLEND_PARAMS_H
+#define CLVR_BLEND_PARAMS_H
+
+#include "cl_types.h"
+#include "ray.h"
+
+typedef struct {
+    ClCamera camera;
+    cl_int4 dims;           /* grid points per axis, w = 0 */
+    cl_float4 grid_origin;  /* world position of grid point (0, 0, 0), w = 0 */
+    cl_float4 inv_spacing;  /* 1 / spacing per axis, w = 0 */
+    cl_float4 to_eye;       /* unit vector towards the eye (-forward), for the reflectance map */
+    cl_float4 background;   /* image background, w = 0 */
+    cl_int width, height;   /* image size in pixels */
+    cl_int tf_count;        /* control points of the transfer function */
+    cl_int map_n;           /* reflectance map size */
+    cl_int shade_on;        /* 1: shade through the reflectance map */
+    cl_float depth0;        /* eye depth where slice 0's slab begins */
+    cl_float delta_s;       /* slice spacing along forward, world units */
+    cl_int slice_count;
+    cl_float threshold;     /* samples with alpha <= this are written clear */
+    cl_int pad0, pad1, pad2;
+} ClBlendParams;            /* 208 bytes */
+
+#endif

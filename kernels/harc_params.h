@@ -1,0 +1,25 @@
+/* kernels/harc_params.h — the scalar arguments of kernels/harc.cl's harc_render as one struct, shared
+ * by host (host/render/tet/harc.cpp) and device, passed by value; buffers stay separate arguments. Sizes
+ * and offsets are probed on the device by tests/layout_test.cpp. */
+#ifndef CLVR_HARC_PARAMS_H
+#define CLVR_HARC_PARAMS_H
+
+#include "cl_types.h"
+#include "ray.h"
+
+typedef struct {
+    ClCamera camera;        /* relative to the mesh's shifted origin */
+    cl_float4 background;   /* image background, w = 0 */
+    cl_float4 full_params;  /* full pre-integration table: (s of sample 0, samples per unit s,
+                             * samples per unit l, 0) */
+    cl_int width, height;   /* image size in pixels */
+    cl_int tf_count;        /* control points of the transfer function */
+    cl_int psi_n;           /* the psi table is psi_n x psi_n */
+    cl_uint max_steps;      /* traversal steps per ray at most */
+    cl_int integration;     /* HARC_INTEGRATION_* */
+    cl_float ert_alpha;     /* stop once the opacity reaches this (2: off) */
+    cl_int full_ns, full_nl; /* full pre-integration table: samples per s axis and along l */
+    cl_int pad0, pad1, pad2;
+} ClHarcParams;             /* 160 bytes */
+
+#endif

@@ -1,0 +1,19 @@
+/* kernels/iso3d_params.h — the uniforms of kernels/iso3d.cl's fragment program as one struct, shared
+ * by host (host/render/grid/iso3d.cpp, through host/render/fragment_uniforms.h) and device (read through
+ * r->uniforms). float4 fields only. Sizes and offsets are probed on the device by tests/layout_test.cpp. */
+#ifndef CLVR_ISO3D_PARAMS_H
+#define CLVR_ISO3D_PARAMS_H
+
+#include "cl_types.h"
+
+typedef struct {
+    cl_float4 grid_origin;  /* world position of grid point (0, 0, 0), w = 0 */
+    cl_float4 inv_spacing;  /* 1 / spacing per axis, w = 0 */
+    cl_float4 dims;         /* grid points per axis, w = 0 */
+    cl_float4 value_map;    /* (value_lo, 1 / (value_hi - value_lo), positions, flip), see clvr_fragment */
+    cl_float4 brick_lo;     /* the brick's first grid point (0 unbricked), w = 0 */
+    cl_float4 brick_end;    /* its box's exclusive upper end in grid units (dims unbricked), w = 0 */
+    cl_float4 brick_dims;   /* its grid points per axis (dims unbricked), w = 0 */
+} ClIso3dUniforms;          /* 112 bytes */
+
+#endif

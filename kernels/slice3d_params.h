@@ -1,0 +1,42 @@
+/* kernels/slice3d_params.h — the scalar arguments of kernels/slice3d.cl's fused kernel as one struct
+ * (passed by value; buffers stay separate arguments), and the uniforms of its fragment program as
+ * another (float4 fields only, read through r->uniforms), shared by host (host/render/grid/slice3d.cpp)
+ * and device. Sizes and offsets are probed on the device by tests/layout_test.cpp. */
+#ifndef CLVR_SLICE3D_PARAMS_H
+#define CLVR_SLICE3D_PARAMS_H
+
+#include "cl_types.h"
+#include "ray.h"
+#include "texture.h"
+
+typedef struct {
+    ClCamera camera;
+    cl_int4 dims;            /* grid points per axis, w = 0 */
+    cl_float4 grid_origin;   /* world position of grid point (0, 0, 0), w = 0 */
+    cl_float4 inv_spacing;   /* 1 / spacing per axis, w = 0 */
+    cl_int4 brick_dims;      /* bricks per axis (empty-space skipping), w = 0 */
+    cl_float4 background;    /* image background, w = 0 */
+    cl_int width, height;    /* image size in pixels */
+    cl_int tf_count;         /* control points of the transfer function */
+    cl_int skip;             /* 1: step over empty bricks */
+    cl_float depth0;         /* eye depth of slice 0 */
+    cl_float delta_s;        /* slice spacing along forward, world units */
+    cl_int slice_count;
+    cl_int front_to_back;    /* 1: front to back with early termination, 0: back to front */
+    cl_float ert_alpha;      /* front to back: stop once the opacity reaches this (2: off) */
+    cl_int clip_inverse;     /* clip texture: 1 keeps the outside */
+    cl_int pad0, pad1;
+    ClTexture clip_tex;      /* clip texture (SLICE3D_CLIP_TEXTURE builds only) */
+    cl_float4 clip_row[3];   /* rows of the affine world -> clip-texture coordinates map */
+} ClSlice3dParams;           /* 304 bytes */
+
+typedef struct {
+    ClCamera camera;
+    cl_float4 frame;         /* (width, height, delta_s, tf_count) */
+    cl_float4 grid_origin;   /* w = 0 */
+    cl_float4 inv_spacing;   /* w = 0 */
+    cl_float4 dims;          /* grid points per axis, w = 0 */
+    cl_float4 clip_tex;      /* CLVR_SLICE3D_CLIP_TEXTURE: (width, height, depth, 1 if inverse) */
+} ClSlice3dUniforms;         /* 160 bytes */
+
+#endif

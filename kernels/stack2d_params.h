@@ -1,0 +1,32 @@
+/* kernels/stack2d_params.h — the uniforms of kernels/stack2d.cl's fragment program as one struct,
+ * shared by host (host/render/grid/stack2d.cpp, through host/render/fragment_uniforms.h) and device (read
+ * through r->uniforms). float4 fields only. Sizes and offsets are probed on the device by
+ * tests/layout_test.cpp. Fields of a mode that is off stay 0. */
+#ifndef CLVR_STACK2D_PARAMS_H
+#define CLVR_STACK2D_PARAMS_H
+
+#include "ray.h"
+
+typedef struct {
+    ClCamera camera;
+    cl_float4 frame;       /* (image width, height, tf_count, 0) */
+    cl_float4 axis;        /* the stack axis as a unit vector */
+    cl_float4 slice_tex;   /* (texture width, height, channels, 0) of one slice */
+    cl_float4 shading;     /* (reflectance map n, 1 if shaded, 0, 0) */
+    cl_float4 to_eye;      /* unit vector towards the eye (-forward) */
+    /* iso-surfaces only */
+    cl_float4 iso;         /* (data minimum, 1 if iso-surface, ambient, diffuse) */
+    cl_float4 surface;     /* (surface color, 1 if gradient-shaded) */
+    cl_float4 light;       /* (unit vector towards the light, 1 / data range) */
+    /* several slices per polygon only */
+    cl_float4 axis_b, axis_c; /* unit vectors along the slice's texture axes b and c */
+    cl_float4 box;         /* (min b, min c, max b, max c), world */
+    cl_float4 uv_box;      /* (u, v at the box min, u, v at the box max) */
+    cl_float4 alpha_ref;   /* (the alpha test's reference, 0, 0, 0) */
+    /* clip textures only */
+    cl_float4 clip_tex;    /* (width, height, depth, 1 if inverse) */
+    cl_float4 clip_row[3]; /* rows of world -> clip-texture coordinates */
+    cl_float4 clip_offset; /* (offset of the texels in buffer[3], in floats, 0, 0, 0) */
+} ClStack2dUniforms;       /* 368 bytes */
+
+#endif
