@@ -220,9 +220,9 @@ __attribute__((always_inline)) void clvr_shade(global const ClTriangle* t, long 
 
 /* One work-item per CLVR_PIXELS_PER_ITEM horizontally adjacent pixels of the viewport rectangle
  * (rect_*, clipped to the frame buffer): independent pixels give the CPU instruction-level
- * parallelism and share each triangle's loads. Tiles of tile_w x tile_h pixels (tile_w a multiple
- * of CLVR_PIXELS_PER_ITEM; the host picks the shape) start at the rectangle's corner, so a work-item's
- * pixels share a tile; tile t lists triangle indices
+ * parallelism and share each triangle's loads. Tiles of 2^tile_w_log2 x 2^tile_h_log2 pixels (the
+ * width a multiple of CLVR_PIXELS_PER_ITEM; the host picks the shape) start at the rectangle's corner,
+ * so a work-item's pixels share a tile; tile t lists triangle indices
  * tile_tris[tile_start[tile_base + t] .. tile_start[tile_base + t + 1]) in submission order (one
  * buffer holds the tile lists of every pass of a batch, and one uniforms buffer their uniforms,
  * this pass's from uniform_base). fragment_counts[row] accumulates the
@@ -230,7 +230,7 @@ __attribute__((always_inline)) void clvr_shade(global const ClTriangle* t, long 
  * outside a triangle's col/row bounds (which include GL's scissor rectangle) are never its fragments. */
 kernel void raster_fragments(global float4* color, global float* depth, global uchar* stencil, const int fb_width,
                              const int rect_x, const int rect_y, const int rect_w, const int rect_h,
-                             const int tile_w, const int tile_h, const int tiles_x, const uint tile_base, global const ClTriangle* tris,
+                             const int tile_w_log2, const int tile_h_log2, const int tiles_x, const uint tile_base, global const ClTriangle* tris,
                              global const uint* tile_start, global const uint* tile_tris, const ClFragmentState fs,
                              const ClBlendState bs, constant float4* uniforms, const uint uniform_base,
                              global const float* buffer0,
@@ -240,7 +240,8 @@ kernel void raster_fragments(global float4* color, global float* depth, global u
     CLVR_GUARD_2D((rect_w + CLVR_PIXELS_PER_ITEM - 1) / CLVR_PIXELS_PER_ITEM, rect_h);
     const int gx0 = (int)get_global_id(0) * CLVR_PIXELS_PER_ITEM;
     const int gy = (int)get_global_id(1);
-    const uint tile = tile_base + (uint)((gy / tile_h) * tiles_x + gx0 / tile_w);
+    /* Shifts, not divisions: an integer division per work-item was the launch's largest cost. */
+    const uint tile = tile_base + (uint)((gy >> tile_h_log2) * tiles_x + (gx0 >> tile_w_log2));
     const uint begin = tile_start[tile];
     const uint end = tile_start[tile + 1];
     if (begin == end)

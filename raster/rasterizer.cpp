@@ -6,6 +6,7 @@
 #include "host/errors.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstring>
@@ -120,8 +121,8 @@ bool toWindow(const glm::dvec4& position, const std::array<glm::dvec4, kMaxAttri
     return true;
 }
 
-// Tiles of a pass: tileW x tileH pixels from the rectangle's corner. tileW is a multiple of
-// CLVR_PIXELS_PER_ITEM, so a work-item's pixels share a tile.
+// Tiles of a pass: tileW x tileH pixels from the rectangle's corner, powers of two (the kernel shifts).
+// tileW is a multiple of CLVR_PIXELS_PER_ITEM, so a work-item's pixels share a tile.
 struct TileGrid {
     Rect rect;
     int tileW = CLVR_TILE_SIZE, tileH = CLVR_TILE_SIZE;
@@ -587,8 +588,8 @@ void Rasterizer::submit(Framebuffer& fb, SetUpDraws& draws)
         k.setArg(arg++, static_cast<cl_int>(rect.y));
         k.setArg(arg++, static_cast<cl_int>(rect.width));
         k.setArg(arg++, static_cast<cl_int>(rect.height));
-        k.setArg(arg++, static_cast<cl_int>(grids[i].tileW));
-        k.setArg(arg++, static_cast<cl_int>(grids[i].tileH));
+        k.setArg(arg++, static_cast<cl_int>(std::countr_zero(static_cast<unsigned>(grids[i].tileW))));
+        k.setArg(arg++, static_cast<cl_int>(std::countr_zero(static_cast<unsigned>(grids[i].tileH))));
         k.setArg(arg++, static_cast<cl_int>(grids[i].tilesX()));
         k.setArg(arg++, static_cast<cl_uint>(bases[i]));
         k.setArg(arg++, s.triangles);
