@@ -1,7 +1,8 @@
 // raster/rasterizer.h — the ordered triangle rasterizer and GL's per-fragment operations
 // (DESIGN.md, raster stage; the exact rules are in docs/raster.md). Triangles are clipped, set up
-// and binned to screen tiles on the host in submission order; one work-item per pixel then walks
-// its tile's list in that order, so blending is exactly ordered and two runs give identical bits.
+// and binned to screen tiles on the host in submission order; one work-item per 8 pixels of a row
+// then walks its tile's list in that order, so blending is exactly ordered and two runs give identical
+// bits. Rasterizer and DrawBatch (below) make many draws cheap; raster::draw is the one-shot form.
 #pragma once
 
 #include "host/device.h"
@@ -88,7 +89,8 @@ struct RasterScratch;  // raster/rasterizer.cpp: device buffers, host staging an
 // lifetime. A draw costs in proportion to its triangles: programs are looked up once per
 // FragmentProgram, buffers persist (grown geometrically), and nothing is read back until takeStats().
 // Draws run in submission order on the device's in-order queue, after whatever was enqueued before them
-// (clears, other passes). Not for use by several threads at once.
+// (clears, other passes). Not for use by several threads at once. Fragment counts are 32-bit per row:
+// take the stats at least once a frame.
 class Rasterizer {
 public:
     explicit Rasterizer(Device& device);
