@@ -1,5 +1,5 @@
 /* kernels/clip_texture.h — the clip texture's test per sample (seeds/003, "Clipping with arbitrary
- * clipping geometry"; host/clip_texture.h), shared by slice3d (fused kernel and fragment program) and
+ * clipping geometry"; host/optics/clip_texture.h), shared by slice3d (fused kernel and fragment program) and
  * stack2d's fragment program: a second, one-channel texture, negative inside (a signed distance, or
  * 0.5 - mask value), sampled with linear filtering at the sample's clip-texture coordinates u
  * (normalized, GL's: texel i centered at (i + 0.5) / n). */
@@ -11,7 +11,7 @@
 #ifdef __OPENCL_C_VERSION__
 
 /* The clip texture of (width, height, depth) = dims.xyz texels: one channel, linear, clamp to edge
- * (as host/clip_texture.cpp uploads it). */
+ * (as host/optics/clip_texture.cpp uploads it). */
 ClTexture clvr_clip_texture(const float4 dims)
 {
     ClTexture t;

@@ -2,7 +2,7 @@
 #ifndef CLVR_COMMON_H
 #define CLVR_COMMON_H
 
-/* Global sizes are padded to the work-group multiple (host/device.h); kernels return past n. */
+/* Global sizes are padded to the work-group multiple (host/runtime/device.h); kernels return past n. */
 #define CLVR_GUARD_1D(n) \
     if (get_global_id(0) >= (size_t)(n)) return
 #define CLVR_GUARD_2D(w, h) \

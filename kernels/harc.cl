@@ -3,13 +3,13 @@
 // tetrahedron to tetrahedron through the adjacency, splits each tetrahedron's segment at the transfer
 // function's control points, integrates each piece by Eq. 2 with ζ (Eq. 3) and ψ (Eq. 4, 2D table),
 // and composites front to back; or, with full pre-integration (HARC-Full, Figure 8), looks each whole
-// segment up in a 3D table over (s_f, s_b, l) built for the transfer function (host/preintegration_table.h).
+// segment up in a 3D table over (s_f, s_b, l) built for the transfer function (host/optics/preintegration_table.h).
 // Entry points come from a per-pixel list of boundary-face crossings
-// sorted by depth (host/render/harc.cpp); after the ray leaves the mesh it re-enters at the next one.
+// sorted by depth (host/render/tet/harc.cpp); after the ray leaves the mesh it re-enters at the next one.
 // The host has validated everything; this file only does arithmetic.
 #include "clvr_common.h"
 
-/* Per tetrahedron, 5 float4 = 80 bytes (Table 1 of seeds/001 uses 96), host/render/harc.h:
+/* Per tetrahedron, 5 float4 = 80 bytes (Table 1 of seeds/001 uses 96), host/render/tet/harc.h:
  *   [0..2] barycentric planes (h_i, k_i), i = 0, 1, 2: b_i(x) = dot(h_i, x) + k_i is 1 at vertex i and
  *          0 on face i (the face opposite vertex i). The fourth is recomputed, Σ b_i = 1:
  *          h_3 = -(h_0 + h_1 + h_2), k_3 = 1 - (k_0 + k_1 + k_2).
@@ -23,7 +23,7 @@
 #define HARC_INTEGRATION_AVERAGE 1
 #define HARC_INTEGRATION_FULL 2
 
-/* ψ of Eq. 4 from the γ-table of host/psi_table.h (bilinear; same arithmetic as PsiTable::lookup). */
+/* ψ of Eq. 4 from the γ-table of host/optics/psi_table.h (bilinear; same arithmetic as PsiTable::lookup). */
 float harc_psi(global const float* psi, const int n, float tau_l_front, float tau_l_back)
 {
     const float f = fmin(tau_l_front, 1e30f), b = fmin(tau_l_back, 1e30f);
@@ -137,7 +137,7 @@ void harc_segment_average(global const float* tf, const int n, const float s_f, 
 }
 
 /* Full pre-integration: trilinear lookup of the segment (s_f -> s_b over length l) in the table of
- * host/preintegration_table.h, table[(k * ns + j) * ns + i] = (premultiplied rgb, α) at s_f sample i,
+ * host/optics/preintegration_table.h, table[(k * ns + j) * ns + i] = (premultiplied rgb, α) at s_f sample i,
  * s_b sample j, l sample k. params = (s of sample 0, samples per unit s, samples per unit l); s is
  * clamped to the sampled range and l to l_max (no segment is longer than the longest tet edge). Manual
  * interpolation on a plain buffer, so that it runs where 3D images of float4 are missing or small; the
@@ -166,7 +166,7 @@ float4 harc_full_lookup(global const float4* table, const int ns, const int nl, 
  * of pixel p's ray, sorted by ray parameter: (λ as float bits, tet * 4 + face). Camera: position,
  * forward, right, up (orthonormal, relative to the mesh's shifted origin); params: x = tan(view_angle
  * / 2) or parallel_scale, y = aspect, z = 1 for a parallel camera. Ray e + λ d, |d| = 1, as
- * host/camera.cpp's Camera::ray. stats[p] = (steps, 1 if the step bound stopped the ray, pieces).
+ * host/model/camera.cpp's Camera::ray. stats[p] = (steps, 1 if the step bound stopped the ray, pieces).
  * integration: HARC_INTEGRATION_*; full_table, full_ns, full_nl, full_params: harc_full_lookup's table
  * (a one-element dummy unless integration is full). Out: (I + T background, 1 - T). */
 kernel void harc_render(global float4* out, global uint* stats, const int width, const int height,

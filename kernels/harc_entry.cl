@@ -1,4 +1,4 @@
-// kernels/harc_entry.cl — the fragment program of HARC's entry pass (host/render/harc_entry.h):
+// kernels/harc_entry.cl — the fragment program of HARC's entry pass (host/render/tet/harc_entry.h):
 // raster::draw appends it, with CLVR_HARC_ENTRY_FRAGMENT defined, after kernels/raster.cl. One draw
 // of the mesh's boundary faces per depth-peeling layer, no culling, depth test LESS: at each pixel the
 // nearest face that the ray enters through (decided here from the face's plane) whose ray parameter λ

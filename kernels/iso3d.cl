@@ -1,5 +1,5 @@
 // kernels/iso3d.cl — shaded iso-surfaces by the alpha test (§3 of seeds/000_354856c7f65dc3f9.txt).
-// Two uses of this file (host/render/iso3d.cpp):
+// Two uses of this file (host/render/grid/iso3d.cpp):
 //  - with CLVR_ISO3D_FRAGMENT defined, it is appended after kernels/raster.cl as the fragment program
 //    of the slices: it samples the RGBA volume (encoded normal, value) trilinearly and puts the value,
 //    normalized to [0,1], in alpha, where the alpha test (GEQUAL iso) keeps the samples at or above

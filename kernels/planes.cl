@@ -11,7 +11,7 @@
 #include "reflectance_map.h"
 #include "transfer_function.h"
 
-/* The ray through pixel center (x + 0.5, y + 0.5), row 0 at the top (host/camera.cpp's Camera::ray):
+/* The ray through pixel center (x + 0.5, y + 0.5), row 0 at the top (host/model/camera.cpp's Camera::ray):
  * origin o and unit direction d. params: x = tan(view_angle / 2) or parallel_scale, y = aspect
  * (width / height), z = 1 for a parallel camera (o on the image plane through the position). */
 void planes_ray(const int x, const int y, const int width, const int height, const float4 position,
@@ -32,7 +32,7 @@ void planes_ray(const int x, const int y, const int width, const int height, con
 
 /* One work-item per pixel. The chord [t0, t1] of the ray inside the box [lo, hi] (t0 >= 0) is cut into
  * count = ceil((t1 - t0) / step) equal segments of length h <= step; sample k sits at the middle of
- * segment k (the midpoint rule of host/reference_integral.h's first level). Per sample:
+ * segment k (the midpoint rule of host/reference/reference_integral.h's first level). Per sample:
  * alpha = 1 - exp(-tau h); if alpha <= threshold the sample is skipped before shading (counted in
  * skipped[]); else c += T alpha C shade, T *= 1 - alpha, and the ray stops once 1 - T >= ert_alpha
  * (counted in terminated[]). shade_on = 0: shade 1 (unshaded, the integral slice3d approximates).

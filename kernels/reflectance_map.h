@@ -1,6 +1,6 @@
 /* kernels/reflectance_map.h — shading of volume samples on the device (§2.2-2.3 of
  * seeds/004_35d3c76e603b55b1.txt): trilinear reconstruction of the RGBA volume (gradient, value) and
- * the reflectance-map lookup. The map's layout and cube-face convention are host/reflectance_map.h's:
+ * the reflectance-map lookup. The map's layout and cube-face convention are host/optics/reflectance_map.h's:
  * 6 n^2 float4 entries (rgb = shade), entry 6 n^2 = the shade of a zero gradient. OpenCL C 1.2. */
 #ifndef CLVR_REFLECTANCE_MAP_H
 #define CLVR_REFLECTANCE_MAP_H

@@ -1,7 +1,7 @@
 // kernels/slice3d.cl — 3D-texture slicing (§2 of seeds/000_354856c7f65dc3f9.txt): planes parallel to
 // the image plane, trilinear samples, classification after interpolation, alpha = 1 - exp(-tau Delta)
 // with Delta the pixel ray's length between slices, premultiplied color, "over" blending.
-// Two uses of this file (host/render/slice3d.cpp):
+// Two uses of this file (host/render/grid/slice3d.cpp):
 //  - the fused kernel slice3d_fused: one work-item per pixel walks all slices (the fast path);
 //  - with CLVR_SLICE3D_FRAGMENT defined, it is appended after kernels/raster.cl as the fragment
 //    program of the pass-by-pass path (the specification): one fragment per slice and pixel.
@@ -13,7 +13,7 @@
 #include "volume_sampling.h"
 
 /* Normalized device coordinates of window position w (pixel center (x + 0.5, row + 0.5), row 0 at
- * the top), y up — host/camera.cpp's Camera::ray. */
+ * the top), y up — host/model/camera.cpp's Camera::ray. */
 float2 slice3d_ndc(const float2 w, const int width, const int height)
 {
     return (float2)(w.x / (float)width * 2.0f - 1.0f, 1.0f - w.y / (float)height * 2.0f);

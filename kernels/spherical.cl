@@ -1,5 +1,5 @@
 // kernels/spherical.cl — the per-shell pixel pass of the spherical technique (seeds/000 §2.2,
-// host/render/spherical.h, docs/spherical.md). The frame buffer `coords` holds, per pixel, the
+// host/render/grid/spherical.h, docs/spherical.md). The frame buffer `coords` holds, per pixel, the
 // sphere's interpolated normalized spherical coordinates after the pixel transfer b + s·CM·p, which
 // also mapped them to texture coordinates; `stencil` marks the pixels the shell covered. Per covered
 // pixel: the φ coordinate wraps (GL_REPEAT of the periodic axis), the pixel texture fetch of the
@@ -16,7 +16,7 @@
  * the next inner sphere, radius center.w (its closest distance p >= center.w), never meets that
  * sphere, so this one takes its whole path below r_hi: the slab then starts at p (r_lo ignored). cam: 0..3 position,
  * forward, right, up; cam[4] = (scale, aspect, parallel, 0) with scale tan(view_angle / 2) or the
- * parallel scale; size = (width, height). The ray is host/camera.cpp's PixelRays::at. */
+ * parallel scale; size = (width, height). The ray is host/model/camera.cpp's PixelRays::at. */
 float clvr_spherical_slab_length(const float px, const float py, const float4 cam0, const float4 cam1,
                                  const float4 cam2, const float4 cam3, const float4 cam4, const float2 size,
                                  const float4 center, const float r_lo, const float r_hi, const float side)

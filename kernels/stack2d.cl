@@ -1,5 +1,5 @@
 // kernels/stack2d.cl — fragment program of the 2D texture stacks (seeds/003_e49ee09fcdafadac.txt;
-// host/render/stack2d.cpp, docs/stack2d.md). The host appends this file, with CLVR_STACK2D_FRAGMENT
+// host/render/grid/stack2d.cpp, docs/stack2d.md). The host appends this file, with CLVR_STACK2D_FRAGMENT
 // defined, after kernels/raster.cl; compiled on its own (the offline syntax test) it pulls in
 // raster.cl itself, so that the fragment program is checked in the context it runs in.
 // The host has validated everything; this file only does arithmetic.
@@ -25,18 +25,18 @@
  * axes b and c; 15 (box min b, min c, max b, max c), world; 16 (u, v at the box min, u, v at the
  * box max); 17 (the alpha test's reference, 0, 0, 0). buffer[0] the stack (slices one after another, x
  * fastest): 1 channel, the value, returned as (v, v, v, v); or, shaded, 4 channels (gradient, value)
- * from host/gradient_volume.h. buffer[1] the transfer function (transfer_function.h); buffer[2] the
+ * from host/optics/gradient_volume.h. buffer[1] the transfer function (transfer_function.h); buffer[2] the
  * reflectance map (reflectance_map.h), shaded only; buffer[3] the slice table (float4 per slice:
  * world coordinate on the axis, lower, weight, thickness), several slices per polygon only, followed
  * by the clip texture's texels (clip textures, below: uniforms 18..22, attr[2]).
  * Sample: bilinear in each slice; an intermediate slice lerps two bilinear samples, the paper's
  * register-combiner step, which makes the sample (and the gradient) trilinear. Classified after
  * interpolation; shaded, the color is C times the map's shade of the interpolated gradient (the
- * model of host/reflectance_map.h, as planes and blend; tau is not shaded);
+ * model of host/optics/reflectance_map.h, as planes and blend; tau is not shaded);
  * alpha = 1 - exp(-tau Delta) with Delta the ray's length through the slab, thickness / |cos| of
  * the angle between the pixel's ray and the axis. Output premultiplied (C alpha, alpha). */
 
-/* Clip texture (seeds/003, "Clipping with arbitrary clipping geometry"; host/clip_texture.h, as
+/* Clip texture (seeds/003, "Clipping with arbitrary clipping geometry"; host/optics/clip_texture.h, as
  * slice3d): with CLVR_STACK2D_CLIP_TEXTURE defined, a second, one-channel texture (negative inside,
  * linear filtering, clamp to edge) decides per sample whether it is drawn. uniforms 18 (width,
  * height, depth, 1 if inverse), 19..21 the rows of world -> clip-texture coordinates
@@ -124,7 +124,7 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
     const ClTexture slice = stack2d_slice_texture(u);
     const bool iso = u[10].y != 0.0f;
 
-    /* The pixel's ray (host/camera.cpp's PixelRays): from the camera through the pixel center, or for
+    /* The pixel's ray (host/model/camera.cpp's PixelRays): from the camera through the pixel center, or for
      * a parallel camera from the pixel's point on the image plane along forward. */
     const float2 ndc = (float2)(f->window.x / u[5].x * 2.0f - 1.0f, 1.0f - f->window.y / u[5].y * 2.0f);
     const float3 offset = (ndc.x * u[4].x * u[4].y) * u[2].xyz + (ndc.y * u[4].x) * u[3].xyz;

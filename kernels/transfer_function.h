@@ -1,8 +1,8 @@
 /* kernels/transfer_function.h — the piecewise-linear transfer function of DESIGN.md on the device:
  * control points (s, r, g, b, tau), evaluated exactly from its control points (no table; float
- * rounding only), the end points' values held outside [s_0, s_{n-1}] as host/transfer_function.h
+ * rounding only), the end points' values held outside [s_0, s_{n-1}] as host/model/transfer_function.h
  * does. OpenCL C 1.2.
- * Layout of the float buffer (host: packTransferFunction in host/render/slice3d.h), m = n rounded
+ * Layout of the float buffer (host: packTransferFunction in host/render/grid/slice3d.h), m = n rounded
  * up to a multiple of 4 (vload4 alignment):
  *   tf[0 .. n)                  s_i, strictly increasing
  *   tf[m + 4i .. m + 4i + 4)     (r, g, b, tau) at s_i

@@ -1,7 +1,7 @@
 // raster/framebuffer.cpp — allocation, clears, read-back and copies of the frame buffer planes.
 #include "raster/framebuffer.h"
 
-#include "host/errors.h"
+#include "host/runtime/errors.h"
 
 #include <string>
 

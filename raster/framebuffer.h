@@ -3,8 +3,8 @@
 // stencil: uchar; accum: optional RGBA float4 accumulation buffer.
 #pragma once
 
-#include "host/device.h"
-#include "host/image.h"
+#include "host/runtime/device.h"
+#include "host/model/image.h"
 
 #include <cstdint>
 #include <vector>

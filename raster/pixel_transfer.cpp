@@ -1,7 +1,7 @@
 // raster/pixel_transfer.cpp — validate, pack, launch, name the launch (kernels/pixel_transfer.cl).
 #include "raster/pixel_transfer.h"
 
-#include "host/errors.h"
+#include "host/runtime/errors.h"
 
 #include <cstdint>
 #include <string>

@@ -4,8 +4,8 @@
 // kernels/pixel_transfer.cl; reference: raster/reference/pixel_transfer.h.
 #pragma once
 
-#include "host/device.h"
-#include "host/image.h"
+#include "host/runtime/device.h"
+#include "host/model/image.h"
 #include "raster/framebuffer.h"
 #include "raster/texture.h"
 

@@ -3,7 +3,7 @@
 // (a run of draws with the same program and state), from buffers that persist in the Rasterizer.
 #include "raster/rasterizer.h"
 
-#include "host/errors.h"
+#include "host/runtime/errors.h"
 
 #include <algorithm>
 #include <bit>

@@ -5,7 +5,7 @@
 // bits. Rasterizer and DrawBatch (below) make many draws cheap; raster::draw is the one-shot form.
 #pragma once
 
-#include "host/device.h"
+#include "host/runtime/device.h"
 #include "raster/fragment_state.h"
 #include "raster/framebuffer.h"
 

@@ -1,7 +1,7 @@
 // raster/texture.cpp — validation, packing and upload of textures.
 #include "raster/texture.h"
 
-#include "host/errors.h"
+#include "host/runtime/errors.h"
 
 #include <string>
 

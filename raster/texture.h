@@ -3,7 +3,7 @@
 // clvr_tex1d/2d/3d with GL's nearest/linear filtering and clamp-to-edge/clamp-to-border wrapping.
 #pragma once
 
-#include "host/device.h"
+#include "host/runtime/device.h"
 #include "kernels/texture.h"
 
 #include <glm/glm.hpp>

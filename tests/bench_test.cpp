@@ -1,5 +1,5 @@
 // tests/bench_test.cpp — correctness (never timing) of clvr bench: the ceiling loop (tools/ceiling.h),
-// whose image must be the emission-absorption integral of the scene as host/reference_integral.h computes
+// whose image must be the emission-absorption integral of the scene as host/reference/reference_integral.h computes
 // it, and the mesh side (tools/bench_mesh.h): the harc bench scenes, the figures from a frame's stats, the
 // TetGen mesh cache and the peer's files. tools/*.cpp are not in the test binary, so their files are
 // compiled in here.
@@ -7,12 +7,12 @@
 #include "tools/bench_suites.cpp"
 #include "tools/ceiling.cpp"
 
-#include "host/errors.h"
-#include "host/generators.h"
-#include "host/mesh_io.h"
-#include "host/reference_integral.h"
+#include "host/runtime/errors.h"
+#include "host/io/generators.h"
+#include "host/io/mesh_io.h"
+#include "host/reference/reference_integral.h"
 #include "host/render/renderer.h"
-#include "tests/test_util.h"
+#include "tests/support/test_util.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

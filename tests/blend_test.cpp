@@ -1,14 +1,14 @@
 // tests/blend_test.cpp — the Blend method (seeds/004 §3.2): options, the shaded image against the CPU shaded
 // reference integral (parallel and perspective), error falling with the slice count, the opacity threshold
 // within its bound, and agreement with planes on the same scene.
-#include "host/render/blend.h"
+#include "host/render/grid/blend.h"
 
-#include "host/errors.h"
-#include "host/generators.h"
-#include "host/gradient_volume.h"
-#include "host/reference_integral.h"
-#include "host/reflectance_map.h"
-#include "tests/test_util.h"
+#include "host/runtime/errors.h"
+#include "host/io/generators.h"
+#include "host/optics/gradient_volume.h"
+#include "host/reference/reference_integral.h"
+#include "host/optics/reflectance_map.h"
+#include "tests/support/test_util.h"
 
 #include <cmath>
 #include <cstdio>

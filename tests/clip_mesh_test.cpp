@@ -1,10 +1,10 @@
-// tests/clip_mesh_test.cpp — clip surfaces (host/clip_mesh.h): generators closed and facing out with
+// tests/clip_mesh_test.cpp — clip surfaces (host/optics/clip_mesh.h): generators closed and facing out with
 // the right volume, the readers (.off and ASCII .stl through tetgenio, binary .stl and .obj by clvr),
 // the closedness check, the scene spec's errors, and ray parity (watertight at shared edges and points) against analytic shapes.
-#include "host/clip_mesh.h"
+#include "host/optics/clip_mesh.h"
 
-#include "host/errors.h"
-#include "tests/test_util.h"
+#include "host/runtime/errors.h"
+#include "tests/support/test_util.h"
 
 #include <nlohmann/json.hpp>
 

@@ -1,18 +1,18 @@
 // tests/clip_texture_test.cpp — slice3d clipped by a second "stencil" texture (seeds/003, "Clipping
-// with arbitrary clipping geometry"; host/clip_texture.h): the signed-distance textures of a sphere, a
+// with arbitrary clipping geometry"; host/optics/clip_texture.h): the signed-distance textures of a sphere, a
 // box and a cylinder and a voxel mask, inside and inverse, on the fused and the raster path, against
 // the reference integral restricted to the unclipped parts of each ray; the placement (offset, matrix)
 // moving the clipped region as moving the shape does, without a new texture; bad input.
-#include "host/clip_texture.h"
+#include "host/optics/clip_texture.h"
 
-#include "host/errors.h"
-#include "host/generators.h"
-#include "host/image_io.h"
-#include "host/reference_integral.h"
+#include "host/runtime/errors.h"
+#include "host/io/generators.h"
+#include "host/io/image_io.h"
+#include "host/reference/reference_integral.h"
 #include "host/render/renderer.h"
-#include "host/render/slice3d.h"
-#include "tests/clip_reference.h"
-#include "tests/test_util.h"
+#include "host/render/grid/slice3d.h"
+#include "tests/support/clip_reference.h"
+#include "tests/support/test_util.h"
 
 #include <algorithm>
 #include <cmath>
@@ -73,7 +73,7 @@ Image4f render(const Scene& scene, FrameStats* stats = nullptr)
 
 ClipTextureSpec specOf(const Scene& scene) { return *parseSlice3dOptions(scene.options).clipTexture; }
 
-// The references of tests/clip_reference.h for this file's volume and the scene's clip texture.
+// The references of tests/support/clip_reference.h for this file's volume and the scene's clip texture.
 Image4d shapeReference(const Scene& scene) { return test::shapeClipReference(marschnerLobb41(), scene, specOf(scene)); }
 
 Image4d textureReference(const Scene& scene) { return test::textureClipReference(marschnerLobb41(), scene, specOf(scene)); }

@@ -1,13 +1,13 @@
 // tests/default_scene_test.cpp — the scene `bash tools/setup.sh` renders (data/scenes/default.json,
 // embedded as defaultScene()) against the CPU reference integral, as shipped: Marschner–Lobb 128³,
 // 256 slices, fused slice3d; only the image is made small (48x48) so the reference stays cheap.
-#include "host/generators.h"
-#include "host/reference_integral.h"
+#include "host/io/generators.h"
+#include "host/reference/reference_integral.h"
 #include "host/render/renderer.h"
-#include "host/render/slice3d.h"
-#include "host/scene.h"
-#include "host/volume_io.h"
-#include "tests/test_util.h"
+#include "host/render/grid/slice3d.h"
+#include "host/model/scene.h"
+#include "host/io/volume_io.h"
+#include "tests/support/test_util.h"
 
 #include <gtest/gtest.h>
 

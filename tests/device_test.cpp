@@ -1,9 +1,9 @@
 // tests/device_test.cpp — the OpenCL host: embedded kernels with #line markers, the program cache,
 // BuildError carrying the log with the real file and line, named launches, device choice.
-#include "host/device.h"
-#include "host/embedded_kernels.h"
-#include "host/errors.h"
-#include "tests/test_util.h"
+#include "host/runtime/device.h"
+#include "host/runtime/embedded_kernels.h"
+#include "host/runtime/errors.h"
+#include "tests/support/test_util.h"
 
 #include <gtest/gtest.h>
 

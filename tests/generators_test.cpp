@@ -1,7 +1,7 @@
 // tests/generators_test.cpp — procedural volumes: Marschner–Lobb at points with closed-form values, the
 // [-1,1]^3 grid mapping, the sphere and blobs fields, and bad names and dims.
-#include "host/errors.h"
-#include "host/generators.h"
+#include "host/runtime/errors.h"
+#include "host/io/generators.h"
 
 #include <gtest/gtest.h>
 

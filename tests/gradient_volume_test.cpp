@@ -1,8 +1,8 @@
-// tests/gradient_volume_test.cpp — the Sobel gradient RGBA volume (host/gradient_volume.h): exact for linear
+// tests/gradient_volume_test.cpp — the Sobel gradient RGBA volume (host/optics/gradient_volume.h): exact for linear
 // fields (faces included), close to the analytic gradient of a smooth field, value kept in w.
-#include "host/gradient_volume.h"
+#include "host/optics/gradient_volume.h"
 
-#include "host/generators.h"
+#include "host/io/generators.h"
 
 #include <gtest/gtest.h>
 

@@ -1,13 +1,13 @@
-// tests/harc_entry_test.cpp — HARC's entry pass through the raster stage (host/render/harc_entry.h)
+// tests/harc_entry_test.cpp — HARC's entry pass through the raster stage (host/render/tet/harc_entry.h)
 // against the exact host crossing lists (buildHarcEntryLists: double ray-triangle intersections):
 // the same faces in the same order at almost every pixel and λ within float rounding on the non-convex
 // TetGen torus (two layers and more), perspective and parallel; nothing when the mesh is out of view.
-#include "host/render/harc_entry.h"
+#include "host/render/tet/harc_entry.h"
 
-#include "host/errors.h"
-#include "host/mesh_io.h"
-#include "host/scene.h"
-#include "tests/test_util.h"
+#include "host/runtime/errors.h"
+#include "host/io/mesh_io.h"
+#include "host/model/scene.h"
+#include "tests/support/test_util.h"
 
 #include <gtest/gtest.h>
 

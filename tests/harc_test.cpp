@@ -1,13 +1,13 @@
-// tests/harc_test.cpp — HARC with partial pre-integration (host/render/harc.h): options, the 80-byte
+// tests/harc_test.cpp — HARC with partial pre-integration (host/render/tet/harc.h): options, the 80-byte
 // layout, a single tetrahedron against the closed form, Kuhn-split box grids (convex and non-convex)
 // against an exact double-precision integral of a globally linear field, identical bits, independence
 // from splitting the transfer function, the step bound, and the paper's meshes against the exact
 // tetrahedral reference when host/tet_reference and host/mesh_io are present.
-#include "host/render/harc.h"
+#include "host/render/tet/harc.h"
 
-#include "host/errors.h"
-#include "host/psi_table.h"
-#include "tests/test_util.h"
+#include "host/runtime/errors.h"
+#include "host/optics/psi_table.h"
+#include "tests/support/test_util.h"
 
 #include <gtest/gtest.h>
 
@@ -593,10 +593,10 @@ TEST(Harc, EarlyTerminationStaysWithinItsThreshold)
 }  // namespace
 }  // namespace clvr
 
-// ---- the paper's meshes against the exact tetrahedral reference (host/tet_reference.h) -------------
-#include "host/mesh_io.h"
-#include "host/scene.h"
-#include "host/tet_reference.h"
+// ---- the paper's meshes against the exact tetrahedral reference (host/reference/tet_reference.h) -------------
+#include "host/io/mesh_io.h"
+#include "host/model/scene.h"
+#include "host/reference/tet_reference.h"
 
 namespace clvr {
 namespace {

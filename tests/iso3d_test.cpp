@@ -1,12 +1,12 @@
 // tests/iso3d_test.cpp — iso-surfaces by the alpha test (seeds/000 §3): options; the color matrix; the exact
 // first-hit reference on fields with known hits; the hit depth of the slices within one slice spacing of the
 // reference, coverage differing only at silhouettes; gradient shading against the reference's shade.
-#include "host/render/iso3d.h"
+#include "host/render/grid/iso3d.h"
 
-#include "host/errors.h"
-#include "host/generators.h"
-#include "host/iso_reference.h"
-#include "tests/test_util.h"
+#include "host/runtime/errors.h"
+#include "host/io/generators.h"
+#include "host/reference/iso_reference.h"
+#include "tests/support/test_util.h"
 
 #include <algorithm>
 #include <cmath>

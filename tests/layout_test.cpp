@@ -2,7 +2,7 @@
 // a kernel writes sizeof/offsetof of every Cl* struct as the device compiles it; the host compares.
 #include "raster/fragment_state.h"
 #include "raster/rasterizer.h"
-#include "tests/test_util.h"
+#include "tests/support/test_util.h"
 
 #include "kernels/texture.h"
 

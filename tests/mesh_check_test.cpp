@@ -1,8 +1,8 @@
 // tests/mesh_check_test.cpp — checkMesh and buildTopology on hand-made meshes: two tetrahedra sharing a
 // face, a cube split into 6, inverted and degenerate cells, a non-manifold face, bad indices and NaN, an
 // O-grid-like ring whose seam has duplicated points, and the time for a mesh of over a million tetrahedra.
-#include "host/errors.h"
-#include "host/mesh.h"
+#include "host/runtime/errors.h"
+#include "host/model/mesh.h"
 
 #include <gtest/gtest.h>
 

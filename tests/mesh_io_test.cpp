@@ -2,12 +2,12 @@
 // tetraMesh.vtk) with their counts and topology, round trips through TetGen and VTK ASCII/BINARY files
 // written here, hexahedron and wedge splits, the scene's "mesh" object, and malformed files giving a
 // one-line InputError that names the file. Files are written to a temporary directory.
-#include "host/errors.h"
-#include "host/generators.h"
-#include "host/mesh.h"
-#include "host/mesh_io.h"
-#include "host/tetgen_mesher.h"
-#include "tests/test_util.h"
+#include "host/runtime/errors.h"
+#include "host/io/generators.h"
+#include "host/model/mesh.h"
+#include "host/io/mesh_io.h"
+#include "host/io/tetgen_mesher.h"
+#include "tests/support/test_util.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

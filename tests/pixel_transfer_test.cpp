@@ -1,12 +1,12 @@
 // tests/pixel_transfer_test.cpp — kernels/pixel_transfer.cl against raster/reference/pixel_transfer.cpp
 // (double), and analytic checks: shifted draws land shifted, an identity-ramp pixel texture returns
 // the coordinates, glAccum's formulas.
-#include "host/errors.h"
+#include "host/runtime/errors.h"
 #include "raster/framebuffer.h"
 #include "raster/pixel_transfer.h"
 #include "raster/reference/pixel_transfer.h"
 #include "raster/texture.h"
-#include "tests/test_util.h"
+#include "tests/support/test_util.h"
 
 #include <gtest/gtest.h>
 

@@ -2,15 +2,15 @@
 // shaded reference integral (parallel and perspective), unshaded against the plain reference, early ray
 // termination and the opacity threshold within their bounds, the reflectance map's size showing within its
 // bound, identical bits twice, orientation.
-#include "host/render/planes.h"
+#include "host/render/grid/planes.h"
 
-#include "host/errors.h"
-#include "host/generators.h"
-#include "host/gradient_volume.h"
-#include "host/image_io.h"
-#include "host/reference_integral.h"
-#include "host/reflectance_map.h"
-#include "tests/test_util.h"
+#include "host/runtime/errors.h"
+#include "host/io/generators.h"
+#include "host/optics/gradient_volume.h"
+#include "host/io/image_io.h"
+#include "host/reference/reference_integral.h"
+#include "host/optics/reflectance_map.h"
+#include "tests/support/test_util.h"
 
 #include <algorithm>
 #include <cmath>

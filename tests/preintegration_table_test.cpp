@@ -1,11 +1,11 @@
-// tests/preintegration_table_test.cpp — the full pre-integration table (host/preintegration_table.h):
-// entries at the grid points are the exact segment integral of host/tet_reference.h rounded to float,
+// tests/preintegration_table_test.cpp — the full pre-integration table (host/optics/preintegration_table.h):
+// entries at the grid points are the exact segment integral of host/reference/tet_reference.h rounded to float,
 // independent closed forms where there is one, bits independent of the thread count, and trilinear
 // lookups between grid points within a stated (measured) tolerance that shrinks with the resolution.
-#include "host/preintegration_table.h"
+#include "host/optics/preintegration_table.h"
 
-#include "host/tet_reference.h"
-#include "tests/test_util.h"
+#include "host/reference/tet_reference.h"
+#include "tests/support/test_util.h"
 
 #include <gtest/gtest.h>
 

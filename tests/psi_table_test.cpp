@@ -1,8 +1,8 @@
 // tests/psi_table_test.cpp — ψ of Eq. 4 (seeds/001): the quadrature against closed forms, and the
 // 512² γ-table's bilinear lookup against the quadrature over the whole range τl ∈ [0, ∞).
-#include "host/psi_table.h"
+#include "host/optics/psi_table.h"
 
-#include "tests/test_util.h"
+#include "tests/support/test_util.h"
 
 #include <gtest/gtest.h>
 

@@ -1,11 +1,11 @@
 // tests/raster_test.cpp — the ordered triangle rasterizer (raster/rasterizer.h) against the CPU
 // reference (raster/reference/rasterizer.h) and against closed-form geometry: coverage and stencil
 // exact, color and depth within stated float tolerances, fill rule, clipping, perspective, order.
-#include "host/errors.h"
+#include "host/runtime/errors.h"
 #include "raster/rasterizer.h"
 #include "raster/reference/rasterizer.h"
 #include "raster/texture.h"
-#include "tests/test_util.h"
+#include "tests/support/test_util.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>

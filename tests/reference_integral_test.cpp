@@ -1,9 +1,9 @@
 // tests/reference_integral_test.cpp — the CPU reference integral against closed forms: constant
 // media (I = C (1 - exp(-tau L))), a linear ramp of extinction (A = 1 - exp(-∫tau)), background
 // compositing and empty volumes, for perspective and parallel cameras.
-#include "host/reference_integral.h"
+#include "host/reference/reference_integral.h"
 
-#include "tests/test_util.h"
+#include "tests/support/test_util.h"
 
 #include <cmath>
 

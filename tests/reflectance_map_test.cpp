@@ -1,8 +1,8 @@
-// tests/reflectance_map_test.cpp — the reflectance map (host/reflectance_map.h) against direct Phong within
+// tests/reflectance_map_test.cpp — the reflectance map (host/optics/reflectance_map.h) against direct Phong within
 // its derived quantization bound, the cube-face indexing, and the scene's lights and material.
-#include "host/reflectance_map.h"
+#include "host/optics/reflectance_map.h"
 
-#include "tests/test_util.h"
+#include "tests/support/test_util.h"
 
 #include <cmath>
 #include <cstdio>

@@ -1,8 +1,8 @@
 // tests/scene_test.cpp — scene JSON parsing and validation: every bad input is an InputError that
 // names the file and the key; --set overrides; the embedded default scene equals data/scenes/default.json.
-#include "host/errors.h"
-#include "host/scene.h"
-#include "test_util.h"
+#include "host/runtime/errors.h"
+#include "host/model/scene.h"
+#include "tests/support/test_util.h"
 
 #include <gtest/gtest.h>
 

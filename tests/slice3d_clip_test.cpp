@@ -2,15 +2,15 @@
 // (§2.1 of seeds/000): two-pass clipping by a sphere, a box, a cylinder and a torus (non-convex),
 // and the inverse, against the reference integral restricted to the inside (outside) of the same
 // mesh; the naive back-face-only stencil (the paper's Figure 2) shown wrong on the torus; options.
-#include "host/render/slice3d.h"
+#include "host/render/grid/slice3d.h"
 
-#include "host/clip_mesh.h"
-#include "host/errors.h"
-#include "host/generators.h"
-#include "host/image_io.h"
-#include "host/reference_integral.h"
+#include "host/optics/clip_mesh.h"
+#include "host/runtime/errors.h"
+#include "host/io/generators.h"
+#include "host/io/image_io.h"
+#include "host/reference/reference_integral.h"
 #include "host/render/renderer.h"
-#include "tests/test_util.h"
+#include "tests/support/test_util.h"
 
 #include <algorithm>
 #include <cmath>

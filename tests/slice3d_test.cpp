@@ -1,15 +1,15 @@
 // tests/slice3d_test.cpp — 3D-texture slicing: slice polygons, options, the fused kernel against the
 // CPU reference integral (error falling with the slice count), back-to-front == front-to-back,
 // early ray termination bound, fused == pass-by-pass raster path, identical bits, orientation.
-#include "host/render/slice3d.h"
+#include "host/render/grid/slice3d.h"
 
-#include "host/errors.h"
-#include "host/generators.h"
-#include "host/image_io.h"
-#include "host/reference_integral.h"
+#include "host/runtime/errors.h"
+#include "host/io/generators.h"
+#include "host/io/image_io.h"
+#include "host/reference/reference_integral.h"
 #include "host/render/renderer.h"
-#include "host/volume_io.h"
-#include "tests/test_util.h"
+#include "host/io/volume_io.h"
+#include "tests/support/test_util.h"
 
 #include <algorithm>
 #include <cmath>

@@ -2,15 +2,15 @@
 // faces and seam, one shell's pixel pass against a direct per-pixel evaluation, the image against the
 // CPU reference integral with the error falling as shells and segments grow, the color-matrix bias
 // rotating φ, and the technique chosen from a scene file.
-#include "host/render/spherical.h"
+#include "host/render/grid/spherical.h"
 
-#include "host/errors.h"
-#include "host/generators.h"
+#include "host/runtime/errors.h"
+#include "host/io/generators.h"
 #include "host/render/renderer.h"
-#include "host/spherical_reference.h"
-#include "host/volume_io.h"
+#include "host/reference/spherical_reference.h"
+#include "host/io/volume_io.h"
 #include "raster/reference/texture.h"
-#include "tests/test_util.h"
+#include "tests/support/test_util.h"
 
 #include <algorithm>
 #include <cmath>

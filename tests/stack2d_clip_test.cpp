@@ -1,19 +1,19 @@
 // tests/stack2d_clip_test.cpp — stack2d clipped by a second "stencil" texture (seeds/003, "Clipping
-// with arbitrary clipping geometry"; host/clip_texture.h, the same options.clip_texture as slice3d):
+// with arbitrary clipping geometry"; host/optics/clip_texture.h, the same options.clip_texture as slice3d):
 // sphere (inside, inverse, moved by an offset) and box, both cameras, one slice per quad and three
 // slices per polygon, against the reference integral restricted to the clip intervals (as
 // tests/clip_texture_test.cpp builds it); a clip texture holding the whole volume changes nothing;
 // clipped samples are no iso-surface hits; bad input gives slice3d's errors.
-#include "host/clip_texture.h"
+#include "host/optics/clip_texture.h"
 
-#include "host/errors.h"
-#include "host/generators.h"
-#include "host/image_io.h"
-#include "host/reference_integral.h"
+#include "host/runtime/errors.h"
+#include "host/io/generators.h"
+#include "host/io/image_io.h"
+#include "host/reference/reference_integral.h"
 #include "host/render/renderer.h"
-#include "host/render/stack2d.h"
-#include "tests/clip_reference.h"
-#include "tests/test_util.h"
+#include "host/render/grid/stack2d.h"
+#include "tests/support/clip_reference.h"
+#include "tests/support/test_util.h"
 
 #include <algorithm>
 #include <cmath>
@@ -76,7 +76,7 @@ Image4f render(const Scene& scene, const Volume& volume = marschnerLobb41(), Fra
 
 ClipTextureSpec specOf(const Scene& scene) { return *parseStack2dOptions(scene.options).clipTexture; }
 
-// The references of tests/clip_reference.h for this file's volume and the scene's clip texture.
+// The references of tests/support/clip_reference.h for this file's volume and the scene's clip texture.
 Image4d shapeReference(const Scene& scene) { return test::shapeClipReference(marschnerLobb41(), scene, specOf(scene)); }
 
 Image4d textureReference(const Scene& scene) { return test::textureClipReference(marschnerLobb41(), scene, specOf(scene)); }

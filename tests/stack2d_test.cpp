@@ -1,15 +1,15 @@
 // tests/stack2d_test.cpp — 2D texture stacks: options, stack choice per view, slice planning (order,
 // weights, slabs), the image against the CPU reference integral with the error falling as
 // intermediate slices are added (the artifact of plain stacks), both cameras, identical bits.
-#include "host/render/stack2d.h"
+#include "host/render/grid/stack2d.h"
 
-#include "host/errors.h"
-#include "host/generators.h"
-#include "host/gradient_volume.h"
-#include "host/reference_integral.h"
-#include "host/reflectance_map.h"
+#include "host/runtime/errors.h"
+#include "host/io/generators.h"
+#include "host/optics/gradient_volume.h"
+#include "host/reference/reference_integral.h"
+#include "host/optics/reflectance_map.h"
 #include "host/render/renderer.h"
-#include "tests/test_util.h"
+#include "tests/support/test_util.h"
 
 #include <algorithm>
 #include <cmath>

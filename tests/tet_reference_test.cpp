@@ -2,10 +2,10 @@
 // zeta against adaptive long-double quadrature; a constant tetrahedron against C (1 - exp(-tau L));
 // linear fields on split cubes and perturbed grids against a fine RK4 of the same ray; transfer-function
 // split invariance; non-convex meshes (gap composition); background; camera placement; speed printout.
-#include "host/tet_reference.h"
+#include "host/reference/tet_reference.h"
 
-#include "host/reference_integral.h"
-#include "tests/test_util.h"
+#include "host/reference/reference_integral.h"
+#include "tests/support/test_util.h"
 
 #include <algorithm>
 #include <chrono>

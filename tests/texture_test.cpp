@@ -1,9 +1,9 @@
 // tests/texture_test.cpp — kernels/texture.h against raster/reference/texture.cpp (double), and
 // analytic checks: a linear ramp texture reproduces the coordinate; nearest returns stored texels.
-#include "host/errors.h"
+#include "host/runtime/errors.h"
 #include "raster/reference/texture.h"
 #include "raster/texture.h"
-#include "tests/test_util.h"
+#include "tests/support/test_util.h"
 
 #include <gtest/gtest.h>
 

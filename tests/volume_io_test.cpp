@@ -2,9 +2,9 @@
 // independently, bit-exact round trips through raw, NRRD (attached, detached, multi-file, gzip, ascii) and
 // VTK (ASCII, big-endian BINARY) files written here, the scene's "volume" object, and every bad input
 // giving a one-line InputError that names the file. Files are written to a temporary directory.
-#include "host/errors.h"
-#include "host/volume_io.h"
-#include "tests/test_util.h"
+#include "host/runtime/errors.h"
+#include "host/io/volume_io.h"
+#include "tests/support/test_util.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

@@ -2,8 +2,8 @@
 // TetGen mesh cache and the peer's files (tools/bench_mesh.h).
 #include "tools/bench_mesh.h"
 
-#include "host/errors.h"
-#include "host/mesh_io.h"
+#include "host/runtime/errors.h"
+#include "host/io/mesh_io.h"
 
 #include <cstdio>
 #include <fstream>

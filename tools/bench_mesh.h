@@ -4,9 +4,9 @@
 // docs/benchmarks.md says what each figure means.
 #pragma once
 
-#include "host/camera.h"
-#include "host/mesh.h"
-#include "host/scene.h"
+#include "host/model/camera.h"
+#include "host/model/mesh.h"
+#include "host/model/scene.h"
 
 #include <nlohmann/json.hpp>
 
@@ -34,7 +34,7 @@ struct MeshFigures {
 // that took frameMs (the median steady frame). InputError naming a missing key or a frameMs <= 0.
 MeshFigures meshFigures(const nlohmann::json& extra, double frameMs);
 
-// The scene's mesh, loaded as `clvr render` loads it (host/mesh_io.h loadMesh), except that a mesh
+// The scene's mesh, loaded as `clvr render` loads it (host/io/mesh_io.h loadMesh), except that a mesh
 // meshed from a surface ({"surface": ...}) is kept in cacheDir as TetGen BASE.{node,ele,neigh}, BASE =
 // <scene stem>-<16 hex digits of meshCacheKey>: read from there when present, else meshed, written
 // there (renamed into place, .node last) and returned. `progress` gets one line before meshing.

@@ -7,7 +7,7 @@
 // script can run the same suite on main's code and on this one (BENCHMARKS.md says how).
 #include "tools/bench_raster.h"
 
-#include "host/device.h"
+#include "host/runtime/device.h"
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
 

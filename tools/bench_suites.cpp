@@ -2,7 +2,7 @@
 // tools/bench.cpp so that tests/bench_test.cpp can compile it in and check the lists against the files.
 #include "tools/bench.h"
 
-#include "host/errors.h"
+#include "host/runtime/errors.h"
 
 #include <string>
 #include <vector>

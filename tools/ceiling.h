@@ -3,14 +3,14 @@
 // piecewise-linear transfer-function lookup, alpha = 1 - exp(-tau Delta), "over" compositing) as a
 // plain C++ loop, multithreaded with std::thread over rows. clvr bench reports clvr's samples/s as
 // a fraction of this loop's (docs/benchmarks.md). Not part of the library; tests/bench_test.cpp
-// checks its image against host/reference_integral.h.
+// checks its image against host/reference/reference_integral.h.
 #pragma once
 
-#include "host/camera.h"
-#include "host/image.h"
-#include "host/render/slice3d.h"
-#include "host/transfer_function.h"
-#include "host/volume.h"
+#include "host/model/camera.h"
+#include "host/model/image.h"
+#include "host/render/grid/slice3d.h"
+#include "host/model/transfer_function.h"
+#include "host/model/volume.h"
 
 #include <glm/glm.hpp>
 

@@ -1,5 +1,5 @@
 // tools/clvr.cpp — main(): the only place that prints an error or chooses an exit code.
-#include "host/errors.h"
+#include "host/runtime/errors.h"
 #include "tools/commands.h"
 
 #include <CL/opencl.hpp>

@@ -2,8 +2,8 @@
 // tools/render_command.cpp, bench in tools/bench.cpp. docs/cli.md documents every option.
 #include "tools/commands.h"
 
-#include "host/device.h"
-#include "host/errors.h"
+#include "host/runtime/device.h"
+#include "host/runtime/errors.h"
 #include "host/render/renderer.h"
 #if __has_include("tools/bench.h")  // tools/bench.{h,cpp} land separately; without them no `bench`
 #include "tools/bench.h"

@@ -1,9 +1,9 @@
 // tools/mesh_command.cpp — `clvr mesh SURFACE -o BASE [--quality Q] [--max-volume V] [--scalar S]`:
-// a tetrahedral mesh of a closed surface with TetGen (host/tetgen_mesher.h), written as BASE.node and
+// a tetrahedral mesh of a closed surface with TetGen (host/io/tetgen_mesher.h), written as BASE.node and
 // BASE.ele that a scene's {"mesh": {"file": "BASE.ele"}} reads back. docs/meshes.md documents it.
-#include "host/errors.h"
-#include "host/mesh_io.h"
-#include "host/tetgen_mesher.h"
+#include "host/runtime/errors.h"
+#include "host/io/mesh_io.h"
+#include "host/io/tetgen_mesher.h"
 
 #include <CLI/CLI.hpp>
 

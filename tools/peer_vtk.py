@@ -8,7 +8,7 @@ Run it as clvr bench does:  xvfb-run -a /usr/bin/python3 tools/peer_vtk.py SCENE
 
 The same integral as clvr (docs/benchmarks.md):
 - volume: the scene's NRRD / VTK legacy file as VTK reads it (native type), or the Marschner-Lobb
-  generator evaluated with numpy by the formula of host/generators.h (float32, [-1,1]^3);
+  generator evaluated with numpy by the formula of host/io/generators.h (float32, [-1,1]^3);
 - camera: position, focal point, view up, view angle (or parallel scale) as given; rays through
   pixel centres as in VTK;
 - colour: a vtkColorTransferFunction through the control points (s, r, g, b);
@@ -36,7 +36,7 @@ from peer_vtk_common import frame_figures, offscreen_view, timed_frames, volume_
 
 
 def marschner_lobb(dims):
-    """host/generators.h: grid point i at -1 + 2 i / (n - 1); f_M = 6, alpha = 0.25."""
+    """host/io/generators.h: grid point i at -1 + 2 i / (n - 1); f_M = 6, alpha = 0.25."""
     nx, ny, nz = dims
     x = np.linspace(-1.0, 1.0, nx)
     y = np.linspace(-1.0, 1.0, ny)

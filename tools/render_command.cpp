@@ -3,14 +3,14 @@
 // temporary file and renamed into place, so a failure never leaves a partial file (DESIGN.md).
 #include "tools/commands.h"
 
-#include "host/device.h"
-#include "host/errors.h"
-#include "host/image_io.h"
-#include "host/mesh_io.h"
+#include "host/runtime/device.h"
+#include "host/runtime/errors.h"
+#include "host/io/image_io.h"
+#include "host/io/mesh_io.h"
 #include "host/render/renderer.h"
-#include "host/scene.h"
-#include "host/volume.h"
-#include "host/volume_io.h"
+#include "host/model/scene.h"
+#include "host/model/volume.h"
+#include "host/io/volume_io.h"
 
 #include <nlohmann/json.hpp>
 

@@ -1,12 +1,12 @@
 // host/render/camera_args.h — the camera as every kernel and fragment program takes it: five float4s,
 // position, forward, right, up and (scale, aspect, 1 if parallel, 0), with scale = tan(view_angle / 2)
-// (perspective) or parallel_scale (parallel). A pixel's ray is then host/camera.cpp's PixelRays::at:
+// (perspective) or parallel_scale (parallel). A pixel's ray is then host/model/camera.cpp's PixelRays::at:
 // with ndc = ((x + 0.5) / width * 2 - 1, 1 - (y + 0.5) / height * 2), direction forward +
 // ndc.x scale aspect right + ndc.y scale up from the position, or, parallel, direction forward from
 // position + ndc.x scale aspect right + ndc.y scale up.
 #pragma once
 
-#include "host/camera.h"
+#include "host/model/camera.h"
 
 #include <CL/opencl.hpp>
 #include <glm/glm.hpp>

@@ -3,7 +3,7 @@
 // and a host vector as a cl_float4 kernel argument.
 #pragma once
 
-#include "host/errors.h"
+#include "host/runtime/errors.h"
 
 #include <CL/opencl.hpp>
 #include <glm/glm.hpp>

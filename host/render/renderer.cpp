@@ -1,14 +1,14 @@
 // host/render/renderer.cpp — technique names and the factories makeRenderer and makeMeshRenderer.
 #include "host/render/renderer.h"
 
-#include "host/errors.h"
-#include "host/render/blend.h"
-#include "host/render/harc.h"
-#include "host/render/iso3d.h"
-#include "host/render/planes.h"
-#include "host/render/slice3d.h"
-#include "host/render/spherical.h"
-#include "host/render/stack2d.h"
+#include "host/runtime/errors.h"
+#include "host/render/grid/blend.h"
+#include "host/render/tet/harc.h"
+#include "host/render/grid/iso3d.h"
+#include "host/render/grid/planes.h"
+#include "host/render/grid/slice3d.h"
+#include "host/render/grid/spherical.h"
+#include "host/render/grid/stack2d.h"
 
 #include <functional>
 

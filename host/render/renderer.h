@@ -2,11 +2,11 @@
 // then render frames. The tool and the benchmarks drive techniques only through this interface.
 #pragma once
 
-#include "host/device.h"
-#include "host/image.h"
-#include "host/mesh.h"
-#include "host/scene.h"
-#include "host/volume.h"
+#include "host/runtime/device.h"
+#include "host/model/image.h"
+#include "host/model/mesh.h"
+#include "host/model/scene.h"
+#include "host/model/volume.h"
 
 #include <nlohmann/json.hpp>
 

@@ -2,7 +2,7 @@
 // and accumulation buffer in double precision.
 #include "raster/reference/pixel_transfer.h"
 
-#include "host/errors.h"
+#include "host/runtime/errors.h"
 #include "raster/reference/texture.h"
 
 #include <algorithm>

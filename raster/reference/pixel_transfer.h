@@ -2,7 +2,7 @@
 // precision, on host images (DESIGN.md, raster stage: CPU reference). Used only by tests.
 #pragma once
 
-#include "host/image.h"
+#include "host/model/image.h"
 #include "raster/pixel_transfer.h"
 #include "raster/texture.h"
 

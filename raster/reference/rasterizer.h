@@ -2,7 +2,7 @@
 // (docs/raster.md) in plain double-precision C++, one triangle at a time. Used only by tests.
 #pragma once
 
-#include "host/image.h"
+#include "host/model/image.h"
 #include "raster/rasterizer.h"
 
 #include <glm/glm.hpp>

@@ -1,7 +1,7 @@
 // raster/reference/texture.cpp — GL 1.2 texture sampling (§3.8.5-3.8.7) in double precision.
 #include "raster/reference/texture.h"
 
-#include "host/errors.h"
+#include "host/runtime/errors.h"
 
 #include <algorithm>
 #include <cmath>

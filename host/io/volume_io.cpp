@@ -1,0 +1,1191 @@
+// host/io/volume_io.cpp — NRRD, raw and VTK legacy STRUCTURED_POINTS readers, and the scene's "volume" object.
+// Every size from a file is checked before it is used: counts are uint64 with overflow checks, files are
+// measured before they are read, and gzip output is bounded before it is allocated.
+#include "host/io/volume_io.h"
+
+#include "host/runtime/errors.h"
+#include "host/runtime/file_io.h"
+#include "host/io/generators.h"
+
+#include <nlohmann/json.hpp>
+#include <zlib.h>
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cctype>
+#include <charconv>
+#include <climits>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <optional>
+#include <sstream>
+#include <vector>
+
+namespace clvr {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// ---------------------------------------------------------------------------------------------------
+// Small text helpers.
+
+std::string trim(std::string_view s)
+{
+    std::size_t b = 0, e = s.size();
+    while (b < e && std::isspace(static_cast<unsigned char>(s[b])))
+        ++b;
+    while (e > b && std::isspace(static_cast<unsigned char>(s[e - 1])))
+        --e;
+    return std::string(s.substr(b, e - b));
+}
+
+std::string lower(std::string s)
+{
+    for (char& c : s)
+        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return s;
+}
+
+std::vector<std::string> splitWhitespace(std::string_view s)
+{
+    std::vector<std::string> out;
+    std::size_t i = 0;
+    while (i < s.size()) {
+        while (i < s.size() && std::isspace(static_cast<unsigned char>(s[i])))
+            ++i;
+        std::size_t j = i;
+        while (j < s.size() && !std::isspace(static_cast<unsigned char>(s[j])))
+            ++j;
+        if (j > i)
+            out.emplace_back(s.substr(i, j - i));
+        i = j;
+    }
+    return out;
+}
+
+// Text for messages: long or binary garbage is cut and made printable.
+std::string shown(std::string_view s)
+{
+    std::string out = "\"";
+    for (std::size_t i = 0; i < s.size() && i < 60; ++i)
+        out += std::isprint(static_cast<unsigned char>(s[i])) ? s[i] : '?';
+    if (s.size() > 60)
+        out += "...";
+    return out + "\"";
+}
+
+std::optional<long long> parseInteger(std::string_view s)
+{
+    long long v = 0;
+    if (!s.empty() && s[0] == '+')
+        s.remove_prefix(1);
+    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+    if (ec != std::errc() || end != s.data() + s.size() || s.empty())
+        return std::nullopt;
+    return v;
+}
+
+// Accepts what strtod accepts ("nan", "inf", exponents), but the whole token must be a number.
+std::optional<double> parseDouble(const std::string& s)
+{
+    if (s.empty())
+        return std::nullopt;
+    char* end = nullptr;
+    const double v = std::strtod(s.c_str(), &end);
+    if (end != s.c_str() + s.size())
+        return std::nullopt;
+    return v;
+}
+
+// A number as a person would write it: 0.5, -1, nan (std::to_string gives 0.500000).
+std::string num(double v)
+{
+    std::ostringstream s;
+    s << v;
+    return s.str();
+}
+
+std::string dimsText(const std::vector<long long>& sizes)
+{
+    std::string s;
+    for (std::size_t a = 0; a < sizes.size(); ++a) {
+        if (a)
+            s += 'x';
+        s += std::to_string(sizes[a]);
+    }
+    return s;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Sizes and files.
+
+// The grid point count, or InputError: every size must be a positive int and the product at most kMaxVoxels.
+std::uint64_t checkedVoxelCount(const std::string& source, const std::vector<long long>& sizes)
+{
+    std::uint64_t count = 1;
+    bool overflow = false;
+    for (std::size_t a = 0; a < sizes.size(); ++a) {
+        if (sizes[a] <= 0)
+            throw InputError(source + ": size of axis " + std::to_string(a) + " is " + std::to_string(sizes[a]) +
+                             ", sizes must be positive");
+        overflow = overflow || __builtin_mul_overflow(count, static_cast<std::uint64_t>(sizes[a]), &count);
+    }
+    bool tooLarge = overflow || count > kMaxVoxels;
+    for (long long s : sizes)
+        tooLarge = tooLarge || s > INT_MAX;
+    if (tooLarge)
+        throw InputError(source + ": " + dimsText(sizes) + " is too large (" +
+                         (overflow ? std::string("the product overflows") : std::to_string(count) + " grid points") +
+                         ", the limit is 2^34)");
+    checkHostMemoryForVoxels(source, count);
+    return count;
+}
+
+std::ifstream openBinary(const fs::path& path)
+{
+    fileSize(path);  // names a missing file or a directory before the stream hides why
+    std::ifstream in(path, std::ios::binary);
+    if (!in)
+        throw InputError(path.string() + ": cannot open for reading");
+    return in;
+}
+
+void readExactly(std::ifstream& in, const fs::path& path, std::uint64_t offset, char* dst, std::uint64_t n)
+{
+    in.clear();
+    in.seekg(static_cast<std::streamoff>(offset));
+    in.read(dst, static_cast<std::streamsize>(n));
+    if (!in || static_cast<std::uint64_t>(in.gcount()) != n)
+        throw InputError(path.string() + ": read error at byte " + std::to_string(offset));
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Sample conversion: bytes of any ScalarType and endianness to float, rejecting NaN and infinity.
+
+template <typename T>
+T loadSample(const unsigned char* p, bool swap)
+{
+    std::array<unsigned char, sizeof(T)> b;
+    std::memcpy(b.data(), p, sizeof(T));
+    if (swap)
+        std::reverse(b.begin(), b.end());
+    T v;
+    std::memcpy(&v, b.data(), sizeof(T));
+    return v;
+}
+
+template <typename T>
+void convertTyped(const unsigned char* src, std::size_t count, bool swap, float* dst)
+{
+    for (std::size_t i = 0; i < count; ++i)
+        dst[i] = static_cast<float>(loadSample<T>(src + i * sizeof(T), swap));
+}
+
+// Converts `count` samples; `first` is the index of src's first sample in the whole volume, for messages.
+void convertSamples(const std::string& source, const unsigned char* src, std::size_t count, ScalarType type,
+                    Endian endian, float* dst, std::uint64_t first, glm::ivec3 dims)
+{
+    const bool swap = scalarSize(type) > 1 && (endian == Endian::Big) != (std::endian::native == std::endian::big);
+    switch (type) {
+    case ScalarType::UInt8: convertTyped<std::uint8_t>(src, count, swap, dst); break;
+    case ScalarType::Int8: convertTyped<std::int8_t>(src, count, swap, dst); break;
+    case ScalarType::Int16: convertTyped<std::int16_t>(src, count, swap, dst); break;
+    case ScalarType::UInt16: convertTyped<std::uint16_t>(src, count, swap, dst); break;
+    case ScalarType::Int32: convertTyped<std::int32_t>(src, count, swap, dst); break;
+    case ScalarType::UInt32: convertTyped<std::uint32_t>(src, count, swap, dst); break;
+    case ScalarType::Float32: convertTyped<float>(src, count, swap, dst); break;
+    case ScalarType::Float64: convertTyped<double>(src, count, swap, dst); break;
+    }
+    if (type == ScalarType::Float32 || type == ScalarType::Float64) {
+        for (std::size_t i = 0; i < count; ++i) {
+            if (std::isfinite(dst[i]))
+                continue;
+            const std::uint64_t n = first + i;
+            const std::uint64_t nx = static_cast<std::uint64_t>(dims.x), nxy = nx * static_cast<std::uint64_t>(dims.y);
+            const double original = type == ScalarType::Float32
+                                        ? static_cast<double>(loadSample<float>(src + i * 4, swap))
+                                        : loadSample<double>(src + i * 8, swap);
+            throw InputError(source + ": value at grid point (" + std::to_string(n % nx) + "," +
+                             std::to_string(n / nx % static_cast<std::uint64_t>(dims.y)) + "," +
+                             std::to_string(n / nxy) + ") is " +
+                             (std::isnan(original) ? "NaN" : std::isinf(original) ? "infinite"
+                                                                                  : "too large for float"));
+        }
+    }
+}
+
+// Whole-token numbers (ASCII encodings) into floats, with the same NaN and infinity check.
+void storeAsciiValue(const std::string& source, const std::string& token, std::uint64_t index, float* dst)
+{
+    const std::optional<double> v = parseDouble(token);
+    if (!v)
+        throw InputError(source + ": value " + std::to_string(index) + " is " + shown(token) + ", not a number");
+    const float f = static_cast<float>(*v);
+    if (!std::isfinite(f))
+        throw InputError(source + ": value " + std::to_string(index) + " is " + shown(token) +
+                         (std::isnan(*v) ? " (NaN)" : " (infinite or too large for float)"));
+    *dst = f;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// gzip.
+
+// Inflates the gzip stream in `src` (several concatenated members allowed), discards the first `skip`
+// bytes of its output and writes the next `n` bytes to dst. Throws for truncated or corrupt data.
+// deflate never compresses better than 1032:1: more output than that from `compressed` bytes means the
+// data is truncated, and saying so before decompressing avoids allocating what a corrupt header asks for.
+bool gzipCanHold(std::uint64_t compressed, std::uint64_t n)
+{
+    return n <= compressed * 1032 + 1024;
+}
+
+void gunzip(const std::string& source, const std::vector<unsigned char>& src, std::uint64_t skip, unsigned char* dst,
+            std::uint64_t n, const std::string& sizeText)
+{
+    if (!gzipCanHold(src.size(), n + skip))
+        throw InputError(source + ": gzip data is truncated (" + std::to_string(src.size()) +
+                         " compressed bytes cannot hold " + sizeText + ")");
+    z_stream z{};
+    if (inflateInit2(&z, 16 + MAX_WBITS) != Z_OK)  // 16: gzip wrapper, as NRRD writes it
+        throw InputError(source + ": cannot initialise zlib");
+    std::vector<unsigned char> scratch(std::min<std::uint64_t>(skip, 1 << 20));
+    std::uint64_t in = 0, skipped = 0, out = 0;
+    std::string error;
+    while (out < n) {
+        if (z.avail_in == 0) {
+            const std::uint64_t chunk = std::min<std::uint64_t>(src.size() - in, UINT_MAX);
+            z.next_in = const_cast<unsigned char*>(src.data() + in);
+            z.avail_in = static_cast<uInt>(chunk);
+            in += chunk;
+        }
+        const bool skipping = skipped < skip;
+        unsigned char* target = skipping ? scratch.data() : dst + out;
+        const std::uint64_t want = skipping ? std::min<std::uint64_t>(skip - skipped, scratch.size()) : n - out;
+        z.next_out = target;
+        z.avail_out = static_cast<uInt>(std::min<std::uint64_t>(want, UINT_MAX));
+        const uInt before = z.avail_out;
+        const int rc = inflate(&z, Z_NO_FLUSH);
+        const std::uint64_t produced = before - z.avail_out;
+        (skipping ? skipped : out) += produced;
+        if (rc == Z_STREAM_END) {
+            if (z.avail_in == 0 && in == src.size())
+                break;  // all input used; checked below
+            if (inflateReset(&z) != Z_OK) {  // another gzip member follows
+                error = "corrupt gzip data";
+                break;
+            }
+            continue;
+        }
+        if (rc == Z_BUF_ERROR && z.avail_in == 0 && in == src.size())
+            break;  // the input ended mid-stream
+        if (rc != Z_OK && rc != Z_BUF_ERROR) {
+            error = std::string("corrupt gzip data (") + (z.msg ? z.msg : "zlib error " + std::to_string(rc)) + ")";
+            break;
+        }
+        if (rc == Z_BUF_ERROR && produced == 0 && z.avail_in != 0)
+            break;  // no progress possible
+    }
+    inflateEnd(&z);
+    if (!error.empty())
+        throw InputError(source + ": " + error);
+    if (out < n)
+        throw InputError(source + ": gzip data is truncated (decompresses to " + std::to_string(skipped + out) +
+                         " bytes, " + sizeText + (skip ? " after a byte skip of " + std::to_string(skip) : "") + ")");
+}
+
+// ---------------------------------------------------------------------------------------------------
+// NRRD.
+
+enum class NrrdEncoding { Raw, Gzip, Ascii };
+
+struct NrrdHeader {
+    fs::path path;
+    std::optional<long long> dimension;
+    std::optional<std::vector<long long>> sizes;
+    std::optional<ScalarType> type;
+    std::optional<NrrdEncoding> encoding;
+    std::optional<Endian> endian;
+    std::optional<std::vector<double>> spacings;         // per axis; NaN for a non-spatial axis
+    std::optional<std::vector<std::string>> directions;  // per axis: "(a,b,c)" or "none"
+    std::optional<std::string> origin;
+    long long byteSkip = 0;
+    long long lineSkip = 0;
+    std::vector<fs::path> dataFiles;  // empty: data attached after the header
+    std::uint64_t dataOffset = 0;     // attached: first byte after the blank line
+};
+
+std::optional<ScalarType> nrrdType(const std::string& t)
+{
+    static const std::array<std::pair<const char*, ScalarType>, 32> kNames{{
+        {"signed char", ScalarType::Int8},       {"int8", ScalarType::Int8},
+        {"int8_t", ScalarType::Int8},            {"uchar", ScalarType::UInt8},
+        {"unsigned char", ScalarType::UInt8},    {"uint8", ScalarType::UInt8},
+        {"uint8_t", ScalarType::UInt8},          {"short", ScalarType::Int16},
+        {"short int", ScalarType::Int16},        {"signed short", ScalarType::Int16},
+        {"signed short int", ScalarType::Int16}, {"int16", ScalarType::Int16},
+        {"int16_t", ScalarType::Int16},          {"ushort", ScalarType::UInt16},
+        {"unsigned short", ScalarType::UInt16},  {"unsigned short int", ScalarType::UInt16},
+        {"uint16", ScalarType::UInt16},          {"uint16_t", ScalarType::UInt16},
+        {"int", ScalarType::Int32},              {"signed int", ScalarType::Int32},
+        {"int32", ScalarType::Int32},            {"int32_t", ScalarType::Int32},
+        {"uint", ScalarType::UInt32},            {"unsigned int", ScalarType::UInt32},
+        {"uint32", ScalarType::UInt32},          {"uint32_t", ScalarType::UInt32},
+        {"float", ScalarType::Float32},          {"double", ScalarType::Float64},
+        {"float32", ScalarType::Float32},        {"float64", ScalarType::Float64},
+        {"single", ScalarType::Float32},         {"float32_t", ScalarType::Float32},
+    }};
+    // Internal runs of spaces count as one ("unsigned  char").
+    std::string norm;
+    for (const std::string& w : splitWhitespace(lower(t)))
+        norm += (norm.empty() ? "" : " ") + w;
+    for (const auto& [name, type] : kNames)
+        if (norm == name)
+            return type;
+    return std::nullopt;
+}
+
+// Field names are compared in lower case with spaces removed, so "data file" and "datafile" agree.
+std::string fieldKey(const std::string& name)
+{
+    std::string k;
+    for (char c : lower(name))
+        if (c != ' ')
+            k += c;
+    return k;
+}
+
+// Expands a "data file: <format> <min> <max> <step> [<subdim>]" format for one index: only %d, %i or %u
+// with optional flags and width (e.g. %03d) are accepted, and %% for a literal percent sign. The format
+// comes from the file, so it never reaches printf.
+std::string expandDataFileFormat(const std::string& source, const std::string& format, long long index)
+{
+    std::string out;
+    int conversions = 0;
+    for (std::size_t i = 0; i < format.size(); ++i) {
+        if (format[i] != '%') {
+            out += format[i];
+            continue;
+        }
+        if (i + 1 < format.size() && format[i + 1] == '%') {
+            out += '%';
+            ++i;
+            continue;
+        }
+        std::size_t j = i + 1;
+        bool zeroPad = false;
+        while (j < format.size() && (format[j] == '0' || format[j] == '-' || format[j] == '+' || format[j] == ' ')) {
+            zeroPad = zeroPad || format[j] == '0';
+            ++j;
+        }
+        int width = 0;
+        while (j < format.size() && std::isdigit(static_cast<unsigned char>(format[j])) && width < 100)
+            width = width * 10 + (format[j++] - '0');
+        if (j >= format.size() || (format[j] != 'd' && format[j] != 'i' && format[j] != 'u') || ++conversions > 1)
+            throw InputError(source + ": data file format " + shown(format) +
+                             " is not supported (one %d, %i or %u with an optional width)");
+        std::string digits = std::to_string(index < 0 ? -index : index);
+        const std::size_t len = digits.size() + (index < 0 ? 1 : 0);
+        if (static_cast<std::size_t>(width) > len)
+            digits.insert(0, static_cast<std::size_t>(width) - len, zeroPad ? '0' : ' ');
+        out += (index < 0 ? "-" : "") + digits;
+        i = j;
+    }
+    if (conversions == 0)
+        throw InputError(source + ": data file format " + shown(format) + " has no %d for the file number");
+    return out;
+}
+
+NrrdHeader readNrrdHeader(const fs::path& path)
+{
+    const std::string source = path.string();
+    std::ifstream in = openBinary(path);
+    NrrdHeader h;
+    h.path = path;
+
+    // Reads one line (without \n or \r\n); false at end of file. Lines and the header are bounded so
+    // that a binary file given as a header fails quickly.
+    constexpr std::size_t kMaxLine = 1 << 20, kMaxHeader = 16 << 20;
+    std::uint64_t consumed = 0;
+    std::size_t lineLimit = 64;  // for the magic line; kMaxLine after it
+    auto readLine = [&](std::string& line) {
+        line.clear();
+        int c;
+        bool any = false;
+        while ((c = in.get()) != EOF) {
+            any = true;
+            ++consumed;
+            if (c == '\n')
+                break;
+            if (line.size() >= lineLimit || consumed > kMaxHeader) {
+                if (lineLimit < kMaxLine)
+                    break;  // a magic line is 8 characters: this is not a NRRD file, said below
+                throw InputError(source + ": NRRD header line " + shown(line) + " is too long");
+            }
+            line += static_cast<char>(c);
+        }
+        if (!line.empty() && line.back() == '\r')
+            line.pop_back();
+        return any;
+    };
+
+    std::string line;
+    if (!readLine(line) || line.size() != 8 || line.compare(0, 4, "NRRD") != 0 ||
+        !std::all_of(line.begin() + 4, line.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }))
+        throw InputError(source + ": not a NRRD file (the first line is " + shown(line) +
+                         ", expected a magic line like \"NRRD0004\")");
+    lineLimit = kMaxLine;
+
+    bool blankLineSeen = false;
+    std::optional<std::string> dataFileValue;
+    bool listForm = false;
+    while (readLine(line)) {
+        if (listForm) {  // "data file: LIST": every remaining line names one data file
+            const std::string name = trim(line);
+            if (!name.empty())
+                h.dataFiles.push_back(name);
+            continue;
+        }
+        if (line.empty()) {
+            blankLineSeen = true;
+            break;
+        }
+        if (line[0] == '#')
+            continue;
+        if (line.find(":=") != std::string::npos && line.find(":=") < line.find(": "))
+            continue;  // key/value pair: free-form metadata
+        const std::size_t colon = line.find(": ");
+        if (colon == std::string::npos)
+            throw InputError(source + ": NRRD header line " + shown(line) + " is not \"field: value\"");
+        const std::string key = fieldKey(line.substr(0, colon));
+        const std::string value = trim(std::string_view(line).substr(colon + 2));
+        auto integer = [&](const char* what) {
+            const std::optional<long long> v = parseInteger(value);
+            if (!v)
+                throw InputError(source + ": " + what + " " + shown(value) + " is not an integer");
+            return *v;
+        };
+        if (key == "dimension") {
+            h.dimension = integer("dimension");
+        } else if (key == "sizes") {
+            std::vector<long long> sizes;
+            for (const std::string& t : splitWhitespace(value)) {
+                const std::optional<long long> v = parseInteger(t);
+                if (!v)
+                    throw InputError(source + ": sizes " + shown(value) + " are not integers");
+                sizes.push_back(*v);
+            }
+            h.sizes = sizes;
+        } else if (key == "type") {
+            h.type = nrrdType(value);
+            if (!h.type)
+                throw InputError(source + ": type " + shown(value) +
+                                 " is not supported (8, 16 and 32-bit integers, float and double are)");
+        } else if (key == "encoding") {
+            const std::string e = lower(value);
+            if (e == "raw")
+                h.encoding = NrrdEncoding::Raw;
+            else if (e == "gzip" || e == "gz")
+                h.encoding = NrrdEncoding::Gzip;
+            else if (e == "ascii" || e == "text" || e == "txt")
+                h.encoding = NrrdEncoding::Ascii;
+            else
+                throw InputError(source + ": encoding " + shown(value) +
+                                 " is not supported (raw, gzip and ascii are)");
+        } else if (key == "endian") {
+            const std::string e = lower(value);
+            if (e == "little")
+                h.endian = Endian::Little;
+            else if (e == "big")
+                h.endian = Endian::Big;
+            else
+                throw InputError(source + ": endian " + shown(value) + " is neither little nor big");
+        } else if (key == "spacings") {
+            std::vector<double> s;
+            for (const std::string& t : splitWhitespace(value)) {
+                const std::optional<double> v = parseDouble(t);
+                if (!v)
+                    throw InputError(source + ": spacings " + shown(value) + " are not numbers");
+                s.push_back(*v);
+            }
+            h.spacings = s;
+        } else if (key == "spacedirections") {
+            // "(1,0,0) (0,1,0) none": a vector may hold spaces, "(1, 0, 0)", so split on parentheses.
+            std::vector<std::string> dirs;
+            for (std::size_t i = 0; i < value.size();) {
+                if (std::isspace(static_cast<unsigned char>(value[i]))) {
+                    ++i;
+                    continue;
+                }
+                std::size_t j = i;
+                if (value[i] == '(') {
+                    j = value.find(')', i);
+                    j = j == std::string::npos ? value.size() : j + 1;
+                } else {
+                    while (j < value.size() && !std::isspace(static_cast<unsigned char>(value[j])))
+                        ++j;
+                }
+                std::string d;
+                for (std::size_t k = i; k < j; ++k)
+                    if (!std::isspace(static_cast<unsigned char>(value[k])))
+                        d += value[k];
+                dirs.push_back(d);
+                i = j;
+            }
+            h.directions = dirs;
+        } else if (key == "spaceorigin") {
+            h.origin = value;
+        } else if (key == "space") {
+            // Any named 3D space ("left-posterior-superior", "3D-left-handed", ...); only the dimension matters.
+            const std::string s = lower(value);
+            static const std::array<const char*, 4> kTwoOrFour{"right-anterior-superior-time", "ras-time",
+                                                               "left-anterior-superior-time", "scanner-xyz-time"};
+            for (const char* t : kTwoOrFour)
+                if (s == t)
+                    throw InputError(source + ": space " + shown(value) + " is not 3D");
+        } else if (key == "spacedimension") {
+            if (integer("space dimension") != 3)
+                throw InputError(source + ": space dimension is " + value + ", only 3 is read");
+        } else if (key == "byteskip") {
+            h.byteSkip = integer("byte skip");
+            if (h.byteSkip < -1)
+                throw InputError(source + ": byte skip " + value + " must be -1 or at least 0");
+        } else if (key == "lineskip") {
+            h.lineSkip = integer("line skip");
+            if (h.lineSkip < 0)
+                throw InputError(source + ": line skip " + value + " must be at least 0");
+        } else if (key == "datafile") {
+            dataFileValue = value;
+            const std::vector<std::string> words = splitWhitespace(value);
+            if (!words.empty() && words[0] == "LIST") {
+                if (words.size() > 2)
+                    throw InputError(source + ": data file " + shown(value) + " is not \"LIST [<subdim>]\"");
+                listForm = true;
+            }
+        }
+        // Every other field (content, kinds, centers, units, labels, min/max, measurement frame, ...)
+        // says nothing about layout and is ignored.
+    }
+    if (!blankLineSeen && !listForm && !dataFileValue)
+        throw InputError(source + ": NRRD header has no data file field and no blank line before attached data");
+    h.dataOffset = consumed;
+
+    const fs::path dir = path.parent_path();
+    auto relative = [&](const std::string& name) { return fs::path(name).is_absolute() ? fs::path(name) : dir / name; };
+    if (listForm) {
+        for (fs::path& f : h.dataFiles)
+            f = relative(f.string());
+        if (h.dataFiles.empty())
+            throw InputError(source + ": data file LIST names no files");
+    } else if (dataFileValue && *dataFileValue != "LOCAL") {
+        const std::vector<std::string> words = splitWhitespace(*dataFileValue);
+        if (words.size() == 1) {
+            h.dataFiles.push_back(relative(words[0]));
+        } else if (words.size() == 4 || words.size() == 5) {
+            const auto lo = parseInteger(words[1]), hi = parseInteger(words[2]), step = parseInteger(words[3]);
+            constexpr long long kMaxIndex = 1LL << 40;  // keeps the arithmetic below far from overflow
+            auto inRange = [&](const std::optional<long long>& x) { return x && *x > -kMaxIndex && *x < kMaxIndex; };
+            if (!inRange(lo) || !inRange(hi) || !inRange(step) || *step == 0 || (*hi - *lo) / *step < 0)
+                throw InputError(source + ": data file " + shown(*dataFileValue) +
+                                 " is not \"<format> <min> <max> <step> [<subdim>]\"");
+            const std::uint64_t count = static_cast<std::uint64_t>((*hi - *lo) / *step) + 1;
+            if (count > (1u << 20))
+                throw InputError(source + ": data file " + shown(*dataFileValue) + " names too many files");
+            for (std::uint64_t n = 0; n < count; ++n)
+                h.dataFiles.push_back(relative(expandDataFileFormat(source, words[0], *lo + static_cast<long long>(n) * *step)));
+        } else {
+            throw InputError(source + ": data file " + shown(*dataFileValue) +
+                             " is not one name, \"<format> <min> <max> <step> [<subdim>]\" or \"LIST\"");
+        }
+    }
+    return h;
+}
+
+// Parses "(a,b,c)" with exactly three components.
+std::optional<glm::dvec3> parseVector(const std::string& s)
+{
+    if (s.size() < 2 || s.front() != '(' || s.back() != ')')
+        return std::nullopt;
+    std::vector<double> v;
+    std::stringstream parts(s.substr(1, s.size() - 2));
+    std::string part;
+    while (std::getline(parts, part, ',')) {
+        const std::optional<double> d = parseDouble(trim(part));
+        if (!d)
+            return std::nullopt;
+        v.push_back(*d);
+    }
+    if (v.size() != 3)
+        return std::nullopt;
+    return glm::dvec3(v[0], v[1], v[2]);
+}
+
+// Reads one data file's share of the samples (or the attached data) and appends them to `out`. Every size
+// is checked before `out` grows, so a corrupt header cannot make it allocate more than the file can hold.
+void readNrrdData(const NrrdHeader& h, const fs::path& file, std::uint64_t start, std::uint64_t count,
+                  std::vector<float>& out, glm::ivec3 dims, const std::string& sizeText)
+{
+    const std::string source = file.string();
+    const std::uint64_t size = fileSize(file);
+    const std::uint64_t first = out.size();  // index of this file's first sample, for messages
+    std::ifstream in = openBinary(file);
+    in.seekg(static_cast<std::streamoff>(start));
+    for (long long l = 0; l < h.lineSkip; ++l) {
+        int c;
+        while ((c = in.get()) != EOF && c != '\n') {
+        }
+        if (c == EOF)
+            throw InputError(source + ": line skip " + std::to_string(h.lineSkip) + " goes past the end of the file");
+    }
+    std::uint64_t pos = static_cast<std::uint64_t>(static_cast<std::streamoff>(in.tellg()));
+    const std::size_t elem = scalarSize(*h.type);
+    const std::uint64_t bytes = count * elem;
+    const Endian endian = h.endian.value_or(Endian::Little);
+    auto tooShort = [&](std::uint64_t available) {
+        return InputError(source + ": " + sizeText + ", file has " + std::to_string(available) + " bytes" +
+                          (pos == 0                               ? std::string()
+                           : h.byteSkip == 0 && h.lineSkip == 0 ? " after the " + std::to_string(pos) + "-byte header"
+                                                                : " after " + std::to_string(pos) +
+                                                                      " bytes of header and skips"));
+    };
+
+    if (*h.encoding == NrrdEncoding::Raw) {
+        if (h.byteSkip == -1) {  // the data is the last `bytes` of the file
+            if (size < bytes || size - bytes < pos)
+                throw tooShort(size - pos);
+            pos = size - bytes;
+        } else {
+            pos += static_cast<std::uint64_t>(h.byteSkip);
+        }
+        const std::uint64_t available = size > pos ? size - pos : 0;
+        if (available < bytes)
+            throw tooShort(available);
+        std::vector<unsigned char> raw(static_cast<std::size_t>(bytes));
+        readExactly(in, file, pos, reinterpret_cast<char*>(raw.data()), bytes);
+        out.resize(static_cast<std::size_t>(first + count));
+        convertSamples(source, raw.data(), static_cast<std::size_t>(count), *h.type, endian, out.data() + first,
+                       first, dims);
+        return;
+    }
+
+    if (h.byteSkip == -1)
+        throw InputError(source + ": byte skip -1 is only allowed with raw encoding");
+    const std::uint64_t skip = static_cast<std::uint64_t>(h.byteSkip);
+    // gzip and ascii: the rest of the file, whole.
+    const std::uint64_t rest = size > pos ? size - pos : 0;
+    if (*h.encoding == NrrdEncoding::Gzip && !gzipCanHold(rest, bytes + skip))
+        throw InputError(source + ": gzip data is truncated (" + std::to_string(rest) +
+                         " compressed bytes cannot hold " + sizeText + ")");
+    std::vector<unsigned char> data(static_cast<std::size_t>(rest));
+    if (rest)
+        readExactly(in, file, pos, reinterpret_cast<char*>(data.data()), rest);
+
+    if (*h.encoding == NrrdEncoding::Gzip) {
+        std::vector<unsigned char> raw(static_cast<std::size_t>(bytes));
+        gunzip(source, data, skip, raw.data(), bytes, sizeText);
+        out.resize(static_cast<std::size_t>(first + count));
+        convertSamples(source, raw.data(), static_cast<std::size_t>(count), *h.type, endian, out.data() + first,
+                       first, dims);
+        return;
+    }
+
+    // ascii: whitespace- or comma-separated numbers; byte skip counts characters. `out` grows with the
+    // values actually found.
+    std::uint64_t n = 0;
+    std::size_t i = static_cast<std::size_t>(std::min<std::uint64_t>(skip, data.size()));
+    std::string token;
+    float value = 0.0f;
+    while (n < count && i < data.size()) {
+        while (i < data.size() && (std::isspace(data[i]) || data[i] == ','))
+            ++i;
+        token.clear();
+        while (i < data.size() && !std::isspace(data[i]) && data[i] != ',') {
+            if (token.size() < 64)
+                token += static_cast<char>(data[i]);
+            else if (token.size() == 64)
+                token += "...";  // a 64-character number is garbage: fail on it, do not split it
+            ++i;
+        }
+        if (!token.empty()) {
+            storeAsciiValue(source, token, first + n, &value);
+            out.push_back(value);
+            ++n;
+        }
+    }
+    if (n < count)
+        throw InputError(source + ": ascii data is truncated: header says " + std::to_string(count) +
+                         " values, file has " + std::to_string(n));
+}
+
+// ---------------------------------------------------------------------------------------------------
+// VTK legacy.
+
+std::optional<ScalarType> vtkType(const std::string& t)
+{
+    const std::string s = lower(t);
+    if (s == "unsigned_char") return ScalarType::UInt8;
+    if (s == "char" || s == "signed_char") return ScalarType::Int8;
+    if (s == "short") return ScalarType::Int16;
+    if (s == "unsigned_short") return ScalarType::UInt16;
+    if (s == "int") return ScalarType::Int32;
+    if (s == "unsigned_int") return ScalarType::UInt32;
+    if (s == "float") return ScalarType::Float32;
+    if (s == "double") return ScalarType::Float64;
+    return std::nullopt;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// The scene's "volume" object.
+
+[[noreturn]] void badKey(const std::string& key, const std::string& what)
+{
+    throw InputError("volume: \"" + key + "\" " + what);
+}
+
+glm::dvec3 jsonVec3(const nlohmann::json& spec, const std::string& key)
+{
+    const nlohmann::json& v = spec.at(key);
+    if (!v.is_array() || v.size() != 3 || !std::all_of(v.begin(), v.end(), [](const auto& x) { return x.is_number(); }))
+        badKey(key, "must be an array of 3 numbers");
+    return {v[0].get<double>(), v[1].get<double>(), v[2].get<double>()};
+}
+
+glm::ivec3 jsonDims(const nlohmann::json& spec)
+{
+    if (!spec.contains("dims"))
+        badKey("dims", "is missing");
+    const nlohmann::json& v = spec.at("dims");
+    if (!v.is_array() || v.size() != 3 ||
+        !std::all_of(v.begin(), v.end(), [](const auto& x) { return x.is_number_integer(); }))
+        badKey("dims", "must be an array of 3 integers");
+    glm::ivec3 d;
+    for (int a = 0; a < 3; ++a) {
+        const long long n = v[static_cast<std::size_t>(a)].get<long long>();
+        if (n < 1 || n > INT_MAX)
+            badKey("dims", "[" + std::to_string(a) + "] is " + std::to_string(n) + ", must be a positive int");
+        d[a] = static_cast<int>(n);
+    }
+    return d;
+}
+
+std::string jsonString(const nlohmann::json& spec, const std::string& key)
+{
+    const nlohmann::json& v = spec.at(key);
+    if (!v.is_string())
+        badKey(key, "must be a string");
+    return v.get<std::string>();
+}
+
+void checkKeys(const nlohmann::json& spec, std::initializer_list<const char*> allowed, const std::string& form)
+{
+    for (auto it = spec.begin(); it != spec.end(); ++it) {
+        if (std::none_of(allowed.begin(), allowed.end(), [&](const char* k) { return it.key() == k; })) {
+            std::string list;
+            for (const char* k : allowed)
+                list += (list.empty() ? "" : ", ") + std::string(k);
+            throw InputError("volume: unknown key \"" + it.key() + "\" for " + form + " (allowed: " + list + ")");
+        }
+    }
+}
+
+}  // namespace
+
+std::size_t scalarSize(ScalarType type)
+{
+    switch (type) {
+    case ScalarType::UInt8:
+    case ScalarType::Int8: return 1;
+    case ScalarType::Int16:
+    case ScalarType::UInt16: return 2;
+    case ScalarType::Int32:
+    case ScalarType::UInt32:
+    case ScalarType::Float32: return 4;
+    case ScalarType::Float64: return 8;
+    }
+    return 1;
+}
+
+Volume readNrrd(const fs::path& path)
+{
+    const std::string source = path.string();
+    const NrrdHeader h = readNrrdHeader(path);
+    if (!h.dimension)
+        throw InputError(source + ": NRRD header is missing the required field \"dimension\"");
+    if (!h.sizes)
+        throw InputError(source + ": NRRD header is missing the required field \"sizes\"");
+    if (!h.type)
+        throw InputError(source + ": NRRD header is missing the required field \"type\"");
+    if (!h.encoding)
+        throw InputError(source + ": NRRD header is missing the required field \"encoding\"");
+    const long long dim = *h.dimension;
+    if (dim != 3 && dim != 4)
+        throw InputError(source + ": dimension is " + std::to_string(dim) + ", only 3D volumes are read");
+    if (static_cast<long long>(h.sizes->size()) != dim)
+        throw InputError(source + ": sizes has " + std::to_string(h.sizes->size()) + " entries for dimension " +
+                         std::to_string(dim));
+    const std::uint64_t count = checkedVoxelCount(source, *h.sizes);
+    // Dimension 4 is read only as one scalar per grid point with an explicit first axis of size 1.
+    const std::size_t skipAxes = dim == 4 ? 1 : 0;
+    if (dim == 4 && (*h.sizes)[0] != 1)
+        throw InputError(source + ": dimension is 4 with " + std::to_string((*h.sizes)[0]) +
+                         " values per grid point, only one scalar per grid point is read");
+    if (scalarSize(*h.type) > 1 && *h.encoding != NrrdEncoding::Ascii && !h.endian)
+        throw InputError(source + ": NRRD header is missing the required field \"endian\" (the type has " +
+                         std::to_string(scalarSize(*h.type)) + " bytes)");
+
+    Volume v;
+    v.source = source;
+    v.dims = glm::ivec3(static_cast<int>((*h.sizes)[skipAxes]), static_cast<int>((*h.sizes)[skipAxes + 1]),
+                        static_cast<int>((*h.sizes)[skipAxes + 2]));
+
+    if (h.spacings && h.directions)
+        throw InputError(source + ": has both spacings and space directions");
+    if (h.spacings) {
+        if (static_cast<long long>(h.spacings->size()) != dim)
+            throw InputError(source + ": spacings has " + std::to_string(h.spacings->size()) +
+                             " entries for dimension " + std::to_string(dim));
+        for (int a = 0; a < 3; ++a) {
+            const double s = (*h.spacings)[skipAxes + static_cast<std::size_t>(a)];
+            if (!(s > 0.0) || !std::isfinite(s))
+                throw InputError(source + ": spacing of axis " + std::to_string(a) + " is " + num(s) +
+                                 ", must be a positive finite number");
+            v.spacing[a] = s;
+        }
+    }
+    if (h.directions) {
+        if (static_cast<long long>(h.directions->size()) != dim)
+            throw InputError(source + ": space directions has " + std::to_string(h.directions->size()) +
+                             " entries for dimension " + std::to_string(dim));
+        if (dim == 4 && (*h.directions)[0] != "none")
+            throw InputError(source + ": the first space direction of a 4D volume must be none");
+        for (int a = 0; a < 3; ++a) {
+            const std::string& text = (*h.directions)[skipAxes + static_cast<std::size_t>(a)];
+            const std::optional<glm::dvec3> d = parseVector(text);
+            if (!d)
+                throw InputError(source + ": space direction " + shown(text) + " of axis " + std::to_string(a) +
+                                 " is not a vector (x,y,z)");
+            for (int b = 0; b < 3; ++b)
+                if (b != a && (*d)[b] != 0.0)
+                    throw InputError(source + ": space directions are not axis-aligned (axis " + std::to_string(a) +
+                                     " is " + text + "), only axis-aligned grids are read");
+            if (!((*d)[a] > 0.0) || !std::isfinite((*d)[a]))
+                throw InputError(source + ": space direction of axis " + std::to_string(a) + " is " + text +
+                                 ", its spacing must be a positive finite number");
+            v.spacing[a] = (*d)[a];
+        }
+    }
+    if (h.origin) {
+        const std::optional<glm::dvec3> o = parseVector(*h.origin);
+        if (!o || !std::isfinite(o->x) || !std::isfinite(o->y) || !std::isfinite(o->z))
+            throw InputError(source + ": space origin " + shown(*h.origin) + " is not a finite vector (x,y,z)");
+        v.origin = *o;
+    }
+
+    const std::size_t elem = scalarSize(*h.type);
+    const std::string sizes = dimsText(*h.sizes) + " x " + std::to_string(elem) + " bytes";
+    if (h.dataFiles.empty()) {
+        const std::string sizeText = "header says " + sizes + " = " + std::to_string(count * elem) + " bytes";
+        if (*h.encoding == NrrdEncoding::Raw)
+            v.values.reserve(static_cast<std::size_t>(count));  // the size is checked before values are read
+        readNrrdData(h, path, h.dataOffset, count, v.values, v.dims, sizeText);
+    } else {
+        // Several files share the samples equally, in order (slices of the slowest axis, usually).
+        const std::uint64_t files = h.dataFiles.size();
+        if (count % files != 0)
+            throw InputError(source + ": " + std::to_string(count) + " grid points do not split evenly into " +
+                             std::to_string(files) + " data files");
+        const std::uint64_t per = count / files;
+        const std::string sizeText =
+            files == 1 ? "header says " + sizes + " = " + std::to_string(count * elem) + " bytes"
+                       : "header says " + sizes + " in " + std::to_string(files) + " files = " +
+                             std::to_string(per * elem) + " bytes per file";
+        // Reserve the whole volume only when every file is at least plausibly big enough; otherwise the
+        // exact check on the first short file throws.
+        bool plausible = *h.encoding != NrrdEncoding::Ascii;
+        for (std::uint64_t f = 0; f < files && plausible; ++f) {
+            std::error_code ec;
+            const std::uint64_t fileBytes = fs::file_size(h.dataFiles[f], ec);
+            plausible = !ec && (*h.encoding == NrrdEncoding::Raw ? fileBytes >= per * elem
+                                                                  : gzipCanHold(fileBytes, per * elem));
+        }
+        if (plausible)
+            v.values.reserve(static_cast<std::size_t>(count));
+        for (std::uint64_t f = 0; f < files; ++f)
+            readNrrdData(h, h.dataFiles[f], 0, per, v.values, v.dims, sizeText);
+    }
+    v.validate();
+    return v;
+}
+
+Volume readRaw(const fs::path& path, const RawLayout& layout)
+{
+    const std::string source = path.string();
+    const std::vector<long long> sizes{layout.dims.x, layout.dims.y, layout.dims.z};
+    const std::uint64_t count = checkedVoxelCount(source, sizes);
+    for (int a = 0; a < 3; ++a)
+        if (!(layout.spacing[a] > 0.0) || !std::isfinite(layout.spacing[a]))
+            throw InputError(source + ": spacing of axis " + std::to_string(a) + " must be a positive finite number");
+    const std::size_t elem = scalarSize(layout.type);
+    const std::uint64_t bytes = count * elem;
+    const std::uint64_t size = fileSize(path);
+    if (layout.headerBytes > kMaxVoxels * 8 || size != layout.headerBytes + bytes)
+        throw InputError(source + ": layout says " + dimsText(sizes) + " x " + std::to_string(elem) + " bytes" +
+                         (layout.headerBytes ? " + " + std::to_string(layout.headerBytes) + " header bytes" : "") +
+                         " = " + std::to_string(layout.headerBytes + bytes) + " bytes, file has " +
+                         std::to_string(size) + " bytes");
+    std::ifstream in = openBinary(path);
+    std::vector<unsigned char> raw(static_cast<std::size_t>(bytes));
+    readExactly(in, path, layout.headerBytes, reinterpret_cast<char*>(raw.data()), bytes);
+    Volume v;
+    v.source = source;
+    v.dims = layout.dims;
+    v.spacing = layout.spacing;
+    v.origin = layout.origin;
+    v.values.resize(static_cast<std::size_t>(count));
+    convertSamples(source, raw.data(), static_cast<std::size_t>(count), layout.type, layout.endian, v.values.data(),
+                   0, v.dims);
+    v.validate();
+    return v;
+}
+
+Volume readVtkStructuredPoints(const fs::path& path)
+{
+    const std::string source = path.string();
+    const std::uint64_t size = fileSize(path);
+    std::ifstream in = openBinary(path);
+    std::string text(static_cast<std::size_t>(size), '\0');
+    if (size)
+        readExactly(in, path, 0, text.data(), size);
+
+    std::size_t pos = 0;
+    auto nextLine = [&]() -> std::optional<std::string> {
+        if (pos >= text.size())
+            return std::nullopt;
+        std::size_t end = text.find('\n', pos);
+        if (end == std::string::npos)
+            end = text.size();
+        std::string line = text.substr(pos, std::min<std::size_t>(end - pos, 4096));
+        pos = end + 1;
+        if (!line.empty() && line.back() == '\r')
+            line.pop_back();
+        return line;
+    };
+    // The next line with content, split; empty at end of file.
+    auto nextTokens = [&]() {
+        while (const std::optional<std::string> line = nextLine()) {
+            std::vector<std::string> t = splitWhitespace(*line);
+            if (!t.empty())
+                return t;
+        }
+        return std::vector<std::string>{};
+    };
+
+    const std::optional<std::string> magic = nextLine();
+    if (!magic || lower(*magic).rfind("# vtk datafile version", 0) != 0)
+        throw InputError(source + ": not a VTK legacy file (the first line is " + shown(magic.value_or("")) +
+                         ", expected \"# vtk DataFile Version x.y\")");
+    nextLine();  // title
+    const std::vector<std::string> format = nextTokens();
+    const std::string fmt = format.empty() ? "" : lower(format[0]);
+    if (fmt != "ascii" && fmt != "binary")
+        throw InputError(source + ": the third line must say ASCII or BINARY, not " +
+                         shown(format.empty() ? "" : format[0]));
+    const bool binary = fmt == "binary";
+
+    std::vector<std::string> t = nextTokens();
+    if (t.empty() || lower(t[0]) != "dataset")
+        throw InputError(source + ": expected DATASET STRUCTURED_POINTS after the " + fmt + " line");
+    if (t.size() < 2 || lower(t[1]) != "structured_points")
+        throw InputError(source + ": DATASET is " + shown(t.size() > 1 ? t[1] : "") +
+                         ", only STRUCTURED_POINTS is read as a regular volume");
+
+    std::optional<std::vector<long long>> dims;
+    glm::dvec3 spacing(1.0), origin(0.0);
+    auto three = [&](const std::vector<std::string>& tok, const char* what) {
+        if (tok.size() != 4)
+            throw InputError(source + ": " + what + " needs 3 numbers");
+        glm::dvec3 r;
+        for (int a = 0; a < 3; ++a) {
+            const std::optional<double> d = parseDouble(tok[static_cast<std::size_t>(a) + 1]);
+            if (!d || !std::isfinite(*d))
+                throw InputError(source + ": " + what + " " + shown(tok[static_cast<std::size_t>(a) + 1]) +
+                                 " is not a finite number");
+            r[a] = *d;
+        }
+        return r;
+    };
+    std::optional<long long> pointData;
+    while (!(t = nextTokens()).empty()) {
+        const std::string key = lower(t[0]);
+        if (key == "dimensions") {
+            if (t.size() != 4)
+                throw InputError(source + ": DIMENSIONS needs 3 integers");
+            std::vector<long long> d;
+            for (int a = 1; a <= 3; ++a) {
+                const std::optional<long long> n = parseInteger(t[static_cast<std::size_t>(a)]);
+                if (!n)
+                    throw InputError(source + ": DIMENSIONS " + shown(t[static_cast<std::size_t>(a)]) +
+                                     " is not an integer");
+                d.push_back(*n);
+            }
+            dims = d;
+        } else if (key == "spacing" || key == "aspect_ratio") {
+            spacing = three(t, "SPACING");
+        } else if (key == "origin") {
+            origin = three(t, "ORIGIN");
+        } else if (key == "point_data") {
+            pointData = t.size() == 2 ? parseInteger(t[1]) : std::nullopt;
+            if (!pointData)
+                throw InputError(source + ": POINT_DATA needs one integer");
+            break;
+        } else if (key == "cell_data") {
+            throw InputError(source + ": has CELL_DATA before POINT_DATA; only point scalars are read");
+        } else {
+            throw InputError(source + ": unexpected " + shown(t[0]) + " in the STRUCTURED_POINTS header");
+        }
+    }
+    if (!dims)
+        throw InputError(source + ": STRUCTURED_POINTS has no DIMENSIONS");
+    if (!pointData)
+        throw InputError(source + ": has no POINT_DATA");
+    const std::uint64_t count = checkedVoxelCount(source, *dims);
+    if (static_cast<std::uint64_t>(*pointData) != count || *pointData < 0)
+        throw InputError(source + ": POINT_DATA " + std::to_string(*pointData) + " does not match DIMENSIONS " +
+                         dimsText(*dims) + " = " + std::to_string(count));
+    for (int a = 0; a < 3; ++a)
+        if (!(spacing[a] > 0.0))
+            throw InputError(source + ": spacing of axis " + std::to_string(a) + " is " + num(spacing[a]) +
+                             ", must be positive");
+
+    t = nextTokens();
+    if (t.empty() || lower(t[0]) != "scalars")
+        throw InputError(source + ": expected SCALARS after POINT_DATA, found " +
+                         shown(t.empty() ? "end of file" : t[0]));
+    if (t.size() < 3 || t.size() > 4)
+        throw InputError(source + ": SCALARS needs a name, a type and optionally a component count");
+    const std::optional<ScalarType> type = vtkType(t[2]);
+    if (!type)
+        throw InputError(source + ": SCALARS type " + shown(t[2]) +
+                         " is not supported (char, short, int, their unsigned forms, float and double are)");
+    if (t.size() == 4 && t[3] != "1")
+        throw InputError(source + ": SCALARS has " + shown(t[3]) + " components, only 1 is read");
+    // LOOKUP_TABLE is optional in files VTK reads; the data begins on the line after it (or after SCALARS).
+    {
+        const std::size_t save = pos;
+        const std::vector<std::string> lut = nextTokens();
+        if (lut.empty() || lower(lut[0]) != "lookup_table")
+            pos = save;
+    }
+
+    Volume v;
+    v.source = source;
+    v.dims = glm::ivec3(static_cast<int>((*dims)[0]), static_cast<int>((*dims)[1]), static_cast<int>((*dims)[2]));
+    v.spacing = spacing;
+    v.origin = origin;
+    const std::size_t elem = scalarSize(*type);
+    if (binary) {
+        const std::uint64_t bytes = count * elem;
+        const std::uint64_t available = pos < text.size() ? text.size() - pos : 0;
+        if (available < bytes)
+            throw InputError(source + ": binary data is truncated: POINT_DATA " + dimsText(*dims) + " x " +
+                             std::to_string(elem) + " bytes = " + std::to_string(bytes) + " bytes, file has " +
+                             std::to_string(available) + " bytes after the header");
+        v.values.resize(static_cast<std::size_t>(count));
+        convertSamples(source, reinterpret_cast<const unsigned char*>(text.data() + pos), static_cast<std::size_t>(count),
+                       *type, Endian::Big, v.values.data(), 0, v.dims);
+    } else {
+        std::uint64_t n = 0;
+        std::string token;
+        while (n < count && pos < text.size()) {
+            while (pos < text.size() && std::isspace(static_cast<unsigned char>(text[pos])))
+                ++pos;
+            token.clear();
+            while (pos < text.size() && !std::isspace(static_cast<unsigned char>(text[pos]))) {
+                if (token.size() < 64)
+                    token += text[pos];
+                else if (token.size() == 64)
+                    token += "...";  // a 64-character number is garbage: fail on it, do not split it
+                ++pos;
+            }
+            if (!token.empty()) {  // values grow with what the file holds, not with what it claims
+                float value = 0.0f;
+                storeAsciiValue(source, token, n, &value);
+                v.values.push_back(value);
+                ++n;
+            }
+        }
+        if (n < count)
+            throw InputError(source + ": ASCII data is truncated: POINT_DATA says " + std::to_string(count) +
+                             " values, file has " + std::to_string(n));
+    }
+    v.validate();
+    return v;
+}
+
+Volume loadVolume(const nlohmann::json& spec, const fs::path& baseDir)
+{
+    if (!spec.is_object())
+        throw InputError("volume: must be an object with \"file\" or \"generator\"");
+    const bool hasFile = spec.contains("file"), hasGenerator = spec.contains("generator");
+    if (hasFile == hasGenerator)
+        throw InputError(std::string("volume: needs exactly one of \"file\" and \"generator\"") +
+                         (hasFile ? ", has both" : ", has neither"));
+
+    if (hasGenerator) {
+        checkKeys(spec, {"generator", "dims"}, "a generator");
+        return generateVolume(jsonString(spec, "generator"), jsonDims(spec));
+    }
+
+    const fs::path file = jsonString(spec, "file");
+    const fs::path path = file.is_absolute() ? file : baseDir / file;
+    const std::string ext = lower(file.extension().string());
+    const bool selfDescribing = ext == ".nrrd" || ext == ".nhdr" || ext == ".vtk";
+    if (!selfDescribing && (spec.contains("dims") || ext == ".raw")) {
+        checkKeys(spec, {"file", "dims", "type", "endian", "spacing", "origin", "header_bytes"}, "a raw file");
+        RawLayout layout;
+        layout.dims = jsonDims(spec);
+        if (!spec.contains("type"))
+            badKey("type", "is missing (uint8, int8, int16, uint16, int32, uint32, float32 or float64)");
+        const std::string type = jsonString(spec, "type");
+        static const std::array<std::pair<const char*, ScalarType>, 8> kTypes{{
+            {"uint8", ScalarType::UInt8},   {"int8", ScalarType::Int8},     {"int16", ScalarType::Int16},
+            {"uint16", ScalarType::UInt16}, {"int32", ScalarType::Int32},   {"uint32", ScalarType::UInt32},
+            {"float32", ScalarType::Float32}, {"float64", ScalarType::Float64},
+        }};
+        const auto it = std::find_if(kTypes.begin(), kTypes.end(), [&](const auto& p) { return type == p.first; });
+        if (it == kTypes.end())
+            badKey("type", "is " + shown(type) + " (uint8, int8, int16, uint16, int32, uint32, float32 or float64)");
+        layout.type = it->second;
+        if (spec.contains("endian")) {
+            const std::string e = jsonString(spec, "endian");
+            if (e != "little" && e != "big")
+                badKey("endian", "is " + shown(e) + ", must be little or big");
+            layout.endian = e == "big" ? Endian::Big : Endian::Little;
+        } else if (scalarSize(layout.type) > 1) {
+            badKey("endian", "is missing (little or big)");
+        }
+        if (spec.contains("spacing"))
+            layout.spacing = jsonVec3(spec, "spacing");
+        if (spec.contains("origin"))
+            layout.origin = jsonVec3(spec, "origin");
+        if (spec.contains("header_bytes")) {
+            const nlohmann::json& hb = spec.at("header_bytes");
+            if (!hb.is_number_integer() || hb.get<long long>() < 0)
+                badKey("header_bytes", "must be a non-negative integer");
+            layout.headerBytes = hb.get<std::uint64_t>();
+        }
+        return readRaw(path, layout);
+    }
+    checkKeys(spec, {"file"}, ext.empty() ? "a file" : "a " + ext + " file");
+    if (ext == ".nrrd" || ext == ".nhdr")
+        return readNrrd(path);
+    if (ext == ".vtk")
+        return readVtkStructuredPoints(path);
+    throw InputError(path.string() + ": unknown volume format " + shown(ext) +
+                     " (.nrrd, .nhdr, .vtk, or .raw / any file with \"dims\")");
+}
+
+}  // namespace clvr

@@ -1,0 +1,77 @@
+// host/model/camera.cpp — camera frame, primary rays and GL-style matrices.
+#include "host/model/camera.h"
+
+#include "host/runtime/errors.h"
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <cmath>
+
+namespace clvr {
+namespace {
+
+bool finite(const glm::dvec3& v)
+{
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+}  // namespace
+
+void Camera::validate() const
+{
+    if (!finite(position) || !finite(focalPoint) || !finite(viewUp))
+        throw InputError("camera: position, focal_point and view_up must be finite numbers");
+    const glm::dvec3 d = focalPoint - position;
+    if (glm::length(d) <= 1e-12 * (1.0 + glm::length(position)))
+        throw InputError("camera: position equals focal_point, so there is no view direction");
+    if (glm::length(viewUp) == 0.0 || glm::length(glm::cross(glm::normalize(d), glm::normalize(viewUp))) < 1e-9)
+        throw InputError("camera: view_up is parallel to the view direction (or zero)");
+    if (!parallel && !(viewAngle > 0.0 && viewAngle < 180.0))
+        throw InputError("camera: view_angle must be in (0, 180) degrees, got " + std::to_string(viewAngle));
+    if (parallel && !(parallelScale > 0.0 && std::isfinite(parallelScale)))
+        throw InputError("camera: parallel_scale must be > 0, got " + std::to_string(parallelScale));
+}
+
+glm::dvec3 Camera::forward() const { return glm::normalize(focalPoint - position); }
+glm::dvec3 Camera::right() const { return glm::normalize(glm::cross(forward(), viewUp)); }
+glm::dvec3 Camera::up() const { return glm::cross(right(), forward()); }
+
+Ray Camera::ray(double px, double py, int width, int height) const
+{
+    return PixelRays(*this, width, height).at(px, py);
+}
+
+PixelRays::PixelRays(const Camera& camera, int width, int height)
+    : position_(camera.position), forward_(camera.forward()), right_(camera.right()), up_(camera.up()),
+      width_(width), height_(height), aspect_(static_cast<double>(width) / height),
+      scale_(camera.parallel ? camera.parallelScale : std::tan(glm::radians(camera.viewAngle) * 0.5)),
+      parallel_(camera.parallel)
+{
+}
+
+Ray PixelRays::at(double px, double py) const
+{
+    // Normalized device coordinates of the pixel center, y up.
+    const double ndcX = (px + 0.5) / width_ * 2.0 - 1.0;
+    const double ndcY = 1.0 - (py + 0.5) / height_ * 2.0;
+    if (parallel_) {
+        const glm::dvec3 origin = position_ + (ndcX * scale_ * aspect_) * right_ + (ndcY * scale_) * up_;
+        return {origin, forward_};
+    }
+    return {position_, glm::normalize(forward_ + (ndcX * scale_ * aspect_) * right_ + (ndcY * scale_) * up_)};
+}
+
+glm::dmat4 Camera::viewMatrix() const
+{
+    return glm::lookAt(position, focalPoint, viewUp);
+}
+
+glm::dmat4 Camera::projectionMatrix(int width, int height, double near, double far) const
+{
+    const double aspect = static_cast<double>(width) / height;
+    if (parallel)
+        return glm::ortho(-parallelScale * aspect, parallelScale * aspect, -parallelScale, parallelScale, near, far);
+    return glm::perspective(glm::radians(viewAngle), aspect, near, far);
+}
+
+}  // namespace clvr

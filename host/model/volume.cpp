@@ -1,0 +1,71 @@
+// host/model/volume.cpp — trilinear reconstruction and validation of regular grids.
+#include "host/model/volume.h"
+
+#include "host/runtime/errors.h"
+
+#include <algorithm>
+#include <cmath>
+#include <unistd.h>
+
+namespace clvr {
+
+void checkHostMemoryForVoxels(const std::string& source, std::uint64_t voxels)
+{
+    const long pages = ::sysconf(_SC_PHYS_PAGES), pageSize = ::sysconf(_SC_PAGE_SIZE);
+    if (pages <= 0 || pageSize <= 0)
+        return;  // unknown: let the allocation decide
+    const std::uint64_t physical = static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(pageSize);
+    const std::uint64_t needed = voxels * sizeof(float);
+    if (needed > physical / 2)
+        throw InputError(source + ": " + std::to_string(voxels) + " grid points need " +
+                         std::to_string(needed >> 20) + " MiB as float32, more than half of this machine's " +
+                         std::to_string(physical >> 20) + " MiB of memory");
+}
+
+std::optional<double> Volume::sample(const glm::dvec3& p) const
+{
+    const glm::dvec3 g = (p - origin) / spacing;  // grid coordinates
+    const glm::dvec3 last(dims - 1);
+    for (int a = 0; a < 3; ++a)
+        if (!(g[a] >= 0.0 && g[a] <= last[a]))
+            return std::nullopt;
+    glm::ivec3 i0 = glm::min(glm::ivec3(glm::floor(g)), dims - 2);
+    i0 = glm::max(i0, glm::ivec3(0));
+    const glm::dvec3 f = g - glm::dvec3(i0);
+    auto v = [&](int dx, int dy, int dz) { return static_cast<double>(at(i0.x + dx, i0.y + dy, i0.z + dz)); };
+    const double c00 = v(0, 0, 0) * (1 - f.x) + v(1, 0, 0) * f.x;
+    const double c10 = v(0, 1, 0) * (1 - f.x) + v(1, 1, 0) * f.x;
+    const double c01 = v(0, 0, 1) * (1 - f.x) + v(1, 0, 1) * f.x;
+    const double c11 = v(0, 1, 1) * (1 - f.x) + v(1, 1, 1) * f.x;
+    const double c0 = c00 * (1 - f.y) + c10 * f.y;
+    const double c1 = c01 * (1 - f.y) + c11 * f.y;
+    return c0 * (1 - f.z) + c1 * f.z;
+}
+
+glm::dvec2 Volume::range() const
+{
+    const auto [lo, hi] = std::minmax_element(values.begin(), values.end());
+    return values.empty() ? glm::dvec2(0.0) : glm::dvec2(*lo, *hi);
+}
+
+void Volume::validate() const
+{
+    for (int a = 0; a < 3; ++a) {
+        if (dims[a] < 2)
+            throw InputError(source + ": dimension " + std::to_string(a) + " is " + std::to_string(dims[a]) +
+                             ", must be at least 2 grid points");
+        if (!(spacing[a] > 0.0) || !std::isfinite(spacing[a]))
+            throw InputError(source + ": spacing " + std::to_string(a) + " must be a positive finite number");
+        if (!std::isfinite(origin[a]))
+            throw InputError(source + ": origin must be finite");
+    }
+    if (values.size() != voxelCount())
+        throw InputError(source + ": has " + std::to_string(values.size()) + " values for " +
+                         std::to_string(dims.x) + "x" + std::to_string(dims.y) + "x" + std::to_string(dims.z) +
+                         " grid points");
+    for (std::size_t i = 0; i < values.size(); ++i)
+        if (!std::isfinite(values[i]))
+            throw InputError(source + ": value " + std::to_string(i) + " is NaN or infinite");
+}
+
+}  // namespace clvr

@@ -1,0 +1,42 @@
+// host/model/volume.h — a regular grid as DESIGN.md defines it: values on grid points (VTK point data),
+// x fastest; bounds origin .. origin + (n-1)*spacing; trilinear reconstruction; empty outside.
+#pragma once
+
+#include <glm/glm.hpp>
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace clvr {
+
+// Throws InputError (naming `source`) when `voxels` float values would not fit in half of this
+// machine's physical memory: a volume that large would be killed by the OOM killer, not reported.
+void checkHostMemoryForVoxels(const std::string& source, std::uint64_t voxels);
+
+struct Volume {
+    glm::ivec3 dims{0};
+    glm::dvec3 spacing{1.0};
+    glm::dvec3 origin{0.0};
+    std::vector<float> values;  // data units, as stored (int16 CT numbers stay CT numbers)
+    std::string source;         // file or generator it came from, for messages
+
+    std::size_t voxelCount() const { return static_cast<std::size_t>(dims.x) * dims.y * dims.z; }
+    glm::dvec3 boundsMin() const { return origin; }
+    glm::dvec3 boundsMax() const { return origin + glm::dvec3(dims - 1) * spacing; }
+    float at(int i, int j, int k) const
+    {
+        return values[(static_cast<std::size_t>(k) * dims.y + j) * dims.x + i];
+    }
+    // Trilinear reconstruction at a world position; nullopt outside the bounds.
+    std::optional<double> sample(const glm::dvec3& p) const;
+    // Smallest and largest value.
+    glm::dvec2 range() const;
+    // Throws InputError (naming `source`) for dims < 1 (or < 2 on any axis), spacing <= 0 or
+    // non-finite, a values size that disagrees with dims, or NaN/infinite values.
+    void validate() const;
+};
+
+}  // namespace clvr

@@ -1,0 +1,705 @@
+// host/render/grid/iso3d.cpp — options, "iso" parsing, the encoded normal volume, the paper's color matrix,
+// and the passes of the iso3d technique: slices through raster::draw with kernels/iso3d.cl as fragment
+// program under the alpha and depth tests, the color-matrix copy, and kernels/iso3d.cl: iso3d_finish.
+#include "host/render/grid/iso3d.h"
+
+#include "host/runtime/embedded_kernels.h"
+#include "host/runtime/errors.h"
+#include "host/render/options_util.h"
+#include "host/optics/gradient_volume.h"
+#include "host/render/grid/slice3d.h"  // planSlices, slicePolygon: the same slices as slice3d
+#include "raster/framebuffer.h"
+#include "raster/pixel_transfer.h"
+#include "raster/rasterizer.h"
+#include "raster/texture.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+namespace clvr {
+namespace {
+
+constexpr int kMaxSlices = 65536;
+// Figure 7: how far behind the box entry (in slices) the depth buffer is put. The first slice inside the box
+// lies within one slice of the entry; 1.5 keeps it in front on faces seen obliquely by a perspective camera.
+constexpr double kEntryDepthSlices = 1.5;
+
+class Iso3dRendererImpl final : public Iso3dRenderer {
+public:
+    Iso3dRendererImpl(Device& device, const Scene& scene, const Volume& volume);
+    Image4f render(FrameStats& stats) override;
+    std::uint64_t residentBytes() const override { return residentBytes_; }
+    void setTransferFunction(const TransferFunction& tf) override;
+    std::vector<double> hitDepth() override;
+    double sliceSpacing() const override { return plan_.deltaS; }
+
+private:
+    Device& device_;
+    Iso3dOptions options_;
+    IsoSurface iso_;
+    Camera camera_;
+    ImageSpec image_;
+    glm::dvec3 lo_, hi_;
+    SlicePlan plan_;
+    double nearZ_ = 0.0, farZ_ = 0.0;  // of the projection the slices were drawn with
+    float alphaRef_ = 0.0f;            // the iso-value in alpha's [0,1] (see the constructor)
+    cl::Buffer volume_;
+    std::uint64_t residentBytes_ = 0;
+    std::unique_ptr<raster::Framebuffer> framebuffer_;
+    raster::FragmentProgram fragmentProgram_;
+    cl::Kernel finish_;
+    // Gradientless shading: the scalar volume as a 3D texture (texel centers at the grid points) and
+    // the shift Delta L in texture coordinates.
+    std::unique_ptr<raster::Texture> scalarTexture_;
+    double gradientlessStep_ = 0.0, gradientlessScale_ = 0.0;
+    glm::vec4 textureShift_{0.0f};
+    // Bricking (§3.1): with more than one brick, brickData_ holds each brick's part of the RGBA volume on
+    // the host (index x + counts.x (y + counts.y z)), uploaded in turn into the one device buffer volume_.
+    glm::dvec3 origin_{0.0}, spacing_{1.0};
+    glm::ivec3 dims_{0};
+    MemoryBricks bricks_;
+    std::vector<std::vector<glm::vec4>> brickData_;
+
+    raster::DrawStats drawBricks(const raster::DrawState& state, const std::vector<raster::Vertex>& vertices,
+                                 const std::vector<std::size_t>& sliceFirst, const glm::dmat4& viewProjection,
+                                 FrameStats& stats);
+};
+
+Iso3dRendererImpl::Iso3dRendererImpl(Device& device, const Scene& scene, const Volume& volume)
+    : device_(device), options_(parseIso3dOptions(scene.options)), iso_(parseIsoSurface(scene)), image_(scene.image)
+{
+    volume.validate();
+    if (volume.voxelCount() > 0xffffffffull)
+        throw InputError(volume.source + ": iso3d takes at most 2^32 - 1 grid points (32-bit voxel indices)");
+    lo_ = volume.boundsMin();
+    hi_ = volume.boundsMax();
+    camera_ = scene.camera ? *scene.camera : fitCamera(lo_, hi_);
+    camera_.validate();
+    if (image_.width < 1 || image_.height < 1)
+        throw InputError("image: width and height must be >= 1");
+    Slice3dOptions sliceOptions;
+    sliceOptions.slices = options_.slices;
+    sliceOptions.sliceSpacing = options_.sliceSpacing;
+    plan_ = planSlices(camera_, lo_, hi_, sliceOptions);
+
+    origin_ = volume.origin;
+    spacing_ = volume.spacing;
+    dims_ = volume.dims;
+    const bool gradientless = iso_.shading == IsoSurface::Shading::Gradientless;
+    // Every byte of texture per grid point: the RGBA volume, and gradientless shading's scalar texture.
+    const std::uint64_t bytesPerPoint = sizeof(glm::vec4) + (gradientless ? sizeof(float) : 0);
+    if (options_.bricks.x > 0)
+        bricks_ = splitBricks(volume.dims, options_.bricks, bytesPerPoint);
+    else if (options_.brickBudget > 0)
+        bricks_ = planBricks(volume.dims, bytesPerPoint, options_.brickBudget);
+    else
+        bricks_ = splitBricks(volume.dims, glm::ivec3(1), bytesPerPoint);
+    const std::string brickKey = options_.bricks.x > 0 ? "bricks" : "brick_budget";
+    const std::string brickGrid = std::to_string(bricks_.counts.x) + "x" + std::to_string(bricks_.counts.y) + "x" +
+                                  std::to_string(bricks_.counts.z);
+    if (bricks_.count() > 1 && gradientless)
+        badOption(brickKey, "gives " + brickGrid + " bricks, and bricking works with iso.shading \"gradient\" or "
+                            "\"none\" only (gradientless shading's shifted lookup X(p0 + Delta L) leaves the brick)");
+    if (bricks_.count() > 1 && options_.interior)
+        badOption(brickKey, "gives " + brickGrid + " bricks, and bricking does not work with options.interior "
+                            "(Figure 7's passes use the stencil themselves)");
+
+    const std::vector<glm::vec4> rgba = encodedNormalVolume(volume);
+    if (bricks_.count() == 1) {
+        volume_ = device_.upload("iso3d RGBA volume (normal, value; float32)", rgba);
+        residentBytes_ = rgba.size() * sizeof(glm::vec4);
+    } else {
+        // Each brick's grid points cut out of the globally computed RGBA volume (so its normals at the
+        // brick faces are the unbricked ones), and one device buffer as large as the largest brick.
+        for (int bz = 0; bz < bricks_.counts.z; ++bz)
+            for (int by = 0; by < bricks_.counts.y; ++by)
+                for (int bx = 0; bx < bricks_.counts.x; ++bx) {
+                    const glm::ivec3 b(bx, by, bz), lo = bricks_.lo(b), n = bricks_.dims(b);
+                    std::vector<glm::vec4> data;
+                    data.reserve(static_cast<std::size_t>(n.x) * n.y * n.z);
+                    for (int k = 0; k < n.z; ++k)
+                        for (int j = 0; j < n.y; ++j) {
+                            const std::size_t row =
+                                (static_cast<std::size_t>(lo.z + k) * volume.dims.y + (lo.y + j)) * volume.dims.x + lo.x;
+                            data.insert(data.end(), rgba.begin() + static_cast<std::ptrdiff_t>(row),
+                                        rgba.begin() + static_cast<std::ptrdiff_t>(row + n.x));
+                        }
+                    brickData_.push_back(std::move(data));
+                }
+        residentBytes_ = bricks_.maxBytes();
+        volume_ = device_.buffer("iso3d brick (RGBA: normal, value; float32)", residentBytes_, CL_MEM_READ_ONLY);
+    }
+
+    // GL clamps the alpha reference to [0,1], as the paper's 8-bit textures hold values in [0,1]:
+    // the value range, widened to hold the iso-value (so that an iso-value above every value keeps
+    // nothing), is mapped onto [0,1]. Both sides use the same float operations (value - lo) * scale,
+    // monotonic in the value, so value >= iso implies alpha >= reference.
+    const glm::dvec2 range = volume.range();
+    const float valueLo = static_cast<float>(std::min(range.x, iso_.value));
+    const float valueHi = static_cast<float>(std::max(range.y, iso_.value));
+    const float scale = valueHi > valueLo ? 1.0f / (valueHi - valueLo) : 1.0f;
+    alphaRef_ = (static_cast<float>(iso_.value) - valueLo) * scale;
+
+    framebuffer_ = std::make_unique<raster::Framebuffer>(device_, image_.width, image_.height);
+    finish_ = device_.kernel("iso3d.cl", "iso3d_finish");
+    std::string_view source;
+    for (const EmbeddedKernel& k : embeddedKernels())
+        if (k.name == "iso3d.cl")
+            source = k.source;
+    fragmentProgram_.source = "#define CLVR_ISO3D_FRAGMENT 1\n" + std::string(source);
+    fragmentProgram_.buffers[0] = volume_;
+    if (options_.interior && gradientless)
+        badOption("interior", "works with \"gradient\" or \"none\" shading (the gradientless difference would need its "
+                              "sign turned per pixel), and iso.shading is \"gradientless\"");
+    fragmentProgram_.uniforms = {
+        glm::vec4(glm::vec3(volume.origin), 0.0f),
+        glm::vec4(glm::vec3(1.0 / volume.spacing), 0.0f),
+        glm::vec4(volume.dims.x, volume.dims.y, volume.dims.z, 0.0f),
+        glm::vec4(valueLo, scale, gradientless ? 1.0f : 0.0f, 0.0f),
+        glm::vec4(0.0f),                                                   // the brick's first grid point ...
+        glm::vec4(volume.dims.x, volume.dims.y, volume.dims.z, 0.0f),      // ... the end of its box ...
+        glm::vec4(volume.dims.x, volume.dims.y, volume.dims.z, 0.0f),      // ... its dims: unbricked, all
+    };
+    if (gradientless) {
+        raster::TextureDesc desc;
+        desc.width = volume.dims.x;
+        desc.height = volume.dims.y;
+        desc.depth = volume.dims.z;
+        desc.channels = 1;
+        desc.filter = raster::Filter::Linear;
+        desc.wrap = raster::Wrap::ClampToEdge;
+        scalarTexture_ = std::make_unique<raster::Texture>(device_, desc, volume.values);
+        residentBytes_ += scalarTexture_->bytes();
+        gradientlessStep_ = options_.gradientlessStep > 0.0
+                                ? options_.gradientlessStep
+                                : std::min({volume.spacing.x, volume.spacing.y, volume.spacing.z});
+        // X(p0) - X(p0 + Delta L) ~ Delta |grad X| <L, N>: the paper's condition is |grad X| = 1 (then
+        // k = 1 / Delta); clvr divides by the median gradient length at the surface instead, unless given.
+        gradientlessScale_ = options_.gradientlessScale > 0.0
+                                 ? options_.gradientlessScale
+                                 : 1.0 / (gradientlessStep_ * medianGradientAtIso(volume, iso_.value));
+        // Delta L in world units -> grid units (/ spacing) -> texture coordinates (/ n).
+        textureShift_ = glm::vec4(glm::vec3(gradientlessStep_ * iso_.light / (volume.spacing * glm::dvec3(volume.dims))), 0.0f);
+    }
+}
+
+void Iso3dRendererImpl::setTransferFunction(const TransferFunction& tf)
+{
+    // Only the surface color depends on it (the color at the iso-value).
+    iso_.color = tf.points().empty() ? glm::dvec3(1.0) : glm::dvec3(tf(iso_.value));
+}
+
+Image4f Iso3dRendererImpl::render(FrameStats& stats)
+{
+    const auto start = std::chrono::steady_clock::now();
+    // The slice polygons, nearest first, fanned into one triangle list; as slice3d's raster path.
+    const glm::dvec3 forward = camera_.forward();
+    nearZ_ = 0.5 * plan_.depth(0);
+    farZ_ = 2.0 * plan_.depthMax + 1.0;
+    const glm::dmat4 viewProjection =
+        camera_.projectionMatrix(image_.width, image_.height, nearZ_, farZ_) * camera_.viewMatrix();
+    std::vector<raster::Vertex> vertices;
+    vertices.reserve(static_cast<std::size_t>(plan_.count) * 12);
+    std::vector<std::size_t> sliceFirst;  // slice k's triangles: vertices[sliceFirst[k] .. sliceFirst[k + 1])
+    sliceFirst.reserve(static_cast<std::size_t>(plan_.count) + 1);
+    for (int k = 0; k < plan_.count; ++k) {
+        sliceFirst.push_back(vertices.size());
+        const double offset = glm::dot(forward, camera_.position) + plan_.depth(k);
+        const std::vector<glm::dvec3> polygon = slicePolygon(lo_, hi_, forward, offset);
+        auto vertex = [&](const glm::dvec3& p) {
+            raster::Vertex v;
+            v.position = glm::vec4(viewProjection * glm::dvec4(p, 1.0));
+            v.attributes[0] = glm::vec4(glm::vec3(p), 1.0f);
+            return v;
+        };
+        for (std::size_t j = 1; j + 1 < polygon.size(); ++j) {
+            vertices.push_back(vertex(polygon[0]));
+            vertices.push_back(vertex(polygon[j]));
+            vertices.push_back(vertex(polygon[j + 1]));
+        }
+    }
+    sliceFirst.push_back(vertices.size());
+    // §3: "pixel values are only drawn if they pass the z-buffer test and if the alpha value is larger
+    // than or equal to the selected iso-value". Front to back with LESS, the first slice that passes
+    // the alpha test at a pixel locks it; back to front would give the same image with more writes.
+    raster::DrawState state;
+    state.fragment.alpha.test = true;
+    state.fragment.alpha.func = raster::CompareFunc::GEqual;
+    state.fragment.alpha.ref = alphaRef_;
+    state.fragment.depth.test = true;
+    state.fragment.depth.func = raster::CompareFunc::Less;
+    state.fragment.depth.write = true;
+    framebuffer_->clearColor(device_, glm::vec4(0.0f));
+    framebuffer_->clearDepth(device_, 1.0f);
+    raster::DrawStats drawStats;
+    // Uploads per frame: none unbricked (the volume stays resident between frames); drawBricks counts its own.
+    stats.extra["brick_uploads"] = 0;
+    stats.extra["brick_upload_bytes"] = 0;
+    stats.extra["brick_upload_ms"] = 0.0;
+    if (vertices.empty()) {
+        // the box is behind the camera: nothing to draw
+    } else if (bricks_.count() > 1) {
+        drawStats = drawBricks(state, vertices, sliceFirst, viewProjection, stats);
+    } else if (!options_.interior) {
+        drawStats = raster::draw(device_, *framebuffer_, state, raster::Topology::Triangles, vertices, fragmentProgram_);
+    } else {
+        // Figure 7 (§3): 1. the depth buffer right behind the first intersection with the box: its 12
+        // triangles moved back by kEntryDepthSlices slices along forward, nearest kept, no color.
+        raster::DrawState box;
+        box.fragment.colorMask = {false, false, false, false};
+        box.fragment.depth.test = true;
+        box.fragment.depth.func = raster::CompareFunc::Less;
+        const glm::dvec3 shift = kEntryDepthSlices * plan_.deltaS * forward;
+        std::vector<raster::Vertex> boxVertices;
+        auto corner = [&](int c) {
+            return glm::dvec3((c & 1) ? hi_.x : lo_.x, (c & 2) ? hi_.y : lo_.y, (c & 4) ? hi_.z : lo_.z) + shift;
+        };
+        for (int axis = 0; axis < 3; ++axis)
+            for (int side = 0; side < 2; ++side) {
+                // The face's 4 corners: bit `axis` fixed to `side`, the other two bits in a cycle.
+                const int a = 1 << ((axis + 1) % 3), b = 1 << ((axis + 2) % 3), base = side ? (1 << axis) : 0;
+                const int quad[4] = {base, base | a, base | a | b, base | b};
+                for (int t : {0, 1, 2, 0, 2, 3}) {
+                    raster::Vertex v;
+                    v.position = glm::vec4(viewProjection * glm::dvec4(corner(quad[t]), 1.0));
+                    boxVertices.push_back(v);
+                }
+            }
+        framebuffer_->clearStencil(device_, 0);
+        raster::draw(device_, *framebuffer_, box, raster::Topology::Triangles, boxVertices);
+        // 2. Samples at or above iso in front of it fail the depth test (GREATER): there the stencil is set.
+        raster::DrawState mark = state;
+        mark.fragment.colorMask = {false, false, false, false};
+        mark.fragment.depth.func = raster::CompareFunc::Greater;
+        mark.fragment.depth.write = false;
+        mark.fragment.stencil.test = true;
+        mark.fragment.stencil.func = raster::CompareFunc::Always;
+        mark.fragment.stencil.ref = 1;
+        mark.fragment.stencil.dpfail = raster::StencilOp::Replace;
+        raster::draw(device_, *framebuffer_, mark, raster::Topology::Triangles, vertices, fragmentProgram_);
+        // 3. The usual alpha test where the stencil is unchanged ...
+        framebuffer_->clearDepth(device_, 1.0f);
+        raster::DrawState exterior = state;
+        exterior.fragment.stencil.test = true;
+        exterior.fragment.stencil.func = raster::CompareFunc::Equal;
+        exterior.fragment.stencil.ref = 0;
+        drawStats = raster::draw(device_, *framebuffer_, exterior, raster::Topology::Triangles, vertices, fragmentProgram_);
+        // 4. ... and reversed (LESS: the first sample below iso) where it is set; the fragment program
+        // turns the normal round there (it points into the material, away from this viewer).
+        raster::DrawState interior = exterior;
+        interior.fragment.alpha.func = raster::CompareFunc::Less;
+        interior.fragment.stencil.ref = 1;
+        raster::FragmentProgram flipped = fragmentProgram_;
+        flipped.uniforms[3].w = 1.0f;
+        const raster::DrawStats d =
+            raster::draw(device_, *framebuffer_, interior, raster::Topology::Triangles, vertices, flipped);
+        drawStats.fragments += d.fragments;
+        drawStats.triangles += d.triangles;
+    }
+
+    const bool shaded = iso_.shading != IsoSurface::Shading::None;
+    if (iso_.shading == IsoSurface::Shading::Gradient) {
+        // Gradient shading (§3): the frame buffer copied onto itself through the color matrix with the
+        // reflectivity as scale and the ambient term as bias, giving c (k_d <L, N> + I_a) in RGB.
+        raster::applyPixelTransfer(device_, *framebuffer_, isoShadingTransfer(iso_));
+    } else if (shaded) {
+        // Gradientless shading (§3): the frame buffer holds the surface points' texture coordinates;
+        // read back and drawn twice through the pixel texture: X(p0), then X(p0 + Delta L) (the shift as
+        // the pixel bias) subtracted from it by blending. X(p0) - X(p0 + Delta L) ~ -Delta dX/dL =
+        // Delta |grad X| <L, N>; times k = 1 / (Delta |grad|~) it is <L, N> where |grad X| = |grad|~
+        // (docs/iso3d.md: off by the factor |grad X| / |grad|~ elsewhere, the paper's condition).
+        const Image4f positions = framebuffer_->readColor(device_);
+        raster::drawPixels(device_, *framebuffer_, positions, {0, 0}, raster::PixelTransfer{},
+                           raster::DrawPixelsBlend::Replace, scalarTexture_.get());
+        raster::PixelTransfer shift;
+        shift.bias = textureShift_;
+        raster::drawPixels(device_, *framebuffer_, positions, {0, 0}, shift, raster::DrawPixelsBlend::ReverseSubtract,
+                           scalarTexture_.get());
+        raster::PixelTransfer light;
+        light.scale = glm::vec4(glm::vec3(iso_.diffuse * gradientlessScale_ * iso_.color), 1.0f);
+        light.bias = glm::vec4(glm::vec3(iso_.ambient * iso_.color), 0.0f);
+        raster::applyPixelTransfer(device_, *framebuffer_, light);
+    }
+    const std::size_t pixels = framebuffer_->pixelCount();
+    int a = 0;
+    finish_.setArg(a++, framebuffer_->color());
+    finish_.setArg(a++, framebuffer_->depth());
+    finish_.setArg(a++, static_cast<cl_uint>(pixels));
+    finish_.setArg(a++, static_cast<cl_int>(shaded ? 1 : 0));
+    finish_.setArg(a++, toCl4(iso_.color, 1.0));
+    finish_.setArg(a++, toCl4(image_.background, 0.0));
+    device_.launch("iso3d: finish", finish_, pixels);
+    Image4f image = framebuffer_->readColor(device_);
+
+    stats.passes = device_.takePassTimes();
+    stats.frameMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    stats.samples = drawStats.fragments;
+    stats.extra["slices"] = plan_.count;
+    stats.extra["slice_spacing"] = plan_.deltaS;
+    stats.extra["triangles"] = drawStats.triangles;
+    stats.extra["iso_value"] = iso_.value;
+    stats.extra["shading"] = iso_.shading == IsoSurface::Shading::Gradient       ? "gradient"
+                             : iso_.shading == IsoSurface::Shading::Gradientless ? "gradientless"
+                                                                                 : "none";
+    stats.extra["resident_bytes"] = residentBytes_;
+    stats.extra["interior"] = options_.interior;
+    stats.extra["bricks"] = bricks_.count();
+    stats.extra["brick_grid"] = {bricks_.counts.x, bricks_.counts.y, bricks_.counts.z};
+    stats.extra["brick_bytes"] = bricks_.maxBytes();
+    return image;
+}
+
+raster::DrawStats Iso3dRendererImpl::drawBricks(const raster::DrawState& unbricked,
+                                                const std::vector<raster::Vertex>& vertices,
+                                                const std::vector<std::size_t>& sliceFirst,
+                                                const glm::dmat4& viewProjection, FrameStats& stats)
+{
+    // §3.1: "Each brick is rendered separately from front to back starting with the one nearest to the
+    // image plane. Since the stencil buffer is immediately locked whenever a hit with the surface occurs,
+    // once a value has been set correctly it will never be changed." A fragment that passes the alpha test
+    // (and the depth test) sets the stencil to 1; the stencil test (NOTEQUAL 1) rejects every later
+    // fragment there, of this brick or of the bricks behind it.
+    raster::DrawState state = unbricked;
+    state.fragment.stencil.test = true;
+    state.fragment.stencil.func = raster::CompareFunc::NotEqual;
+    state.fragment.stencil.ref = 1;
+    state.fragment.stencil.dppass = raster::StencilOp::Replace;
+    framebuffer_->clearStencil(device_, 0);
+
+    const glm::dvec3 forward = camera_.forward();
+    raster::DrawStats total;
+    std::uint64_t uploads = 0, uploadBytes = 0;
+    double uploadMs = 0.0;
+    raster::FragmentProgram program = fragmentProgram_;
+    for (const glm::ivec3& b : brickOrder(bricks_, camera_, origin_, spacing_)) {
+        const glm::ivec3 lo = bricks_.lo(b), hi = bricks_.hi(b), n = bricks_.dims(b);
+        const glm::dvec3 boxLo = origin_ + glm::dvec3(lo) * spacing_, boxHi = origin_ + glm::dvec3(hi) * spacing_;
+        // The slices that can reach the brick: its corners' eye-depth range, one slice more on each side
+        // (a slice drawn for a brick it misses only costs discarded fragments; one missed would lose samples).
+        double dMin = std::numeric_limits<double>::infinity(), dMax = -dMin;
+        bool allInFront = true;
+        glm::dvec2 wMin(std::numeric_limits<double>::infinity()), wMax(-std::numeric_limits<double>::infinity());
+        for (int c = 0; c < 8; ++c) {
+            const glm::dvec3 p((c & 1) ? boxHi.x : boxLo.x, (c & 2) ? boxHi.y : boxLo.y, (c & 4) ? boxHi.z : boxLo.z);
+            const double d = glm::dot(forward, p - camera_.position);
+            dMin = std::min(dMin, d);
+            dMax = std::max(dMax, d);
+            const glm::dvec4 clip = viewProjection * glm::dvec4(p, 1.0);
+            if (!(clip.w > 0.0)) {
+                allInFront = false;
+                continue;
+            }
+            const glm::dvec2 window((clip.x / clip.w + 1.0) * 0.5 * image_.width,
+                                    (1.0 - clip.y / clip.w) * 0.5 * image_.height);
+            wMin = glm::min(wMin, window);
+            wMax = glm::max(wMax, window);
+        }
+        const int kLo = std::max(0, static_cast<int>(std::floor((dMin - plan_.depthMin) / plan_.deltaS - 0.5)) - 1);
+        const int kHi =
+            std::min(plan_.count - 1, static_cast<int>(std::ceil((dMax - plan_.depthMin) / plan_.deltaS - 0.5)) + 1);
+        if (kLo > kHi || sliceFirst[kLo] == sliceFirst[kHi + 1])
+            continue;
+        // The scissor: the brick's projected box (the hull of its corners when all are in front of the
+        // eye), one pixel wider on every side; the whole frame otherwise (the eye near or in the brick).
+        state.scissor = {};
+        if (allInFront) {
+            const int x0 = std::max(0, static_cast<int>(std::floor(wMin.x)) - 1);
+            const int y0 = std::max(0, static_cast<int>(std::floor(wMin.y)) - 1);
+            const int x1 = std::min(image_.width, static_cast<int>(std::ceil(wMax.x)) + 1);
+            const int y1 = std::min(image_.height, static_cast<int>(std::ceil(wMax.y)) + 1);
+            if (x0 >= x1 || y0 >= y1)
+                continue;  // off screen
+            state.scissor = {true, x0, y0, x1 - x0, y1 - y0};
+        }
+
+        const std::vector<glm::vec4>& data = brickData_[static_cast<std::size_t>(b.x + bricks_.counts.x * (b.y + bricks_.counts.y * b.z))];
+        const auto t0 = std::chrono::steady_clock::now();
+        device_.queue().enqueueWriteBuffer(volume_, CL_TRUE, 0, data.size() * sizeof(glm::vec4), data.data());
+        uploadMs += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        ++uploads;
+        uploadBytes += data.size() * sizeof(glm::vec4);
+
+        // Upper ends of the brick's half-open box in grid units; the last slab of an axis keeps its far face.
+        const glm::vec4 end(hi.x == dims_.x - 1 ? dims_.x : hi.x, hi.y == dims_.y - 1 ? dims_.y : hi.y,
+                            hi.z == dims_.z - 1 ? dims_.z : hi.z, 0.0f);
+        program.uniforms[4] = glm::vec4(lo.x, lo.y, lo.z, 0.0f);
+        program.uniforms[5] = end;
+        program.uniforms[6] = glm::vec4(n.x, n.y, n.z, 0.0f);
+        const std::vector<raster::Vertex> part(vertices.begin() + static_cast<std::ptrdiff_t>(sliceFirst[kLo]),
+                                               vertices.begin() + static_cast<std::ptrdiff_t>(sliceFirst[kHi + 1]));
+        const raster::DrawStats d =
+            raster::draw(device_, *framebuffer_, state, raster::Topology::Triangles, part, program);
+        total.fragments += d.fragments;
+        total.triangles += d.triangles;
+    }
+    stats.extra["brick_uploads"] = uploads;
+    stats.extra["brick_upload_bytes"] = uploadBytes;
+    stats.extra["brick_upload_ms"] = uploadMs;
+    return total;
+}
+
+std::vector<double> Iso3dRendererImpl::hitDepth()
+{
+    // Window depth d back to eye depth z for the projection of the last frame (glm's, NDC z in [-1,1],
+    // d = (ndc + 1) / 2): perspective ndc = (f + n)/(f - n) - 2fn/((f - n) z); parallel ndc = (2z - f - n)/(f - n).
+    const std::vector<float> depth = framebuffer_->readDepth(device_);
+    std::vector<double> z(depth.size(), std::numeric_limits<double>::infinity());
+    const double n = nearZ_, f = farZ_;
+    for (std::size_t i = 0; i < depth.size(); ++i) {
+        if (!(depth[i] < 1.0f))
+            continue;
+        const double ndc = 2.0 * depth[i] - 1.0;
+        z[i] = camera_.parallel ? 0.5 * (ndc * (f - n) + f + n) : 2.0 * f * n / ((f + n) - ndc * (f - n));
+    }
+    return z;
+}
+
+}  // namespace
+
+Iso3dOptions parseIso3dOptions(const nlohmann::json& options)
+{
+    Iso3dOptions o;
+    if (options.is_null())
+        return o;
+    if (!options.is_object())
+        throw InputError("options: must be an object");
+    for (const auto& [key, value] : options.items()) {
+        if (key == "slices") {
+            if (!value.is_number_integer())
+                badOption(key, "must be an integer, got " + value.dump());
+            const auto n = value.get<long long>();
+            if (n < 1 || n > kMaxSlices)
+                badOption(key, "must be in [1, " + std::to_string(kMaxSlices) + "], got " + std::to_string(n));
+            o.slices = static_cast<int>(n);
+        } else if (key == "slice_spacing") {
+            if (!value.is_number() || !(value.get<double>() > 0.0) || !std::isfinite(value.get<double>()))
+                badOption(key, "must be a positive number (world units), got " + value.dump());
+            o.sliceSpacing = value.get<double>();
+        } else if (key == "gradientless_step") {
+            if (!value.is_number() || !(value.get<double>() > 0.0) || !std::isfinite(value.get<double>()))
+                badOption(key, "must be a positive number (world units), got " + value.dump());
+            o.gradientlessStep = value.get<double>();
+        } else if (key == "gradientless_scale") {
+            if (!value.is_number() || !(value.get<double>() > 0.0) || !std::isfinite(value.get<double>()))
+                badOption(key, "must be a positive number (per data unit), got " + value.dump());
+            o.gradientlessScale = value.get<double>();
+        } else if (key == "brick_budget") {
+            if (!value.is_number_integer() || value.get<long long>() < 1)
+                badOption(key, "must be a positive integer (bytes of brick textures on the device), got " + value.dump());
+            o.brickBudget = value.get<std::uint64_t>();
+        } else if (key == "bricks") {
+            if (!value.is_array() || value.size() != 3)
+                badOption(key, "must be [nx, ny, nz], bricks per axis, got " + value.dump());
+            for (int a = 0; a < 3; ++a) {
+                if (!value[a].is_number_integer() || value[a].get<long long>() < 1 || value[a].get<long long>() > 65536)
+                    badOption(key, "must be [nx, ny, nz], integers in [1, 65536], got " + value.dump());
+                o.bricks[a] = value[a].get<int>();
+            }
+        } else if (key == "interior") {
+            if (!value.is_boolean())
+                badOption(key, "must be true or false, got " + value.dump());
+            o.interior = value.get<bool>();
+        } else {
+            badOption(key, "unknown option for iso3d (known: slices, slice_spacing, gradientless_step, gradientless_scale, "
+                           "interior, brick_budget, bricks)");
+        }
+    }
+    if (options.contains("slices") && options.contains("slice_spacing"))
+        badOption("slice_spacing", "give either slices or slice_spacing, not both");
+    if (options.contains("brick_budget") && options.contains("bricks"))
+        badOption("bricks", "give either brick_budget or bricks, not both");
+    return o;
+}
+
+IsoSurface parseIsoSurface(const Scene& scene)
+{
+    // scene.cpp has checked types and ranges; what is left is iso3d's own choices.
+    const nlohmann::json& v = scene.iso;
+    if (!v.is_object())
+        throw InputError("iso: technique iso3d needs \"iso\": {\"value\": ...}, and the scene has none");
+    IsoSurface iso;
+    iso.value = v.at("value").get<double>();
+    if (v.contains("shading")) {
+        const std::string s = v["shading"].get<std::string>();
+        if (s == "gradient")
+            iso.shading = IsoSurface::Shading::Gradient;
+        else if (s == "gradientless")
+            iso.shading = IsoSurface::Shading::Gradientless;
+        else if (s == "none")
+            iso.shading = IsoSurface::Shading::None;
+        else
+            throw InputError("iso.shading: must be \"gradient\", \"gradientless\" or \"none\" for iso3d, got \"" + s + "\"");
+    }
+    if (v.contains("light")) {
+        const auto l = v["light"];
+        iso.light = glm::normalize(glm::dvec3(l[0].get<double>(), l[1].get<double>(), l[2].get<double>()));
+    }
+    if (v.contains("ambient"))
+        iso.ambient = v["ambient"].get<double>();
+    if (v.contains("diffuse"))
+        iso.diffuse = v["diffuse"].get<double>();
+    if (!scene.transferFunction.points().empty())
+        iso.color = glm::dvec3(scene.transferFunction(iso.value));
+    return iso;
+}
+
+std::vector<glm::vec4> encodedNormalVolume(const Volume& volume)
+{
+    std::vector<glm::vec4> rgba = sobelGradientVolume(volume);
+    for (glm::vec4& p : rgba) {
+        const glm::dvec3 g(p);
+        const double length = glm::length(g);
+        const glm::dvec3 n = length > 0.0 ? -g / length : glm::dvec3(0.0);
+        p = glm::vec4(glm::vec3(0.5 * n + 0.5), p.w);
+    }
+    return rgba;
+}
+
+double medianGradientAtIso(const Volume& volume, double iso)
+{
+    const std::vector<glm::vec4> gradients = sobelGradientVolume(volume);
+    const glm::ivec3 n = volume.dims;
+    std::vector<float> lengths;
+    for (int k = 0; k < n.z; ++k)
+        for (int j = 0; j < n.y; ++j)
+            for (int i = 0; i < n.x; ++i) {
+                const double f = volume.at(i, j, k) - iso;
+                const bool crossing = (i + 1 < n.x && f * (volume.at(i + 1, j, k) - iso) <= 0.0) ||
+                                      (j + 1 < n.y && f * (volume.at(i, j + 1, k) - iso) <= 0.0) ||
+                                      (k + 1 < n.z && f * (volume.at(i, j, k + 1) - iso) <= 0.0);
+                if (crossing)
+                    lengths.push_back(glm::length(glm::vec3(gradients[(static_cast<std::size_t>(k) * n.y + j) * n.x + i])));
+            }
+    if (lengths.empty())
+        return 1.0;
+    std::nth_element(lengths.begin(), lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2), lengths.end());
+    const double median = lengths[lengths.size() / 2];
+    return median > 0.0 ? median : 1.0;
+}
+
+glm::dmat4 isoColorMatrix(const glm::dvec3& light, const glm::dmat3& rotation)
+{
+    // glm is column-major: m[c][r]. The paper's three factors, right to left.
+    glm::dmat4 decode(2.0);  // 2c - 1 on rgb, alpha kept
+    decode[3] = glm::dvec4(-1.0, -1.0, -1.0, 1.0);
+    const glm::dmat4 rot(rotation);
+    glm::dmat4 lightRows(0.0);  // rows 0..2 = (L_x, L_y, L_z, 0), row 3 = (0, 0, 0, 1)
+    for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r)
+            lightRows[c][r] = light[c];
+    lightRows[3][3] = 1.0;
+    return lightRows * rot * decode;
+}
+
+raster::PixelTransfer isoShadingTransfer(const IsoSurface& iso, const glm::dmat3& rotation)
+{
+    glm::dmat4 matrix = isoColorMatrix(iso.light, rotation);
+    matrix[3] = glm::dvec4(0.0, 0.0, 0.0, 1.0);  // the alpha column: no -1 there, alpha passes
+    const double decodeBias = glm::dot(iso.light, rotation * glm::dvec3(1.0));  // <L, M_rot (1, 1, 1)>
+    raster::PixelTransfer xf;
+    xf.colorMatrix = glm::mat4(matrix);
+    xf.scale = glm::vec4(glm::vec3(iso.diffuse * iso.color), 1.0f);
+    xf.bias = glm::vec4(glm::vec3(iso.color * (iso.ambient - iso.diffuse * decodeBias)), 0.0f);
+    return xf;
+}
+
+std::uint64_t MemoryBricks::bytes(const glm::ivec3& b) const
+{
+    const glm::ivec3 n = dims(b);
+    return static_cast<std::uint64_t>(n.x) * n.y * n.z * bytesPerPoint;
+}
+
+std::uint64_t MemoryBricks::maxBytes() const
+{
+    // Slabs differ by at most one cell per axis: the largest brick takes the largest slab of each.
+    glm::ivec3 n(0);
+    for (int a = 0; a < 3; ++a)
+        for (int s = 0; s < counts[a]; ++s)
+            n[a] = std::max(n[a], starts[a][s + 1] - starts[a][s] + 1);
+    return static_cast<std::uint64_t>(n.x) * n.y * n.z * bytesPerPoint;
+}
+
+MemoryBricks splitBricks(const glm::ivec3& dims, const glm::ivec3& counts, std::uint64_t bytesPerPoint)
+{
+    MemoryBricks grid;
+    grid.counts = counts;
+    grid.bytesPerPoint = bytesPerPoint;
+    for (int a = 0; a < 3; ++a) {
+        const int cells = dims[a] - 1;
+        if (counts[a] < 1 || counts[a] > cells)
+            badOption("bricks", "axis " + std::to_string(a) + " has " + std::to_string(cells) + " cells, so from 1 to " +
+                                    std::to_string(cells) + " bricks, got " + std::to_string(counts[a]));
+        grid.starts[a].resize(static_cast<std::size_t>(counts[a]) + 1);
+        for (int s = 0; s <= counts[a]; ++s)
+            grid.starts[a][s] = static_cast<int>(static_cast<long long>(s) * cells / counts[a]);
+    }
+    return grid;
+}
+
+MemoryBricks planBricks(const glm::ivec3& dims, std::uint64_t bytesPerPoint, std::uint64_t budget)
+{
+    const std::uint64_t smallest = 8 * bytesPerPoint;
+    if (budget < smallest)
+        badOption("brick_budget", std::to_string(budget) + " bytes is less than the smallest brick, 2x2x2 grid points x " +
+                                      std::to_string(bytesPerPoint) + " bytes = " + std::to_string(smallest) + " bytes");
+    glm::ivec3 counts(1);
+    for (;;) {
+        const MemoryBricks grid = splitBricks(dims, counts, bytesPerPoint);
+        if (grid.maxBytes() <= budget)
+            return grid;
+        // Cut the axis whose bricks have the most grid points (of those with more than one cell left).
+        int axis = -1, most = 0;
+        for (int a = 0; a < 3; ++a) {
+            const int cells = dims[a] - 1;
+            const int points = (cells + counts[a] - 1) / counts[a] + 1;
+            if (points > 2 && points > most) {
+                most = points;
+                axis = a;
+            }
+        }
+        ++counts[axis];  // axis >= 0: 2x2x2 points fit the budget
+    }
+}
+
+std::vector<glm::ivec3> brickOrder(const MemoryBricks& grid, const Camera& camera, const glm::dvec3& origin,
+                                   const glm::dvec3& spacing)
+{
+    // Per axis, the key of slab s: perspective, |s - the eye's slab| (the eye's coordinate clamped to the
+    // grid); parallel, s counted along the view direction. Along any ray from the eye each axis' key never
+    // decreases and one grows at every brick change, so the sum is a visibility order.
+    const glm::dvec3 forward = camera.forward();
+    std::array<std::vector<int>, 3> key;
+    for (int a = 0; a < 3; ++a) {
+        const int n = grid.counts[a];
+        key[a].resize(static_cast<std::size_t>(n));
+        if (camera.parallel) {
+            for (int s = 0; s < n; ++s)
+                key[a][s] = forward[a] > 0.0 ? s : forward[a] < 0.0 ? n - 1 - s : 0;
+        } else {
+            const double g = (camera.position[a] - origin[a]) / spacing[a];  // the eye in grid units
+            int eye = 0;
+            while (eye + 1 < n && g >= grid.starts[a][eye + 1])
+                ++eye;
+            for (int s = 0; s < n; ++s)
+                key[a][s] = std::abs(s - eye);
+        }
+    }
+    std::vector<glm::ivec3> order;
+    for (int z = 0; z < grid.counts.z; ++z)
+        for (int y = 0; y < grid.counts.y; ++y)
+            for (int x = 0; x < grid.counts.x; ++x)
+                order.emplace_back(x, y, z);
+    std::stable_sort(order.begin(), order.end(), [&](const glm::ivec3& p, const glm::ivec3& q) {
+        return key[0][p.x] + key[1][p.y] + key[2][p.z] < key[0][q.x] + key[1][q.y] + key[2][q.z];
+    });
+    return order;
+}
+
+std::unique_ptr<Iso3dRenderer> makeIso3dRenderer(Device& device, const Scene& scene, const Volume& volume)
+{
+    return std::make_unique<Iso3dRendererImpl>(device, scene, volume);
+}
+
+}  // namespace clvr

@@ -1,0 +1,755 @@
+// host/render/grid/slice3d.cpp — options, slice planning, slice polygons, and the two paths of the
+// slice3d technique: the fused kernel (kernels/slice3d.cl: slice3d_fused) and the pass-by-pass
+// path through raster::draw with kernels/slice3d.cl as fragment program.
+#include "host/render/grid/slice3d.h"
+
+#include "host/runtime/embedded_kernels.h"
+#include "host/runtime/errors.h"
+#include "host/render/camera_args.h"
+#include "host/render/options_util.h"
+#include "raster/framebuffer.h"
+#include "raster/rasterizer.h"
+#include "raster/texture.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+namespace clvr {
+namespace {
+
+constexpr int kMaxSlices = 65536;
+constexpr const char* kKnownOptions =
+    "slices, slice_spacing, order, early_termination, path, empty_space_skipping, voxel_type, clip, clip_texture";
+
+class Slice3dRenderer final : public Renderer {
+public:
+    Slice3dRenderer(Device& device, const Scene& scene, const Volume& volume);
+    Image4f render(FrameStats& stats) override;
+    std::uint64_t residentBytes() const override { return residentBytes_; }
+    void setTransferFunction(const TransferFunction& tf) override;
+    void setClipPlacement(const glm::dvec3& offset, const glm::dmat3& matrix);
+
+private:
+    Image4f renderFused(FrameStats& stats);
+    Image4f renderRaster(FrameStats& stats);
+    raster::DrawStats drawClipped(const std::vector<raster::Vertex>& slices, const std::vector<std::size_t>& firsts,
+                                  const raster::DrawState& sliceState, const glm::dmat4& viewProjection);
+
+    Device& device_;
+    Slice3dOptions options_;
+    Camera camera_;
+    ImageSpec image_;
+    glm::ivec3 dims_;
+    glm::dvec3 origin_, spacing_, lo_, hi_;
+    int tfCount_ = 0;
+    SlicePlan plan_;
+    cl::Buffer volume_, tf_;
+    std::uint64_t residentBytes_ = 0;
+    // Empty-space skipping (fused path).
+    glm::ivec3 brickDims_{0};
+    BrickGrid brickGrid_;  // min-max per brick, kept to classify the bricks again for a new transfer function
+    cl::Buffer emptyBricks_;
+    std::uint64_t emptyBrickCount_ = 0;
+    double brickSetupMs_ = 0.0;
+    std::string voxelType_ = "float32";  // on the device
+    // Fused path.
+    cl::Kernel fused_;
+    cl::Buffer out_, samples_, skipped_;
+    // Pass-by-pass path.
+    std::unique_ptr<raster::Framebuffer> framebuffer_;
+    raster::FragmentProgram fragmentProgram_;
+    raster::Rasterizer rasterizer_{device_};      // slice polygons: its stats are the frame's samples
+    raster::Rasterizer clipRasterizer_{device_};  // the clip mesh's stencil passes, not counted
+    cl::Kernel overBackground_;
+    // Clipping (raster path): the closed mesh and its farthest eye depth.
+    std::optional<ClipMesh> clipMesh_;
+    double clipDepthMax_ = 0.0;
+    // Clip texture (both paths): the texture, its device copy, and world -> texture coordinates.
+    std::optional<ClipTexture> clipTexture_;
+    std::unique_ptr<raster::Texture> clipTexels_;
+    glm::dmat4 clipCoordinates_{1.0};
+};
+
+Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volume& volume)
+    : device_(device), options_(parseSlice3dOptions(scene.options)), image_(scene.image)
+{
+    volume.validate();
+    if (volume.voxelCount() > 0xffffffffull)
+        throw InputError(volume.source + ": slice3d takes at most 2^32 - 1 grid points (32-bit voxel indices)");
+    dims_ = volume.dims;
+    origin_ = volume.origin;
+    spacing_ = volume.spacing;
+    lo_ = volume.boundsMin();
+    hi_ = volume.boundsMax();
+    camera_ = scene.camera ? *scene.camera : fitCamera(lo_, hi_);
+    camera_.validate();
+    if (image_.width < 1 || image_.height < 1)
+        throw InputError("image: width and height must be >= 1");
+    plan_ = planSlices(camera_, lo_, hi_, options_);
+    if (options_.clip) {
+        clipMesh_ = loadClipMesh(options_.clip->mesh, scene.baseDir);
+        clipDepthMax_ = -std::numeric_limits<double>::infinity();
+        for (const glm::dvec3& p : clipMesh_->points)
+            clipDepthMax_ = std::max(clipDepthMax_, glm::dot(camera_.forward(), p - camera_.position));
+    }
+
+    if (options_.clipTexture) {
+        clipTexture_ = makeClipTexture(*options_.clipTexture, scene.baseDir);
+        clipCoordinates_ =
+            clipTextureCoordinates(*clipTexture_, options_.clipTexture->offset, options_.clipTexture->matrix);
+    }
+
+    // On the fused path with voxel_type auto, uint8 or uint16 when every value is an integer in that
+    // range (1 or 2 bytes per grid point, converted to float exactly in the kernel); else float32, 4
+    // bytes per grid point. Device::buffer throws DeviceError if too big.
+    std::string trilinearOptions;
+    const bool fused = options_.path == Slice3dOptions::Path::Fused;
+    auto integralUpTo = [&](float top) {
+        return std::all_of(volume.values.begin(), volume.values.end(),
+                           [top](float v) { return v >= 0.0f && v <= top && v == std::floor(v); });
+    };
+    if (fused && options_.nativeVoxels && integralUpTo(255.0f)) {
+        std::vector<cl_uchar> v(volume.values.begin(), volume.values.end());
+        volume_ = device_.upload("slice3d volume (uint8)", v);
+        voxelType_ = "uint8";
+        residentBytes_ = v.size();
+        trilinearOptions = "-DSLICE3D_VOXEL=uchar -DSLICE3D_TRILINEAR=clvr_trilinear_uchar";
+    } else if (fused && options_.nativeVoxels && integralUpTo(65535.0f)) {
+        std::vector<cl_ushort> v(volume.values.begin(), volume.values.end());
+        volume_ = device_.upload("slice3d volume (uint16)", v);
+        voxelType_ = "uint16";
+        residentBytes_ = v.size() * sizeof(cl_ushort);
+        trilinearOptions = "-DSLICE3D_VOXEL=ushort -DSLICE3D_TRILINEAR=clvr_trilinear_ushort";
+    } else {
+        volume_ = device_.upload("slice3d volume (float32)", volume.values);
+        residentBytes_ = volume.values.size() * sizeof(float);
+    }
+    const std::vector<float> tf = packTransferFunction(scene.transferFunction);
+    tfCount_ = static_cast<int>(scene.transferFunction.points().size());
+    tf_ = device_.upload("slice3d transfer function", tf);
+    residentBytes_ += tf.size() * sizeof(float);
+
+    if (clipTexture_) {
+        clipTexels_ = std::make_unique<raster::Texture>(device_, clipTexture_->desc, clipTexture_->texels);
+        residentBytes_ += clipTexels_->bytes();
+        trilinearOptions += " -DSLICE3D_CLIP_TEXTURE=1";
+    }
+
+    const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
+    if (options_.path == Slice3dOptions::Path::Fused) {
+        fused_ = device_.kernel("slice3d.cl", "slice3d_fused", {}, trilinearOptions);
+        out_ = device_.buffer("slice3d image", pixels * sizeof(cl_float4), CL_MEM_WRITE_ONLY);
+        samples_ = device_.buffer("slice3d sample counts", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
+        skipped_ = device_.buffer("slice3d skipped sample counts", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
+        // The min-max grid (host) and one flag byte per brick for this transfer function (device).
+        const auto t0 = std::chrono::steady_clock::now();
+        brickGrid_ = buildBrickGrid(volume);
+        const BrickGrid& grid = brickGrid_;
+        std::vector<cl_uchar> flags = emptyBricks(grid, scene.transferFunction);
+        brickSetupMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        brickDims_ = grid.dims;
+        emptyBrickCount_ = static_cast<std::uint64_t>(std::count(flags.begin(), flags.end(), cl_uchar(1)));
+        emptyBricks_ = device_.upload("slice3d empty-space radii", emptySpaceRadii(grid.dims, flags));
+        residentBytes_ += flags.size();
+    } else {
+        framebuffer_ = std::make_unique<raster::Framebuffer>(device_, image_.width, image_.height);
+        overBackground_ = device_.kernel("slice3d.cl", "slice3d_over_background");
+        std::string_view source;
+        for (const EmbeddedKernel& k : embeddedKernels())
+            if (k.name == "slice3d.cl")
+                source = k.source;
+        fragmentProgram_.source = std::string("#define CLVR_SLICE3D_FRAGMENT 1\n") +
+                                  (clipTexture_ ? "#define CLVR_SLICE3D_CLIP_TEXTURE 1\n" : "") + std::string(source);
+        fragmentProgram_.buffers[0] = volume_;
+        fragmentProgram_.buffers[1] = tf_;
+        const glm::dvec3 invSpacing = 1.0 / spacing_;
+        const std::array<glm::vec4, 5> cameraUniforms = cameraVectors(camera_, image_.width, image_.height);
+        fragmentProgram_.uniforms = {
+            cameraUniforms[0], cameraUniforms[1], cameraUniforms[2], cameraUniforms[3], cameraUniforms[4],
+            glm::vec4(image_.width, image_.height, static_cast<float>(plan_.deltaS), tfCount_),
+            glm::vec4(glm::vec3(origin_), 0.0f),
+            glm::vec4(glm::vec3(invSpacing), 0.0f),
+            glm::vec4(dims_.x, dims_.y, dims_.z, 0.0f),
+        };
+        if (clipTexture_) {  // the second texture: buffer 2, uniform 9, coordinates in attribute 1
+            fragmentProgram_.buffers[2] = clipTexels_->buffer();
+            const glm::ivec3 n = clipTexture_->dims();
+            fragmentProgram_.uniforms.push_back(
+                glm::vec4(n.x, n.y, n.z, options_.clipTexture->inverse ? 1.0f : 0.0f));
+        }
+    }
+}
+
+void Slice3dRenderer::setClipPlacement(const glm::dvec3& offset, const glm::dmat3& matrix)
+{
+    if (!clipTexture_)
+        throw InputError("slice3d: no clip texture to move (options.clip_texture is not given)");
+    if (!(std::abs(glm::determinant(matrix)) > 0.0))
+        throw InputError("slice3d: the clip texture's matrix must be invertible");
+    options_.clipTexture->offset = offset;
+    options_.clipTexture->matrix = matrix;
+    clipCoordinates_ = clipTextureCoordinates(*clipTexture_, offset, matrix);
+}
+
+Image4f Slice3dRenderer::render(FrameStats& stats)
+{
+    const auto start = std::chrono::steady_clock::now();
+    Image4f image = options_.path == Slice3dOptions::Path::Fused ? renderFused(stats) : renderRaster(stats);
+    stats.frameMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    stats.extra["slices"] = plan_.count;
+    stats.extra["slice_spacing"] = plan_.deltaS;
+    stats.extra["depth_range"] = {plan_.depthMin, plan_.depthMax};
+    stats.extra["order"] = options_.order == Slice3dOptions::Order::BackToFront ? "back-to-front" : "front-to-back";
+    stats.extra["path"] = options_.path == Slice3dOptions::Path::Fused ? "fused" : "raster";
+    stats.extra["early_termination"] = options_.earlyTermination;
+    stats.extra["voxels"] = static_cast<std::uint64_t>(dims_.x) * dims_.y * dims_.z;
+    stats.extra["resident_bytes"] = residentBytes_;
+    stats.extra["voxel_type"] = voxelType_;
+    if (clipTexture_) {
+        const glm::ivec3 n = clipTexture_->dims();
+        stats.extra["clip_texture"] = clipTexture_->source;
+        stats.extra["clip_texture_dims"] = {n.x, n.y, n.z};
+        stats.extra["clip_texture_inverse"] = options_.clipTexture->inverse;
+    }
+    return image;
+}
+
+void Slice3dRenderer::setTransferFunction(const TransferFunction& tf)
+{
+    const std::vector<float> packed = packTransferFunction(tf);
+    residentBytes_ -= static_cast<std::uint64_t>(((tfCount_ + 3) / 4 * 4 + 8 * tfCount_) * sizeof(float));
+    tfCount_ = static_cast<int>(tf.points().size());
+    tf_ = device_.upload("slice3d transfer function", packed);
+    residentBytes_ += packed.size() * sizeof(float);
+    if (options_.path == Slice3dOptions::Path::Fused) {
+        // Which bricks are empty depends on the transfer function: classify the kept min-max grid again.
+        const auto t0 = std::chrono::steady_clock::now();
+        const std::vector<cl_uchar> flags = emptyBricks(brickGrid_, tf);
+        const std::vector<cl_uchar> radii = emptySpaceRadii(brickGrid_.dims, flags);
+        brickSetupMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        emptyBrickCount_ = static_cast<std::uint64_t>(std::count(flags.begin(), flags.end(), cl_uchar(1)));
+        device_.queue().enqueueWriteBuffer(emptyBricks_, CL_TRUE, 0, radii.size(), radii.data());
+    } else {
+        fragmentProgram_.buffers[1] = tf_;
+        fragmentProgram_.uniforms[5].w = static_cast<float>(tfCount_);
+    }
+}
+
+Image4f Slice3dRenderer::renderFused(FrameStats& stats)
+{
+    const glm::dvec3 invSpacing = 1.0 / spacing_;
+    const bool frontToBack = options_.order == Slice3dOptions::Order::FrontToBack;
+    // ERT threshold 1.0 means off: pass a value accumulated opacity can never reach.
+    const float ert = options_.earlyTermination < 1.0 ? static_cast<float>(options_.earlyTermination) : 2.0f;
+    int a = 0;
+    fused_.setArg(a++, out_);
+    fused_.setArg(a++, samples_);
+    fused_.setArg(a++, skipped_);
+    fused_.setArg(a++, static_cast<cl_int>(image_.width));
+    fused_.setArg(a++, static_cast<cl_int>(image_.height));
+    fused_.setArg(a++, volume_);
+    fused_.setArg(a++, cl_int4{{dims_.x, dims_.y, dims_.z, 0}});
+    fused_.setArg(a++, toCl4(origin_));
+    fused_.setArg(a++, toCl4(invSpacing));
+    fused_.setArg(a++, tf_);
+    fused_.setArg(a++, static_cast<cl_int>(tfCount_));
+    fused_.setArg(a++, emptyBricks_);
+    fused_.setArg(a++, cl_int4{{brickDims_.x, brickDims_.y, brickDims_.z, 0}});
+    // Off when asked, or when no brick is empty (then the loop is the plain one).
+    const bool skip = options_.emptySpaceSkipping && emptyBrickCount_ > 0;
+    fused_.setArg(a++, static_cast<cl_int>(skip ? 1 : 0));
+    a = setCameraArgs(fused_, a, camera_, image_.width, image_.height);
+    fused_.setArg(a++, static_cast<cl_float>(plan_.depth(0)));
+    fused_.setArg(a++, static_cast<cl_float>(plan_.deltaS));
+    fused_.setArg(a++, static_cast<cl_int>(plan_.count));
+    fused_.setArg(a++, static_cast<cl_int>(frontToBack ? 1 : 0));
+    fused_.setArg(a++, static_cast<cl_float>(ert));
+    fused_.setArg(a++, toCl4(image_.background, 0.0));
+    if (clipTexture_) {
+        fused_.setArg(a++, clipTexels_->buffer());
+        fused_.setArg(a++, clipTexels_->toCl());
+        for (int r = 0; r < 3; ++r)  // rows of the affine world -> texture coordinates map
+            fused_.setArg(a++, toCl4(glm::dvec3(clipCoordinates_[0][r], clipCoordinates_[1][r], clipCoordinates_[2][r]),
+                                     clipCoordinates_[3][r]));
+        fused_.setArg(a++, static_cast<cl_int>(options_.clipTexture->inverse ? 1 : 0));
+    }
+    device_.launch("slice3d: fused", fused_, image_.width, image_.height);
+
+    const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
+    Image4f image(image_.width, image_.height);
+    device_.queue().enqueueReadBuffer(out_, CL_FALSE, 0, pixels * sizeof(glm::vec4), image.pixels().data());
+    const std::vector<cl_uint> counts = device_.download<cl_uint>(samples_, pixels);
+    const std::vector<cl_uint> skippedCounts = device_.download<cl_uint>(skipped_, pixels);
+    // samples: inside the box (taken + stepped over), as without skipping; the skipped ones apart.
+    stats.samples = std::accumulate(counts.begin(), counts.end(), std::uint64_t(0));
+    const std::uint64_t skipped = std::accumulate(skippedCounts.begin(), skippedCounts.end(), std::uint64_t(0));
+    stats.extra["samples_skipped"] = skipped;
+    stats.extra["samples_taken"] = stats.samples - skipped;
+    stats.extra["empty_space_skipping"] = skip;
+    stats.extra["bricks"] = {brickDims_.x, brickDims_.y, brickDims_.z};
+    stats.extra["empty_bricks"] = emptyBrickCount_;
+    stats.extra["brick_setup_ms"] = brickSetupMs_;
+    stats.passes = device_.takePassTimes();
+    return image;
+}
+
+Image4f Slice3dRenderer::renderRaster(FrameStats& stats)
+{
+    const bool frontToBack = options_.order == Slice3dOptions::Order::FrontToBack;
+    // Clip-space vertices of every slice polygon, fanned into a triangle list, in blending order;
+    // firsts[i] is where the i-th slice drawn begins. The far plane lies beyond the box and the clip
+    // mesh (its back faces must not be cut); x, y and w do not depend on it, so neither do the slices.
+    const glm::dvec3 forward = camera_.forward();
+    const double nearZ = 0.5 * plan_.depth(0);
+    const double farZ = 2.0 * std::max(plan_.depthMax, clipMesh_ ? clipDepthMax_ : 0.0) + 1.0;
+    const glm::dmat4 viewProjection =
+        camera_.projectionMatrix(image_.width, image_.height, nearZ, farZ) * camera_.viewMatrix();
+    std::vector<raster::Vertex> vertices;
+    std::vector<std::size_t> firsts;
+    vertices.reserve(static_cast<std::size_t>(plan_.count) * 12);
+    for (int i = 0; i < plan_.count; ++i) {
+        const int k = frontToBack ? i : plan_.count - 1 - i;
+        const double offset = glm::dot(forward, camera_.position) + plan_.depth(k);
+        const std::vector<glm::dvec3> polygon = slicePolygon(lo_, hi_, forward, offset);
+        auto vertex = [&](const glm::dvec3& p) {
+            raster::Vertex v;
+            v.position = glm::vec4(viewProjection * glm::dvec4(p, 1.0));
+            v.attributes[0] = glm::vec4(glm::vec3(p), 1.0f);
+            if (clipTexture_)  // the second texture's coordinates: moving the clip texture changes only these
+                v.attributes[1] = glm::vec4(glm::vec3(clipCoordinates_ * glm::dvec4(p, 1.0)), 1.0f);
+            return v;
+        };
+        firsts.push_back(vertices.size());
+        for (std::size_t j = 1; j + 1 < polygon.size(); ++j) {
+            vertices.push_back(vertex(polygon[0]));
+            vertices.push_back(vertex(polygon[j]));
+            vertices.push_back(vertex(polygon[j + 1]));
+        }
+    }
+    firsts.push_back(vertices.size());
+    raster::DrawState state;
+    state.fragment.blend.enabled = true;
+    if (frontToBack) {  // "under": dst += (1 - dst.a) src
+        state.fragment.blend.srcRgb = state.fragment.blend.srcAlpha = raster::BlendFactor::OneMinusDstAlpha;
+        state.fragment.blend.dstRgb = state.fragment.blend.dstAlpha = raster::BlendFactor::One;
+    } else {            // "over" on premultiplied color: dst = src + (1 - src.a) dst
+        state.fragment.blend.srcRgb = state.fragment.blend.srcAlpha = raster::BlendFactor::One;
+        state.fragment.blend.dstRgb = state.fragment.blend.dstAlpha = raster::BlendFactor::OneMinusSrcAlpha;
+    }
+    framebuffer_->clearColor(device_, glm::vec4(0.0f));
+    raster::DrawStats drawStats;
+    if (clipMesh_)
+        drawStats = drawClipped(vertices, firsts, state, viewProjection);
+    else if (!vertices.empty()) {
+        rasterizer_.draw(*framebuffer_, state, raster::Topology::Triangles, vertices, fragmentProgram_);
+        drawStats = rasterizer_.takeStats();
+    }
+    const std::size_t pixels = framebuffer_->pixelCount();
+    overBackground_.setArg(0, framebuffer_->color());
+    overBackground_.setArg(1, static_cast<cl_int>(pixels));
+    overBackground_.setArg(2, toCl4(image_.background, 0.0));
+    device_.launch("slice3d: over background", overBackground_, pixels);
+    Image4f image = framebuffer_->readColor(device_);
+    stats.passes = device_.takePassTimes();
+    stats.samples = drawStats.fragments;  // fragments of slice polygons; those outside the grid are discarded
+    stats.extra["triangles"] = drawStats.triangles;
+    if (clipMesh_) {
+        stats.extra["clip_triangles"] = clipMesh_->triangles.size();
+        stats.extra["clip_method"] = options_.clip->method == Slice3dClip::Method::TwoPass ? "two-pass" : "naive";
+        stats.extra["clip_inverse"] = options_.clip->inverse;
+    }
+    return image;
+}
+
+// §2.1 of seeds/000, one slice at a time (docs/slice3d.md, "Clipping with closed meshes"). For a
+// pixel, the slice's point P is inside the closed mesh iff the first surface the ray meets beyond P
+// is a back face (the ray leaves there). So, with a user clip plane at the slice plane keeping only
+// what lies behind it:
+//   1. back faces, depth test LESS with depth writes, stencil := 1: the stencil marks pixels with any
+//      back face behind P, and the depth buffer holds the nearest one;
+//   2. front faces, depth test LESS without writes, stencil := 0 where one is in front of that
+//      nearest back face: the ray enters the mesh before it first leaves it, so P is outside
+//      (the naive method stops after 1 and keeps these pixels, Figure 2's error);
+//   3. the slice polygon where stencil == 1 (inside), or == 0 (inverse), blended as without clipping.
+raster::DrawStats Slice3dRenderer::drawClipped(const std::vector<raster::Vertex>& slices,
+                                               const std::vector<std::size_t>& firsts,
+                                               const raster::DrawState& sliceState, const glm::dmat4& viewProjection)
+{
+    const bool frontToBack = options_.order == Slice3dOptions::Order::FrontToBack;
+    const bool twoPass = options_.clip->method == Slice3dClip::Method::TwoPass;
+    const bool inverse = options_.clip->inverse;
+    std::vector<raster::Vertex> mesh;
+    mesh.reserve(clipMesh_->triangles.size() * 3);
+    for (const auto& t : clipMesh_->triangles)
+        for (std::uint32_t i : t) {
+            raster::Vertex v;
+            v.position = glm::vec4(viewProjection * glm::dvec4(clipMesh_->points[i], 1.0));
+            mesh.push_back(v);
+        }
+
+    raster::DrawState back;  // pass 1: no color writes, only stencil (and depth for pass 2)
+    back.fragment.colorMask = {false, false, false, false};
+    back.fragment.cull = raster::CullFace::Front;
+    back.fragment.stencil.test = true;
+    back.fragment.stencil.func = raster::CompareFunc::Always;
+    back.fragment.stencil.ref = 1;
+    back.fragment.stencil.dppass = raster::StencilOp::Replace;
+    back.fragment.depth.test = twoPass;
+    back.fragment.depth.func = raster::CompareFunc::Less;
+    back.fragment.depth.write = true;
+    raster::DrawState front = back;  // pass 2: clear where a front face is nearer than the nearest back face
+    front.fragment.cull = raster::CullFace::Back;
+    front.fragment.stencil.func = raster::CompareFunc::Equal;
+    front.fragment.stencil.dppass = raster::StencilOp::Zero;
+    front.fragment.depth.write = false;
+    raster::DrawState slice = sliceState;  // pass 3
+    slice.fragment.stencil.test = true;
+    slice.fragment.stencil.func = raster::CompareFunc::Equal;
+    slice.fragment.stencil.ref = inverse ? 0 : 1;
+
+    const glm::dmat4 planeToClip = glm::transpose(glm::inverse(viewProjection));
+    for (int i = 0; i < plan_.count; ++i) {
+        if (firsts[i] == firsts[i + 1])
+            continue;  // the plane misses the box
+        const int k = frontToBack ? i : plan_.count - 1 - i;
+        const double offset = glm::dot(camera_.forward(), camera_.position) + plan_.depth(k);
+        const std::vector<raster::Vertex> polygon(slices.begin() + static_cast<std::ptrdiff_t>(firsts[i]),
+                                                  slices.begin() + static_cast<std::ptrdiff_t>(firsts[i + 1]));
+        raster::DrawState sliceHere = slice;
+        if (plan_.depth(k) >= clipDepthMax_) {
+            // No part of the mesh lies behind this slice: every point of it is outside (the passes
+            // would leave the stencil all 0), so skip them.
+            if (!inverse)
+                continue;
+            sliceHere.fragment.stencil.test = false;
+        } else {
+            framebuffer_->clearStencil(device_, 0);
+            if (twoPass)
+                framebuffer_->clearDepth(device_, 1.0f);
+            // Keep dot(forward, p) >= offset: the part of the mesh behind the slice plane. As
+            // raster::clipPlaneFromWorld, but in double (offset may be large next to the box).
+            back.clipPlanes = front.clipPlanes = {glm::vec4(planeToClip * glm::dvec4(camera_.forward(), -offset))};
+            clipRasterizer_.draw(*framebuffer_, back, raster::Topology::Triangles, mesh);
+            if (twoPass)
+                clipRasterizer_.draw(*framebuffer_, front, raster::Topology::Triangles, mesh);
+        }
+        rasterizer_.draw(*framebuffer_, sliceHere, raster::Topology::Triangles, polygon, fragmentProgram_);
+    }
+    clipRasterizer_.takeStats();  // resets its counters
+    return rasterizer_.takeStats();
+}
+
+}  // namespace
+
+namespace {
+
+// options.clip: {"mesh": ..., "inverse": false, "method": "two-pass"|"naive"}; docs/slice3d.md.
+Slice3dClip parseClip(const nlohmann::json& value)
+{
+    if (!value.is_object())
+        badOption("clip", "must be an object such as {\"mesh\": \"torus.off\"}, got " + value.dump());
+    if (!value.contains("mesh"))
+        badOption("clip.mesh", "is missing (a surface file, or {\"generator\": \"box\"|\"sphere\"|\"cylinder\", ...})");
+    Slice3dClip clip;
+    for (const auto& [key, v] : value.items()) {
+        if (key == "mesh") {
+            clip.mesh = parseClipMeshSpec(v, "options.clip.mesh");
+        } else if (key == "inverse") {
+            if (!v.is_boolean())
+                badOption("clip.inverse", "must be true or false, got " + v.dump());
+            clip.inverse = v.get<bool>();
+        } else if (key == "method") {
+            const std::string m = v.is_string() ? v.get<std::string>() : "";
+            if (m == "two-pass")
+                clip.method = Slice3dClip::Method::TwoPass;
+            else if (m == "naive")
+                clip.method = Slice3dClip::Method::Naive;
+            else
+                badOption("clip.method", "must be \"two-pass\" or \"naive\", got " + v.dump());
+        } else {
+            badOption("clip." + key, "unknown key (known: mesh, inverse, method)");
+        }
+    }
+    return clip;
+}
+
+}  // namespace
+
+Slice3dOptions parseSlice3dOptions(const nlohmann::json& options)
+{
+    Slice3dOptions o;
+    forEachOption(options, [&](const std::string& key, const nlohmann::json& value) {
+        if (key == "slices") {
+            if (!value.is_number_integer())
+                badOption(key, "must be an integer, got " + value.dump());
+            const auto n = value.get<long long>();
+            if (n < 1 || n > kMaxSlices)
+                badOption(key, "must be in [1, " + std::to_string(kMaxSlices) + "], got " + std::to_string(n));
+            o.slices = static_cast<int>(n);
+        } else if (key == "slice_spacing") {
+            o.sliceSpacing = numberOption(key, value, [](double x) { return x > 0.0; }, "a positive number (world units)");
+        } else if (key == "order") {
+            const std::string s = value.is_string() ? value.get<std::string>() : "";
+            if (s == "back-to-front")
+                o.order = Slice3dOptions::Order::BackToFront;
+            else if (s == "front-to-back")
+                o.order = Slice3dOptions::Order::FrontToBack;
+            else
+                badOption(key, "must be \"back-to-front\" or \"front-to-back\", got " + value.dump());
+        } else if (key == "early_termination") {
+            o.earlyTermination =
+                numberOption(key, value, [](double x) { return x > 0.0 && x <= 1.0; }, "an opacity in (0, 1] (1 = off)");
+        } else if (key == "path") {
+            const std::string s = value.is_string() ? value.get<std::string>() : "";
+            if (s == "fused")
+                o.path = Slice3dOptions::Path::Fused;
+            else if (s == "raster")
+                o.path = Slice3dOptions::Path::Raster;
+            else
+                badOption(key, "must be \"fused\" or \"raster\", got " + value.dump());
+        } else if (key == "voxel_type") {
+            const std::string s = value.is_string() ? value.get<std::string>() : "";
+            if (s == "auto")
+                o.nativeVoxels = true;
+            else if (s == "float32")
+                o.nativeVoxels = false;
+            else
+                badOption(key, "must be \"auto\" or \"float32\", got " + value.dump());
+        } else if (key == "empty_space_skipping") {
+            if (!value.is_boolean())
+                badOption(key, "must be true or false, got " + value.dump());
+            o.emptySpaceSkipping = value.get<bool>();
+        } else if (key == "clip") {
+            o.clip = parseClip(value);
+        } else if (key == "clip_texture") {
+            o.clipTexture = parseClipTextureSpec(value, "options.clip_texture");
+        } else {
+            badOption(key, std::string("unknown option for slice3d (known: ") + kKnownOptions + ")");
+        }
+    });
+    if (o.clip) {
+        // The stencil passes run per slice, between the slice polygons: only the raster path has them.
+        if (options.contains("path") && o.path == Slice3dOptions::Path::Fused)
+            badOption("clip", "needs \"path\": \"raster\" (the clip mesh is drawn into the stencil buffer per slice; "
+                              "the fused kernel has no stencil), got \"path\": \"fused\"");
+        o.path = Slice3dOptions::Path::Raster;
+    }
+    if (options.contains("slices") && options.contains("slice_spacing"))
+        badOption("slice_spacing", "give either slices or slice_spacing, not both");
+    if (o.earlyTermination < 1.0 && o.order != Slice3dOptions::Order::FrontToBack)
+        badOption("early_termination", "needs \"order\": \"front-to-back\" (back to front cannot stop early)");
+    if (o.earlyTermination < 1.0 && o.path == Slice3dOptions::Path::Raster)
+        badOption("early_termination", "is only available on the fused path (the blending stage cannot stop a pixel)");
+    return o;
+}
+
+SlicePlan planSlices(const Camera& camera, const glm::dvec3& lo, const glm::dvec3& hi, const Slice3dOptions& options)
+{
+    const glm::dvec3 forward = camera.forward();
+    double dMin = std::numeric_limits<double>::infinity(), dMax = -dMin;
+    for (int c = 0; c < 8; ++c) {
+        const glm::dvec3 corner((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
+        const double d = glm::dot(forward, corner - camera.position);
+        dMin = std::min(dMin, d);
+        dMax = std::max(dMax, d);
+    }
+    SlicePlan plan;
+    plan.depthMin = std::max(dMin, 0.0);
+    plan.depthMax = dMax;
+    const double range = dMax - plan.depthMin;
+    if (!(range > 0.0))
+        return plan;  // behind the camera: no slices
+    if (options.sliceSpacing > 0.0) {
+        const double n = std::ceil(range / options.sliceSpacing);
+        if (n > kMaxSlices)
+            badOption("slice_spacing", std::to_string(options.sliceSpacing) + " gives " + std::to_string(n) +
+                                           " slices for this view, more than " + std::to_string(kMaxSlices));
+        plan.count = std::max(1, static_cast<int>(n));
+        plan.deltaS = options.sliceSpacing;
+    } else {
+        plan.count = options.slices;
+        plan.deltaS = range / options.slices;
+    }
+    return plan;
+}
+
+std::vector<glm::dvec3> slicePolygon(const glm::dvec3& lo, const glm::dvec3& hi, const glm::dvec3& normal,
+                                     double offset)
+{
+    std::vector<glm::dvec3> points;
+    auto corner = [&](int c) {
+        return glm::dvec3((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
+    };
+    const double scale = glm::length(hi - lo);
+    const double eps = 1e-12 * (scale + std::abs(offset));
+    // The 12 edges: corner pairs differing in one bit.
+    for (int c = 0; c < 8; ++c)
+        for (int bit = 1; bit < 8; bit <<= 1) {
+            if (c & bit)
+                continue;
+            const glm::dvec3 a = corner(c), b = corner(c | bit);
+            const double da = glm::dot(normal, a) - offset, db = glm::dot(normal, b) - offset;
+            if ((da > eps && db > eps) || (da < -eps && db < -eps))
+                continue;
+            glm::dvec3 p;
+            if (std::abs(da - db) <= eps)  // edge in the plane: both ends
+                continue;                  // (its ends are found by the adjacent edges)
+            p = a + (b - a) * glm::clamp(da / (da - db), 0.0, 1.0);
+            bool duplicate = false;
+            for (const glm::dvec3& q : points)
+                duplicate = duplicate || glm::length(p - q) <= 1e-9 * scale;
+            if (!duplicate)
+                points.push_back(p);
+        }
+    if (points.size() < 3)
+        return {};
+    glm::dvec3 centroid(0.0);
+    for (const glm::dvec3& p : points)
+        centroid += p;
+    centroid /= static_cast<double>(points.size());
+    // Plane basis (u, v) with u x v = normal.
+    const glm::dvec3 helper = std::abs(normal.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
+    const glm::dvec3 u = glm::normalize(glm::cross(helper, normal));
+    const glm::dvec3 v = glm::cross(normal, u);
+    std::sort(points.begin(), points.end(), [&](const glm::dvec3& a, const glm::dvec3& b) {
+        return std::atan2(glm::dot(a - centroid, v), glm::dot(a - centroid, u)) <
+               std::atan2(glm::dot(b - centroid, v), glm::dot(b - centroid, u));
+    });
+    return points;
+}
+
+BrickGrid buildBrickGrid(const Volume& volume)
+{
+    BrickGrid grid;
+    const glm::ivec3 n = volume.dims;
+    grid.dims = (n - 1 + (kBrickCells - 1)) / kBrickCells;  // cells n - 1 per axis
+    grid.minMax.assign(static_cast<std::size_t>(grid.dims.x) * grid.dims.y * grid.dims.z,
+                       glm::vec2(std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity()));
+    // Per row of x: (min, max) over each brick's x range [Bb, Bb + B], then merged into every brick
+    // whose y and z ranges hold the row (2 bricks where j or k is a multiple of B).
+    std::vector<glm::vec2> row(grid.dims.x);
+    for (int k = 0; k < n.z; ++k)
+        for (int j = 0; j < n.y; ++j) {
+            const float* v = volume.values.data() + (static_cast<std::size_t>(k) * n.y + j) * n.x;
+            for (int bx = 0; bx < grid.dims.x; ++bx) {
+                const int i0 = bx * kBrickCells, i1 = std::min(i0 + kBrickCells, n.x - 1);
+                const auto [mn, mx] = std::minmax_element(v + i0, v + i1 + 1);
+                row[bx] = {*mn, *mx};
+            }
+            const int by1 = std::min(j / kBrickCells, grid.dims.y - 1), bz1 = std::min(k / kBrickCells, grid.dims.z - 1);
+            const int by0 = (j % kBrickCells == 0 && j > 0) ? j / kBrickCells - 1 : by1;
+            const int bz0 = (k % kBrickCells == 0 && k > 0) ? k / kBrickCells - 1 : bz1;
+            for (int bz = bz0; bz <= bz1; ++bz)
+                for (int by = by0; by <= by1; ++by) {
+                    glm::vec2* b = grid.minMax.data() + (static_cast<std::size_t>(bz) * grid.dims.y + by) * grid.dims.x;
+                    for (int bx = 0; bx < grid.dims.x; ++bx)
+                        b[bx] = {std::min(b[bx].x, row[bx].x), std::max(b[bx].y, row[bx].y)};
+                }
+        }
+    return grid;
+}
+
+bool tauZeroOn(const TransferFunction& tf, float lo, float hi)
+{
+    // The device compares x with the float control points: find the control points whose values
+    // clvr_tf_eval can use for some x in [lo, hi]: from the segment holding lo (point 0 when
+    // lo <= s_0) to the first point at or above hi (the last point when hi >= s_{n-1}).
+    const auto& p = tf.points();
+    const int n = static_cast<int>(p.size());
+    auto s = [&](int i) { return static_cast<float>(p[i].s); };
+    int first = 0;
+    while (first + 1 < n && s(first + 1) <= lo)
+        ++first;
+    int last = 0;
+    while (last + 1 < n && s(last) < hi)
+        ++last;
+    for (int i = first; i <= last; ++i)
+        if (p[i].tau != 0.0)  // exactly 0 in double: then the packed slopes are exactly 0 too
+            return false;
+    return true;
+}
+
+std::vector<cl_uchar> emptyBricks(const BrickGrid& grid, const TransferFunction& tf)
+{
+    std::vector<cl_uchar> flags(grid.minMax.size(), 0);
+    for (std::size_t b = 0; b < flags.size(); ++b) {
+        const glm::vec2 m = grid.minMax[b];
+        // Trilinear values are convex combinations of the brick's points; in float they can stray a
+        // few ulp outside [min, max]: widen by 2^-16 of the magnitude (far more than that).
+        const float pad = std::ldexp(std::max(std::abs(m.x), std::abs(m.y)), -16) + 1e-30f;
+        flags[b] = tauZeroOn(tf, m.x - pad, m.y + pad) ? 1 : 0;
+    }
+    return flags;
+}
+
+std::vector<cl_uchar> emptySpaceRadii(const glm::ivec3& brickDims, const std::vector<cl_uchar>& empty)
+{
+    // value(b) = 1 + min over b's 27-neighbourhood of value(n) for an empty brick (outside the grid:
+    // unbounded), 0 for one that is not: iterated to the fixed point, one ring per pass.
+    std::vector<cl_uchar> space(empty.size());
+    for (std::size_t b = 0; b < empty.size(); ++b)
+        space[b] = empty[b] ? 255 : 0;
+    const glm::ivec3 n = brickDims;
+    auto at = [&](int x, int y, int z) { return (static_cast<std::size_t>(z) * n.y + y) * n.x + x; };
+    for (bool changed = true; changed;) {
+        changed = false;
+        std::vector<cl_uchar> next = space;
+        for (int z = 0; z < n.z; ++z)
+            for (int y = 0; y < n.y; ++y)
+                for (int x = 0; x < n.x; ++x) {
+                    if (space[at(x, y, z)] == 0)
+                        continue;
+                    int m = 254;
+                    for (int dz = -1; dz <= 1; ++dz)
+                        for (int dy = -1; dy <= 1; ++dy)
+                            for (int dx = -1; dx <= 1; ++dx) {
+                                const int xx = x + dx, yy = y + dy, zz = z + dz;
+                                if (xx >= 0 && yy >= 0 && zz >= 0 && xx < n.x && yy < n.y && zz < n.z)
+                                    m = std::min<int>(m, space[at(xx, yy, zz)]);
+                            }
+                    const auto v = static_cast<cl_uchar>(m + 1);
+                    if (v != space[at(x, y, z)]) {
+                        next[at(x, y, z)] = v;
+                        changed = true;
+                    }
+                }
+        space.swap(next);
+    }
+    return space;
+}
+
+std::vector<float> packTransferFunction(const TransferFunction& tf)
+{
+    const auto& points = tf.points();
+    const std::size_t n = points.size(), m = (n + 3) / 4 * 4;
+    std::vector<float> out(m + 8 * n, 0.0f);
+    auto value = [&](std::size_t i) { return glm::dvec4(points[i].color, points[i].tau); };
+    for (std::size_t i = 0; i < n; ++i) {
+        out[i] = static_cast<float>(points[i].s);
+        const glm::dvec4 slope =
+            i + 1 < n ? (value(i + 1) - value(i)) / (points[i + 1].s - points[i].s) : glm::dvec4(0.0);
+        for (int c = 0; c < 4; ++c) {
+            out[m + 4 * i + c] = static_cast<float>(value(i)[c]);
+            out[m + 4 * n + 4 * i + c] = static_cast<float>(slope[c]);
+        }
+    }
+    return out;
+}
+
+std::unique_ptr<Renderer> makeSlice3dRenderer(Device& device, const Scene& scene, const Volume& volume)
+{
+    return std::make_unique<Slice3dRenderer>(device, scene, volume);
+}
+
+void setSlice3dClipPlacement(Renderer& renderer, const glm::dvec3& offset, const glm::dmat3& matrix)
+{
+    auto* slice3d = dynamic_cast<Slice3dRenderer*>(&renderer);
+    if (!slice3d)
+        throw InputError("setSlice3dClipPlacement: the renderer is not slice3d");
+    slice3d->setClipPlacement(offset, matrix);
+}
+
+}  // namespace clvr

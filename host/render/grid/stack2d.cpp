@@ -1,0 +1,539 @@
+// host/render/grid/stack2d.cpp — options, stack choice, slice planning and the pass-by-pass rendering of
+// the stack2d technique: one raster::draw of all quads of the chosen stack, back to front, with
+// kernels/stack2d.cl as fragment program, then the background pass of slice3d.
+#include "host/render/grid/stack2d.h"
+
+#include "host/runtime/embedded_kernels.h"
+#include "host/runtime/errors.h"
+#include "host/render/camera_args.h"
+#include "host/render/options_util.h"
+#include "host/optics/gradient_volume.h"
+#include "host/optics/reflectance_map.h"
+#include "host/render/grid/slice3d.h"  // packTransferFunction
+#include "raster/framebuffer.h"
+#include "raster/rasterizer.h"
+#include "raster/texture.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <optional>
+
+namespace clvr {
+namespace {
+
+// The most intermediate slices per stack interval; 64 already samples far finer than the data.
+constexpr int kMaxIntermediate = 64;
+constexpr int kMaxMapSize = 1024;
+constexpr int kMaxSlicesPerPolygon = 64;
+constexpr const char* kKnownOptions = "intermediate, reflectance_map_size, slices_per_polygon, clip_texture";
+constexpr const char* kAxisNames[3] = {"x", "y", "z"};
+
+// The stack along `axis`: slice i (grid index i on that axis) is a 2D texture over the other two
+// axes (b, c) = ((axis + 1) % 3, (axis + 2) % 3) ordered as x < y < z, i.e. (y, z), (x, z), (x, y);
+// the first of them runs fastest. Slices follow one another in one buffer.
+struct StackShape {
+    int b = 0, c = 0;  // texture width along axis b, height along axis c
+};
+StackShape stackShape(int axis)
+{
+    const int p = (axis + 1) % 3, q = (axis + 2) % 3;
+    return {std::min(p, q), std::max(p, q)};
+}
+
+// The texels of that stack from `channels` floats per grid point (x fastest, then y, then z).
+std::vector<float> stackTexels(const float* points, const glm::ivec3& n, int channels, int axis)
+{
+    const StackShape s = stackShape(axis);
+    std::vector<float> texels(static_cast<std::size_t>(n.x) * n.y * n.z * channels);
+    float* out = texels.data();
+    glm::ivec3 g;
+    for (g[axis] = 0; g[axis] < n[axis]; ++g[axis])
+        for (g[s.c] = 0; g[s.c] < n[s.c]; ++g[s.c])
+            for (g[s.b] = 0; g[s.b] < n[s.b]; ++g[s.b]) {
+                const float* p = points + ((static_cast<std::size_t>(g.z) * n.y + g.y) * n.x + g.x) * channels;
+                out = std::copy(p, p + channels, out);
+            }
+    return texels;
+}
+
+class Stack2dRenderer final : public Renderer {
+public:
+    Stack2dRenderer(Device& device, const Scene& scene, const Volume& volume);
+    Image4f render(FrameStats& stats) override;
+    std::uint64_t residentBytes() const override { return residentBytes_; }
+    void setTransferFunction(const TransferFunction& tf) override;
+    void setClipPlacement(const glm::dvec3& offset, const glm::dmat3& matrix);
+
+private:
+    void setClipCoordinateUniforms();
+
+    Device& device_;
+    Stack2dOptions options_;
+    Camera camera_;
+    ImageSpec image_;
+    glm::ivec3 dims_;
+    glm::dvec3 origin_, spacing_, lo_, hi_;
+    Lighting lighting_;
+    // Iso-surface mode (scene "iso"): the alpha test on the value keeps the slice fragments inside the
+    // surface, the front-most one stays.
+    struct Iso {
+        double value = 0.0;
+        bool gradientShading = true;  // "shading": "gradient"; "none": flat surface color
+        glm::dvec3 light{0.0};        // towards the light; default: the headlight, -forward
+        double ambient = 0.1, diffuse = 0.9;
+        glm::dvec3 color{1.0};        // the transfer function's color at the value, or white
+        double dataMin = 0.0, dataMax = 1.0;
+    };
+    std::optional<Iso> iso_;
+    int axis_ = 2;
+    std::vector<StackSlice> slices_;
+    SliceGroups grouped_;  // slices_per_polygon > 1 only
+    cl::Buffer sliceTable_;  // buffer[3]: the slice table (slices_per_polygon > 1), then the clip texels
+    // Clip texture: the texture and world -> clip-texture coordinates.
+    std::optional<ClipTexture> clipTexture_;
+    glm::dmat4 clipCoordinates_{1.0};
+    std::vector<raster::Texture> stacks_;  // x, y, z: all three stay resident, as on the paper's boards
+    cl::Buffer tf_, map_;
+    std::size_t tfBytes_ = 0;
+    std::uint64_t residentBytes_ = 0;
+    std::unique_ptr<raster::Framebuffer> framebuffer_;
+    raster::FragmentProgram fragmentProgram_;
+    cl::Kernel overBackground_, isoFinish_;
+};
+
+Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volume& volume)
+    : device_(device), options_(parseStack2dOptions(scene.options)), image_(scene.image), lighting_(sceneLighting(scene))
+{
+    volume.validate();
+    dims_ = volume.dims;
+    origin_ = volume.origin;
+    spacing_ = volume.spacing;
+    lo_ = volume.boundsMin();
+    hi_ = volume.boundsMax();
+    camera_ = scene.camera ? *scene.camera : fitCamera(lo_, hi_);
+    camera_.validate();
+    if (image_.width < 1 || image_.height < 1)
+        throw InputError("image: width and height must be >= 1");
+    if (!scene.iso.is_null()) {  // keys and types checked by parseScene
+        Iso iso;
+        iso.value = scene.iso["value"].get<double>();
+        const std::string shading = scene.iso.value("shading", std::string("gradient"));
+        if (shading != "gradient" && shading != "none")
+            throw InputError("iso.shading: stack2d knows \"gradient\" and \"none\", got \"" + shading + "\"");
+        iso.gradientShading = shading == "gradient";
+        iso.light = scene.iso.contains("light")
+                        ? glm::normalize(glm::dvec3(scene.iso["light"][0].get<double>(), scene.iso["light"][1].get<double>(),
+                                                    scene.iso["light"][2].get<double>()))
+                        : -camera_.forward();
+        iso.ambient = scene.iso.value("ambient", iso.ambient);
+        iso.diffuse = scene.iso.value("diffuse", iso.diffuse);
+        if (!scene.transferFunction.points().empty())
+            iso.color = glm::dvec3(scene.transferFunction(iso.value));
+        const auto [mn, mx] = std::minmax_element(volume.values.begin(), volume.values.end());
+        iso.dataMin = *mn;
+        iso.dataMax = *mx;
+        iso_ = iso;
+    }
+    if (options_.clipTexture) {
+        clipTexture_ = makeClipTexture(*options_.clipTexture, scene.baseDir);
+        clipCoordinates_ =
+            clipTextureCoordinates(*clipTexture_, options_.clipTexture->offset, options_.clipTexture->matrix);
+    }
+    axis_ = stackAxis(camera_);
+    slices_ = planStack(camera_, origin_, spacing_, dims_, axis_, options_.intermediate);
+
+    // Unshaded: the values (1 channel). Shaded or iso-surface: (gradient, value) per texel, the paper's
+    // RGBA slices with the gradient in RGB, so that one bilinear fetch (and the lerp) interpolates both.
+    const bool gradients = lighting_.shaded() || iso_;
+    const int channels = gradients ? 4 : 1;
+    std::vector<glm::vec4> rgba;
+    if (gradients)
+        rgba = sobelGradientVolume(volume);
+    const float* points = gradients ? &rgba[0].x : volume.values.data();
+    for (int a = 0; a < 3; ++a) {
+        const StackShape s = stackShape(a);
+        raster::TextureDesc desc;
+        desc.width = dims_[s.b];
+        desc.height = dims_[s.c];
+        desc.depth = dims_[a];
+        desc.channels = channels;
+        desc.filter = raster::Filter::Linear;
+        desc.wrap = raster::Wrap::ClampToEdge;
+        stacks_.emplace_back(device_, desc, stackTexels(points, dims_, channels, a));
+        residentBytes_ += stacks_.back().bytes();
+    }
+    // The map holds one view direction for the image (-forward), as in planes and blend.
+    if (lighting_.shaded()) {
+        const ReflectanceMap map = buildReflectanceMap(lighting_, -camera_.forward(), options_.reflectanceMapSize);
+        map_ = device_.upload("stack2d reflectance map", map.entries);
+        residentBytes_ += map.entries.size() * sizeof(glm::vec4);
+    }
+    setTransferFunction(scene.transferFunction);
+
+    framebuffer_ = std::make_unique<raster::Framebuffer>(device_, image_.width, image_.height);
+    overBackground_ = device_.kernel("slice3d.cl", "slice3d_over_background");
+    std::string_view source;
+    for (const EmbeddedKernel& k : embeddedKernels())
+        if (k.name == "stack2d.cl")
+            source = k.source;
+    fragmentProgram_.source = "#define CLVR_STACK2D_FRAGMENT 1\n" +
+                              std::string(clipTexture_ ? "#define CLVR_STACK2D_CLIP_TEXTURE 1\n" : "") + std::string(source);
+    fragmentProgram_.buffers[0] = stacks_[axis_].buffer();
+    glm::vec4 axisVector(0.0f);
+    axisVector[axis_] = 1.0f;
+    const StackShape s = stackShape(axis_);
+    const std::array<glm::vec4, 5> cameraUniforms = cameraVectors(camera_, image_.width, image_.height);
+    fragmentProgram_.uniforms = {
+        cameraUniforms[0], cameraUniforms[1], cameraUniforms[2], cameraUniforms[3], cameraUniforms[4],
+        glm::vec4(image_.width, image_.height, 0.0f, 0.0f),  // z: tf_count, set with the transfer function
+        axisVector,
+        glm::vec4(dims_[s.b], dims_[s.c], channels, 0.0f),
+        glm::vec4(options_.reflectanceMapSize, lighting_.shaded() ? 1.0f : 0.0f, 0.0f, 0.0f),
+        glm::vec4(glm::vec3(-camera_.forward()), 0.0f),
+        glm::vec4(0.0f),  // 10..12: iso-surface mode
+        glm::vec4(0.0f),
+        glm::vec4(0.0f),
+    };
+    if (iso_) {
+        const double range = iso_->dataMax > iso_->dataMin ? iso_->dataMax - iso_->dataMin : 1.0;
+        fragmentProgram_.uniforms[10] = glm::vec4(static_cast<float>(iso_->dataMin), 1.0f,
+                                                  static_cast<float>(iso_->ambient), static_cast<float>(iso_->diffuse));
+        fragmentProgram_.uniforms[11] = glm::vec4(glm::vec3(iso_->color), iso_->gradientShading ? 1.0f : 0.0f);
+        fragmentProgram_.uniforms[12] = glm::vec4(glm::vec3(iso_->light), static_cast<float>(1.0 / range));
+        isoFinish_ = device_.kernel("stack2d.cl", "stack2d_iso_finish");
+    }
+    fragmentProgram_.buffers[2] = map_;
+    // buffer[3]: the slice table (several slices per polygon), then the clip texels (four buffers in
+    // all, and the reflectance map takes the third): one upload, the texels at a float offset.
+    std::vector<glm::vec4> table;
+    if (options_.slicesPerPolygon > 1) {
+        grouped_ = groupStackSlices(slices_, camera_, origin_, spacing_, axis_, options_.slicesPerPolygon);
+        for (const StackSlice& slice : grouped_.slices)
+            table.emplace_back(static_cast<float>(origin_[axis_] + slice.position * spacing_[axis_]),
+                               static_cast<float>(slice.lower), slice.weight, static_cast<float>(slice.thickness));
+    }
+    if (clipTexture_) {
+        std::vector<float> packed(reinterpret_cast<const float*>(table.data()),
+                                  reinterpret_cast<const float*>(table.data() + table.size()));
+        packed.insert(packed.end(), clipTexture_->texels.begin(), clipTexture_->texels.end());
+        sliceTable_ = device_.upload("stack2d slice table and clip texture", packed);
+        residentBytes_ += packed.size() * sizeof(float);
+        fragmentProgram_.buffers[3] = sliceTable_;
+    } else if (!table.empty()) {
+        sliceTable_ = device_.upload("stack2d slice table", table);
+        residentBytes_ += table.size() * sizeof(glm::vec4);
+        fragmentProgram_.buffers[3] = sliceTable_;
+    }
+    if (options_.slicesPerPolygon > 1) {
+        glm::vec4 eb(0.0f), ec(0.0f);
+        eb[s.b] = 1.0f;
+        ec[s.c] = 1.0f;
+        const double alphaRef =
+            iso_ ? std::clamp((iso_->value - iso_->dataMin) / (iso_->dataMax > iso_->dataMin ? iso_->dataMax - iso_->dataMin : 1.0),
+                              0.0, 1.0)
+                 : 0.0;
+        fragmentProgram_.uniforms.push_back(eb);  // 13
+        fragmentProgram_.uniforms.push_back(ec);  // 14
+        fragmentProgram_.uniforms.push_back(glm::vec4(lo_[s.b], lo_[s.c], hi_[s.b], hi_[s.c]));  // 15
+        fragmentProgram_.uniforms.push_back(glm::vec4(0.5f / dims_[s.b], 0.5f / dims_[s.c], (dims_[s.b] - 0.5f) / dims_[s.b],
+                                                      (dims_[s.c] - 0.5f) / dims_[s.c]));  // 16, as the quads' corners
+        fragmentProgram_.uniforms.push_back(glm::vec4(static_cast<float>(alphaRef), 0.0f, 0.0f, 0.0f));  // 17
+    }
+    if (clipTexture_) {
+        fragmentProgram_.uniforms.resize(18, glm::vec4(0.0f));  // 13..17 unused with one slice per quad
+        const glm::ivec3 n = clipTexture_->dims();
+        fragmentProgram_.uniforms.push_back(glm::vec4(n.x, n.y, n.z, options_.clipTexture->inverse ? 1.0f : 0.0f));  // 18
+        fragmentProgram_.uniforms.resize(22, glm::vec4(0.0f));  // 19..21: setClipCoordinateUniforms
+        setClipCoordinateUniforms();
+        fragmentProgram_.uniforms.push_back(glm::vec4(static_cast<float>(table.size() * 4), 0.0f, 0.0f, 0.0f));  // 22
+    }
+    fragmentProgram_.uniforms[5].z = static_cast<float>(scene.transferFunction.points().size());
+    fragmentProgram_.buffers[1] = tf_;
+}
+
+// Uniforms 19..21: the rows of world -> clip-texture coordinates (the several-slices path maps the
+// ray's hit points with them; the one-slice path's vertices carry the mapped points, made per frame).
+void Stack2dRenderer::setClipCoordinateUniforms()
+{
+    for (int r = 0; r < 3; ++r)
+        fragmentProgram_.uniforms[19 + r] =
+            glm::vec4(static_cast<float>(clipCoordinates_[0][r]), static_cast<float>(clipCoordinates_[1][r]),
+                      static_cast<float>(clipCoordinates_[2][r]), static_cast<float>(clipCoordinates_[3][r]));
+}
+
+void Stack2dRenderer::setClipPlacement(const glm::dvec3& offset, const glm::dmat3& matrix)
+{
+    if (!clipTexture_)
+        throw InputError("stack2d: no clip texture to move (options.clip_texture is not given)");
+    if (!(std::abs(glm::determinant(matrix)) > 0.0))
+        throw InputError("stack2d: the clip texture's matrix must be invertible");
+    options_.clipTexture->offset = offset;
+    options_.clipTexture->matrix = matrix;
+    clipCoordinates_ = clipTextureCoordinates(*clipTexture_, offset, matrix);
+    setClipCoordinateUniforms();
+}
+
+void Stack2dRenderer::setTransferFunction(const TransferFunction& tf)
+{
+    std::vector<float> packed = packTransferFunction(tf);
+    if (packed.empty())
+        packed.push_back(0.0f);  // an iso-surface scene without a transfer function: never read
+    residentBytes_ -= tfBytes_;
+    tfBytes_ = packed.size() * sizeof(float);
+    residentBytes_ += tfBytes_;
+    tf_ = device_.upload("stack2d transfer function", packed);
+    fragmentProgram_.buffers[1] = tf_;
+    if (fragmentProgram_.uniforms.size() > 5)  // not yet during construction, which sets them itself
+        fragmentProgram_.uniforms[5].z = static_cast<float>(tf.points().size());
+    if (iso_ && fragmentProgram_.uniforms.size() > 11 && !tf.points().empty()) {  // the surface color
+        iso_->color = glm::dvec3(tf(iso_->value));
+        fragmentProgram_.uniforms[11] = glm::vec4(glm::vec3(iso_->color), fragmentProgram_.uniforms[11].w);
+    }
+}
+
+Image4f Stack2dRenderer::render(FrameStats& stats)
+{
+    const auto start = std::chrono::steady_clock::now();
+    // Near and far planes around the box's eye-depth range; depth is not tested, so only the near
+    // plane matters: it removes what lies behind the camera (perspective) or in front of its image
+    // plane (parallel: depth 0, as the reference integral counts the ray from there).
+    double dMin = std::numeric_limits<double>::infinity(), dMax = -dMin;
+    for (int c = 0; c < 8; ++c) {
+        const glm::dvec3 corner((c & 1) ? hi_.x : lo_.x, (c & 2) ? hi_.y : lo_.y, (c & 4) ? hi_.z : lo_.z);
+        const double d = glm::dot(camera_.forward(), corner - camera_.position);
+        dMin = std::min(dMin, d);
+        dMax = std::max(dMax, d);
+    }
+    const double nearZ = camera_.parallel ? 0.0 : (dMin > 0.0 ? 0.5 * dMin : 1e-4 * std::max(dMax, 1e-30));
+    const double farZ = 2.0 * std::max(dMax, 0.0) + 1.0;
+    const glm::dmat4 viewProjection =
+        camera_.projectionMatrix(image_.width, image_.height, nearZ, farZ) * camera_.viewMatrix();
+    const StackShape s = stackShape(axis_);
+    // Quad corners in the (b, c) plane and their texture coordinates: grid point i of n is texel i,
+    // centered at (i + 0.5) / n, so the box [0, n - 1] maps to [0.5 / n, (n - 0.5) / n].
+    const glm::dvec2 uvLo(0.5 / dims_[s.b], 0.5 / dims_[s.c]);
+    const glm::dvec2 uvHi((dims_[s.b] - 0.5) / dims_[s.b], (dims_[s.c] - 0.5) / dims_[s.c]);
+    std::vector<raster::Vertex> vertices;
+    auto quad = [&](double axisWorld, glm::dvec2 rectLo, glm::dvec2 rectHi, float lower, float weight,
+                    glm::vec4 attribute1) {
+        for (const auto& [cb, cc] : std::array<std::pair<int, int>, 6>{{{0, 0}, {1, 0}, {1, 1}, {0, 0}, {1, 1}, {0, 1}}}) {
+            glm::dvec3 p;
+            p[axis_] = axisWorld;
+            p[s.b] = cb ? rectHi.x : rectLo.x;
+            p[s.c] = cc ? rectHi.y : rectLo.y;
+            // Texture coordinates linear in (b, c): the box corners get uvLo and uvHi exactly.
+            glm::dvec2 uv;
+            for (int k = 0; k < 2; ++k) {
+                const int a = k == 0 ? s.b : s.c;
+                const double extent = hi_[a] - lo_[a];
+                uv[k] = extent > 0.0 ? uvLo[k] + (p[a] - lo_[a]) / extent * (uvHi[k] - uvLo[k]) : uvLo[k];
+                if (p[a] == hi_[a])
+                    uv[k] = uvHi[k];
+            }
+            raster::Vertex v;
+            v.position = glm::vec4(viewProjection * glm::dvec4(p, 1.0));
+            v.attributes[0] = glm::vec4(static_cast<float>(uv.x), static_cast<float>(uv.y), lower, weight);
+            v.attributes[1] = attribute1;
+            if (clipTexture_)  // the second texture's coordinates of the slice point (one slice per quad)
+                v.attributes[2] = glm::vec4(glm::vec3(clipCoordinates_ * glm::dvec4(p, 1.0)), 1.0f);
+            vertices.push_back(v);
+        }
+    };
+    const glm::dvec2 boxLo(lo_[s.b], lo_[s.c]), boxHi(hi_[s.b], hi_[s.c]);
+    if (options_.slicesPerPolygon == 1) {
+        vertices.reserve(slices_.size() * 6);
+        for (const StackSlice& slice : slices_)
+            quad(origin_[axis_] + slice.position * spacing_[axis_], boxLo, boxHi, static_cast<float>(slice.lower),
+                 slice.weight, glm::vec4(static_cast<float>(slice.thickness), 0.0f, 0.0f, 0.0f));
+    } else {
+        // One quad per group, in the plane of its front-most slice, covering the box's cross-section
+        // of every slice of the group as seen from the camera: the bounding rectangle of their
+        // corners projected onto that plane along the rays (through the camera, or along forward).
+        vertices.reserve(grouped_.groups.size() * 6);
+        for (const auto& [first, count] : grouped_.groups) {
+            const double drawn = origin_[axis_] + grouped_.slices[first + count - 1].position * spacing_[axis_];
+            glm::dvec2 rectLo(std::numeric_limits<double>::infinity()), rectHi(-std::numeric_limits<double>::infinity());
+            for (int j = first; j < first + count; ++j) {
+                const double x = origin_[axis_] + grouped_.slices[j].position * spacing_[axis_];
+                for (int corner = 0; corner < 4; ++corner) {
+                    glm::dvec3 p;
+                    p[axis_] = x;
+                    p[s.b] = (corner & 1) ? hi_[s.b] : lo_[s.b];
+                    p[s.c] = (corner & 2) ? hi_[s.c] : lo_[s.c];
+                    const glm::dvec3 q = camera_.parallel
+                                             ? p + camera_.forward() * ((drawn - x) / camera_.forward()[axis_])
+                                             : camera_.position + (p - camera_.position) *
+                                                                      ((drawn - camera_.position[axis_]) / (x - camera_.position[axis_]));
+                    rectLo = glm::min(rectLo, glm::dvec2(q[s.b], q[s.c]));
+                    rectHi = glm::max(rectHi, glm::dvec2(q[s.b], q[s.c]));
+                }
+            }
+            // Widen by a hair so that pixels whose rays graze a box edge are covered; the fragment
+            // program tests each slice against the box itself.
+            const glm::dvec2 pad = 1e-6 * (rectHi - rectLo) + 1e-12;
+            quad(drawn, rectLo - pad, rectHi + pad, 0.0f, 0.0f,
+                 glm::vec4(0.0f, static_cast<float>(first), static_cast<float>(count), 0.0f));
+        }
+    }
+    raster::DrawState state;
+    if (!iso_) {  // "over" on premultiplied color: dst = src + (1 - src.a) dst
+        state.fragment.blend.enabled = true;
+        state.fragment.blend.srcRgb = state.fragment.blend.srcAlpha = raster::BlendFactor::One;
+        state.fragment.blend.dstRgb = state.fragment.blend.dstAlpha = raster::BlendFactor::OneMinusSrcAlpha;
+    } else {
+        // Alpha test on the value mapped to [0, 1] as the fragment program maps it: GEQUAL the mapped
+        // iso-value (an iso-value above the data passes nothing); the stencil marks covered pixels.
+        const double range = iso_->dataMax > iso_->dataMin ? iso_->dataMax - iso_->dataMin : 1.0;
+        state.fragment.alpha.test = true;
+        state.fragment.alpha.func = iso_->value > iso_->dataMax ? raster::CompareFunc::Never : raster::CompareFunc::GEqual;
+        state.fragment.alpha.ref = static_cast<float>(std::clamp((iso_->value - iso_->dataMin) / range, 0.0, 1.0));
+        state.fragment.stencil.test = true;
+        state.fragment.stencil.func = raster::CompareFunc::Always;
+        state.fragment.stencil.ref = 1;
+        state.fragment.stencil.dppass = raster::StencilOp::Replace;
+        framebuffer_->clearStencil(device_, 0);
+    }
+    framebuffer_->clearColor(device_, glm::vec4(0.0f));
+    const raster::DrawStats drawStats =
+        raster::draw(device_, *framebuffer_, state, raster::Topology::Triangles, vertices, fragmentProgram_);
+    const std::size_t pixels = framebuffer_->pixelCount();
+    const cl_float4 background{{static_cast<float>(image_.background.r), static_cast<float>(image_.background.g),
+                                static_cast<float>(image_.background.b), 0.0f}};
+    if (iso_) {
+        isoFinish_.setArg(0, framebuffer_->color());
+        isoFinish_.setArg(1, framebuffer_->stencil());
+        isoFinish_.setArg(2, static_cast<cl_int>(pixels));
+        isoFinish_.setArg(3, background);
+        device_.launch("stack2d: iso-surface over background", isoFinish_, pixels);
+    } else {
+        overBackground_.setArg(0, framebuffer_->color());
+        overBackground_.setArg(1, static_cast<cl_int>(pixels));
+        overBackground_.setArg(2, background);
+        device_.launch("stack2d: over background", overBackground_, pixels);
+    }
+    Image4f image = framebuffer_->readColor(device_);
+    stats.passes = device_.takePassTimes();
+    stats.frameMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    // One sample per fragment of a quad; with several slices per polygon at most `count` per fragment
+    // (fewer where the enlarged quad covers pixels outside some of its slices): an upper bound.
+    std::uint64_t samples = drawStats.fragments;
+    if (options_.slicesPerPolygon > 1)
+        samples = static_cast<std::uint64_t>(static_cast<double>(drawStats.fragments) * grouped_.slices.size() /
+                                             std::max<std::size_t>(grouped_.groups.size(), 1));
+    stats.samples = samples;
+    stats.extra["axis"] = kAxisNames[axis_];
+    stats.extra["slices"] = slices_.size();
+    stats.extra["intermediate"] = options_.intermediate;
+    stats.extra["slices_per_polygon"] = options_.slicesPerPolygon;
+    stats.extra["polygons"] = options_.slicesPerPolygon > 1 ? grouped_.groups.size() : slices_.size();
+    stats.extra["fragments"] = drawStats.fragments;
+    stats.extra["shaded"] = lighting_.shaded();
+    stats.extra["iso"] = iso_.has_value();
+    stats.extra["reflectance_map_size"] = options_.reflectanceMapSize;
+    stats.extra["triangles"] = drawStats.triangles;
+    stats.extra["voxels"] = static_cast<std::uint64_t>(dims_.x) * dims_.y * dims_.z;
+    stats.extra["resident_bytes"] = residentBytes_;
+    if (clipTexture_) {
+        const glm::ivec3 n = clipTexture_->dims();
+        stats.extra["clip_texture"] = clipTexture_->source;
+        stats.extra["clip_texture_dims"] = {n.x, n.y, n.z};
+        stats.extra["clip_texture_inverse"] = options_.clipTexture->inverse;
+    }
+    return image;
+}
+
+}  // namespace
+
+Stack2dOptions parseStack2dOptions(const nlohmann::json& options)
+{
+    Stack2dOptions o;
+    forEachOption(options, [&](const std::string& key, const nlohmann::json& value) {
+        if (key == "intermediate")
+            o.intermediate = integerOption(key, value, 0, kMaxIntermediate);
+        else if (key == "reflectance_map_size")
+            o.reflectanceMapSize = integerOption(key, value, 1, kMaxMapSize);
+        else if (key == "slices_per_polygon")
+            o.slicesPerPolygon = integerOption(key, value, 1, kMaxSlicesPerPolygon);
+        else if (key == "clip_texture")
+            o.clipTexture = parseClipTextureSpec(value, "options.clip_texture");
+        else
+            badOption(key, std::string("unknown option for stack2d (known: ") + kKnownOptions + ")");
+    });
+    return o;
+}
+
+int stackAxis(const Camera& camera)
+{
+    const glm::dvec3 f = glm::abs(camera.forward());
+    int axis = 0;
+    for (int a = 1; a < 3; ++a)
+        if (f[a] > f[axis])
+            axis = a;
+    return axis;
+}
+
+std::vector<StackSlice> planStack(const Camera& camera, const glm::dvec3& origin, const glm::dvec3& spacing,
+                                  const glm::ivec3& dims, int axis, int intermediate)
+{
+    const int perCell = intermediate + 1;
+    const int count = (dims[axis] - 1) * perCell + 1;
+    std::vector<StackSlice> slices(count);
+    for (int j = 0; j < count; ++j) {
+        StackSlice& s = slices[j];
+        s.lower = j / perCell;
+        s.weight = static_cast<float>(j % perCell) / static_cast<float>(perCell);
+        s.position = s.lower + static_cast<double>(j % perCell) / perCell;
+        s.thickness = spacing[axis] / perCell * (j == 0 || j == count - 1 ? 0.5 : 1.0);
+    }
+    // Back to front. Perspective: the rays that meet a plane come from the camera, so along every
+    // ray the planes follow in increasing distance |camera - plane| along the axis (planes on the
+    // other side of the camera are behind it and clipped away). Parallel: depth along forward.
+    const double forwardAxis = camera.forward()[axis];
+    auto farness = [&](const StackSlice& s) {
+        const double x = origin[axis] + s.position * spacing[axis];
+        return camera.parallel ? forwardAxis * x : std::abs(x - camera.position[axis]);
+    };
+    std::stable_sort(slices.begin(), slices.end(),
+                     [&](const StackSlice& a, const StackSlice& b) { return farness(a) > farness(b); });
+    return slices;
+}
+
+SliceGroups groupStackSlices(const std::vector<StackSlice>& drawOrder, const Camera& camera, const glm::dvec3& origin,
+                             const glm::dvec3& spacing, int axis, int perPolygon)
+{
+    SliceGroups out;
+    std::vector<StackSlice> sides[2];
+    for (const StackSlice& slice : drawOrder) {
+        const double x = origin[axis] + slice.position * spacing[axis];
+        if (camera.parallel)
+            sides[0].push_back(slice);
+        else if (x != camera.position[axis])
+            sides[x > camera.position[axis] ? 0 : 1].push_back(slice);
+    }
+    for (const std::vector<StackSlice>& side : sides)
+        for (std::size_t first = 0; first < side.size(); first += perPolygon) {
+            const std::size_t count = std::min<std::size_t>(perPolygon, side.size() - first);
+            out.groups.emplace_back(static_cast<int>(out.slices.size()), static_cast<int>(count));
+            out.slices.insert(out.slices.end(), side.begin() + first, side.begin() + first + count);
+        }
+    return out;
+}
+
+std::unique_ptr<Renderer> makeStack2dRenderer(Device& device, const Scene& scene, const Volume& volume)
+{
+    return std::make_unique<Stack2dRenderer>(device, scene, volume);
+}
+
+void setStack2dClipPlacement(Renderer& renderer, const glm::dvec3& offset, const glm::dmat3& matrix)
+{
+    auto* stack2d = dynamic_cast<Stack2dRenderer*>(&renderer);
+    if (!stack2d)
+        throw InputError("setStack2dClipPlacement: the renderer is not stack2d");
+    stack2d->setClipPlacement(offset, matrix);
+}
+
+}  // namespace clvr

@@ -1,0 +1,509 @@
+// host/render/tet/harc.cpp — options, the 80-byte device layout, per-pixel boundary entry lists and the
+// harc renderer (kernels/harc.cl: harc_render).
+#include "host/render/tet/harc.h"
+
+#include "host/runtime/errors.h"
+#include "host/render/camera_args.h"
+#include "host/render/options_util.h"
+#include "host/runtime/parallel.h"
+#include "host/optics/preintegration_table.h"
+#include "host/optics/psi_table.h"
+#include "host/render/tet/harc_entry.h"
+#include "host/render/grid/slice3d.h"  // packTransferFunction: kernels/transfer_function.h's layout
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <mutex>
+#include <string>
+
+namespace clvr {
+namespace {
+
+constexpr const char* kKnownOptions = "integration, full_table, max_steps, early_termination, entry, max_layers";
+
+void meshBounds(const TetMesh& mesh, glm::dvec3& lo, glm::dvec3& hi)
+{
+    lo = glm::dvec3(std::numeric_limits<double>::infinity());
+    hi = -lo;
+    for (const glm::uvec4& t : mesh.tets)
+        for (int k = 0; k < 4; ++k) {
+            lo = glm::min(lo, mesh.points[t[k]]);
+            hi = glm::max(hi, mesh.points[t[k]]);
+        }
+}
+
+class HarcRenderer final : public Renderer {
+public:
+    HarcRenderer(Device& device, const Scene& scene, const TetMesh& mesh, const TetTopology& topology);
+    Image4f render(FrameStats& stats) override;
+    std::uint64_t residentBytes() const override { return residentBytes_; }
+    void setTransferFunction(const TransferFunction& tf) override;
+
+private:
+    void buildFullTable(const TransferFunction& tf);
+
+
+    Device& device_;
+    HarcOptions options_;
+    Camera camera_;
+    ImageSpec image_;
+    TetMesh mesh_;          // copies: the renderer outlives the caller's mesh
+    TetTopology topology_;
+    glm::dvec3 shift_{0.0};
+    int tfCount_ = 0;
+    std::uint64_t maxSteps_ = 0;
+    cl::Buffer tets_, tf_, psi_, out_, stats_;
+    cl::Kernel kernel_;
+    std::unique_ptr<HarcRasterEntries> rasterEntries_;  // options_.entry == Raster
+    std::uint64_t residentBytes_ = 0;
+    std::uint64_t pointCount_ = 0, tetCount_ = 0, tetsRead_ = 0, tetsDegenerate_ = 0;
+    // Full pre-integration (options_.integration == Full): the table on the device, its s range (the
+    // hull of the transfer function's and the mesh's), its l range and the last build's time.
+    cl::Buffer full_;
+    glm::dvec2 meshScalarRange_{0.0};
+    double fullLMax_ = 1.0;
+    double fullSLo_ = 0.0, fullSHi_ = 1.0;
+    double fullBuildMs_ = 0.0;
+    std::uint64_t fullBytes_ = 0;
+};
+
+HarcRenderer::HarcRenderer(Device& device, const Scene& scene, const TetMesh& mesh, const TetTopology& topology)
+    : device_(device), options_(parseHarcOptions(scene.options)), image_(scene.image), mesh_(mesh),
+      topology_(topology)
+{
+    if (mesh.tets.empty())
+        throw InputError(mesh.source + ": harc needs a mesh with at least one tetrahedron");
+    if (mesh.tets.size() >= (std::size_t(1) << 29))
+        throw InputError(mesh.source + ": harc takes fewer than 2^29 tetrahedra (tet * 4 + face in 31 bits)");
+    if (topology.neighbor.size() != mesh.tets.size())
+        throw InputError(mesh.source + ": topology does not match the mesh");
+    if (image_.width < 1 || image_.height < 1)
+        throw InputError("image: width and height must be >= 1");
+    glm::dvec3 lo, hi;
+    meshBounds(mesh, lo, hi);
+    shift_ = 0.5 * (lo + hi);
+    camera_ = scene.camera ? *scene.camera : fitCamera(lo, hi);
+    camera_.validate();
+
+    tetCount_ = mesh.tets.size();
+    pointCount_ = mesh.points.size();
+    tetsRead_ = mesh.tetsRead ? mesh.tetsRead : mesh.tets.size();
+    tetsDegenerate_ = mesh.tetsDegenerate;
+    maxSteps_ = options_.maxSteps
+                    ? options_.maxSteps
+                    : static_cast<std::uint64_t>(4.0 * std::cbrt(static_cast<double>(tetCount_))) + 10000;
+
+    const std::vector<cl_float4> tets = packHarcTets(mesh, topology, shift_);
+    tets_ = device_.upload("harc tetrahedra (80 bytes each)", tets);
+    const std::vector<float> tf = packTransferFunction(scene.transferFunction);
+    tfCount_ = static_cast<int>(scene.transferFunction.points().size());
+    tf_ = device_.upload("harc transfer function", tf);
+    const PsiTable& psi = psiTable();
+    psi_ = device_.upload("harc psi table", psi.values);
+    residentBytes_ = tets.size() * sizeof(cl_float4) + tf.size() * sizeof(float) + psi.values.size() * sizeof(float);
+    meshScalarRange_ = mesh.scalarRange();
+    fullLMax_ = longestTetEdge(mesh);
+    if (!(fullLMax_ > 0.0))
+        fullLMax_ = 1.0;  // every cell flat: no segment has a length, any l range will do
+    if (options_.integration == HarcOptions::Integration::Full) {
+        buildFullTable(scene.transferFunction);
+        residentBytes_ += fullBytes_;
+    } else {
+        full_ = device_.buffer("harc full table (unused)", sizeof(cl_float4));  // no zero-size buffers
+    }
+
+    const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
+    out_ = device_.buffer("harc image", pixels * sizeof(cl_float4), CL_MEM_WRITE_ONLY);
+    stats_ = device_.buffer("harc ray counts", pixels * 3 * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
+    kernel_ = device_.kernel("harc.cl", "harc_render");
+    if (options_.entry == HarcOptions::Entry::Raster)
+        rasterEntries_ = std::make_unique<HarcRasterEntries>(device_, mesh, topology, shift_, tets_, image_.width,
+                                                             image_.height, options_.maxLayers);
+}
+
+// The table over s in the hull of the transfer function's range and the mesh's: a segment whose s
+// leaves the transfer function's range still has to cross into it at the right λ, which clamping s to
+// that range would move. l runs to the longest tetrahedron edge, the longest segment any ray can have.
+void HarcRenderer::buildFullTable(const TransferFunction& tf)
+{
+    const auto start = std::chrono::steady_clock::now();
+    fullSLo_ = std::min(tf.sMin(), meshScalarRange_.x);
+    fullSHi_ = std::max(tf.sMax(), meshScalarRange_.y);
+    const PreintegrationTable table = buildPreintegrationTable(tf, fullSLo_, fullSHi_, fullLMax_,
+                                                               options_.fullScalarSamples, options_.fullLengthSamples);
+    full_ = device_.upload("harc full pre-integration table", table.values);
+    fullBytes_ = table.bytes();
+    fullBuildMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+void HarcRenderer::setTransferFunction(const TransferFunction& tf)
+{
+    // Full pre-integration has to rebuild its whole table (same size, so residentBytes_ keeps it): the
+    // cost that partial pre-integration avoids (seeds/001 §1).
+    if (options_.integration == HarcOptions::Integration::Full)
+        buildFullTable(tf);
+
+    // Partial pre-integration needs no table that depends on the transfer function: only the packed
+    // control points change (the ψ table is the same for every transfer function).
+    const std::vector<float> packed = packTransferFunction(tf);
+    residentBytes_ -= static_cast<std::uint64_t>(((tfCount_ + 3) / 4 * 4 + 8 * tfCount_) * sizeof(float));
+    tfCount_ = static_cast<int>(tf.points().size());
+    tf_ = device_.upload("harc transfer function", packed);
+    residentBytes_ += packed.size() * sizeof(float);
+}
+
+Image4f HarcRenderer::render(FrameStats& stats)
+{
+    const auto start = std::chrono::steady_clock::now();
+    // Entry points: the boundary front faces' crossings per pixel, sorted by depth, every frame.
+    HarcRasterEntryStats peel;
+    const HarcEntryLists lists = rasterEntries_
+                                     ? rasterEntries_->build(camera_, peel)
+                                     : buildHarcEntryLists(mesh_, topology_, camera_, image_.width, image_.height);
+    const double entryMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    const cl::Buffer offsets = device_.upload("harc entry offsets", lists.offsets);
+    std::vector<cl_int2> entries = lists.entries;
+    if (entries.empty())
+        entries.push_back(cl_int2{{0, 0}});  // no zero-size buffers
+    const cl::Buffer entryBuffer = device_.upload("harc entry crossings", entries);
+
+    const float ert = options_.earlyTermination < 1.0 ? static_cast<float>(options_.earlyTermination) : 2.0f;
+    const cl_uint maxSteps = static_cast<cl_uint>(std::min<std::uint64_t>(maxSteps_, 0xffffffffu));
+    int a = 0;
+    kernel_.setArg(a++, out_);
+    kernel_.setArg(a++, stats_);
+    kernel_.setArg(a++, static_cast<cl_int>(image_.width));
+    kernel_.setArg(a++, static_cast<cl_int>(image_.height));
+    kernel_.setArg(a++, tets_);
+    kernel_.setArg(a++, offsets);
+    kernel_.setArg(a++, entryBuffer);
+    kernel_.setArg(a++, tf_);
+    kernel_.setArg(a++, static_cast<cl_int>(tfCount_));
+    kernel_.setArg(a++, psi_);
+    kernel_.setArg(a++, static_cast<cl_int>(psiTable().size));
+    a = setCameraArgs(kernel_, a, camera_, image_.width, image_.height, shift_);
+    kernel_.setArg(a++, maxSteps);
+    const cl_int integration = options_.integration == HarcOptions::Integration::Average ? 1
+                               : options_.integration == HarcOptions::Integration::Full  ? 2
+                                                                                          : 0;
+    kernel_.setArg(a++, integration);  // HARC_INTEGRATION_* of kernels/harc.cl
+    kernel_.setArg(a++, static_cast<cl_float>(ert));
+    kernel_.setArg(a++, toCl4(image_.background));
+    // The table's sample spacing as PreintegrationTable::lookup computes it (float), so host and device
+    // interpolate alike.
+    const int ns = options_.fullScalarSamples, nl = options_.fullLengthSamples;
+    const cl_float4 fullParams{{static_cast<float>(fullSLo_),
+                                static_cast<float>(ns - 1) / static_cast<float>(fullSHi_ - fullSLo_),
+                                static_cast<float>(nl - 1) / static_cast<float>(fullLMax_), 0.0f}};
+    kernel_.setArg(a++, full_);
+    kernel_.setArg(a++, static_cast<cl_int>(ns));
+    kernel_.setArg(a++, static_cast<cl_int>(nl));
+    kernel_.setArg(a++, fullParams);
+    device_.launch("harc: walk", kernel_, image_.width, image_.height);
+
+    const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
+    Image4f image(image_.width, image_.height);
+    device_.queue().enqueueReadBuffer(out_, CL_FALSE, 0, pixels * sizeof(glm::vec4), image.pixels().data());
+    const std::vector<cl_uint> counts = device_.download<cl_uint>(stats_, pixels * 3);
+    std::uint64_t steps = 0, bounded = 0, pieces = 0;
+    for (std::size_t p = 0; p < pixels; ++p) {
+        steps += counts[3 * p];
+        bounded += counts[3 * p + 1];
+        pieces += counts[3 * p + 2];
+    }
+    std::vector<PassTime> deviceTimes = device_.takePassTimes();
+    if (rasterEntries_) {
+        // The peeling draws' own device passes are in deviceTimes; this is the whole entry stage,
+        // draws, read-backs and the host's compaction included.
+        stats.passes.push_back({"harc: entry lists (raster, all layers)", entryMs});
+        stats.passes.push_back({"harc: entry lists (raster) host compaction", peel.compactMs});
+    } else {
+        stats.passes.push_back({"harc: entry lists (host)", entryMs});
+    }
+    for (PassTime& t : deviceTimes)
+        stats.passes.push_back(std::move(t));
+    stats.frameMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    stats.extra["points"] = pointCount_;
+    stats.extra["tets"] = tetsRead_;
+    stats.extra["tets_rendered"] = tetCount_;
+    stats.extra["tets_degenerate"] = tetsDegenerate_;
+    stats.extra["bytes_per_tet"] = static_cast<double>(residentBytes_) / static_cast<double>(tetCount_);
+    stats.extra["tet_layout_bytes"] = kHarcBytesPerTet;
+    stats.extra["resident_bytes"] = residentBytes_;
+    stats.extra["psi_table"] = std::to_string(psiTable().size) + "x" + std::to_string(psiTable().size);
+    stats.extra["steps"] = steps;
+    stats.extra["pieces"] = pieces;
+    stats.extra["rays_step_bound"] = bounded;
+    stats.extra["max_steps"] = maxSteps_;
+    stats.extra["boundary_faces"] = topology_.boundary.size();
+    stats.extra["entry_crossings"] = lists.entries.size();
+    switch (options_.integration) {
+    case HarcOptions::Integration::Partial: stats.extra["integration"] = "partial"; break;
+    case HarcOptions::Integration::Average: stats.extra["integration"] = "average"; break;
+    case HarcOptions::Integration::Full:
+        stats.extra["integration"] = "full";
+        stats.extra["full_table"] = std::to_string(ns) + "x" + std::to_string(ns) + "x" + std::to_string(nl);
+        stats.extra["full_table_bytes"] = fullBytes_;
+        stats.extra["full_table_build_ms"] = fullBuildMs_;  // the last build: construction or TF change
+        stats.extra["full_table_l_max"] = fullLMax_;
+        stats.extra["full_table_s_range"] = {fullSLo_, fullSHi_};
+        break;
+    }
+    stats.extra["early_termination"] = options_.earlyTermination;
+    stats.extra["entry"] = rasterEntries_ ? "raster" : "host";
+    stats.extra["entry_ms"] = entryMs;
+    if (rasterEntries_) {
+        stats.extra["entry_layers"] = peel.layers;
+        stats.extra["max_layers"] = options_.maxLayers;
+        stats.extra["rays_layer_bound"] = peel.pixelsAtBound;  // lists cut at max_layers
+        stats.extra["entry_triangles"] = peel.triangles;
+        stats.extra["entry_fragments"] = peel.fragments;
+    }
+    return image;
+}
+
+}  // namespace
+
+HarcOptions parseHarcOptions(const nlohmann::json& options)
+{
+    HarcOptions o;
+    if (options.is_null())
+        return o;
+    if (!options.is_object())
+        throw InputError("options: must be an object");
+    for (const auto& [key, value] : options.items()) {
+        if (key == "integration") {
+            const std::string s = value.is_string() ? value.get<std::string>() : "";
+            if (s == "partial")
+                o.integration = HarcOptions::Integration::Partial;
+            else if (s == "average")
+                o.integration = HarcOptions::Integration::Average;
+            else if (s == "full")
+                o.integration = HarcOptions::Integration::Full;
+            else
+                badOption(key, "must be \"partial\", \"average\" or \"full\", got " + value.dump());
+        } else if (key == "full_table") {
+            const bool pair = value.is_array() && value.size() == 2;
+            for (std::size_t i = 0; pair && i < 2; ++i)
+                if (!value[i].is_number_integer() || value[i].get<long long>() < 2 || value[i].get<long long>() > 512)
+                    badOption(key, "must be [NS, NL], integers in [2, 512], got " + value.dump());
+            if (!pair)
+                badOption(key, "must be [NS, NL] (samples of s_f and s_b, samples of l), got " + value.dump());
+            o.fullScalarSamples = value[0].get<int>();
+            o.fullLengthSamples = value[1].get<int>();
+            const std::uint64_t bytes = std::uint64_t(o.fullScalarSamples) * o.fullScalarSamples *
+                                        o.fullLengthSamples * sizeof(cl_float4);
+            if (bytes > kMaxFullTableBytes)
+                badOption(key, value.dump() + " is a table of " + std::to_string(bytes >> 20) +
+                                   " MiB (NS x NS x NL x 16 bytes); at most " +
+                                   std::to_string(kMaxFullTableBytes >> 20) + " MiB");
+        } else if (key == "entry") {
+            const std::string s = value.is_string() ? value.get<std::string>() : "";
+            if (s == "raster")
+                o.entry = HarcOptions::Entry::Raster;
+            else if (s == "host")
+                o.entry = HarcOptions::Entry::Host;
+            else
+                badOption(key, "must be \"raster\" or \"host\", got " + value.dump());
+        } else if (key == "max_layers") {
+            if (!value.is_number_integer() || value.get<long long>() < 1 || value.get<long long>() > 255)
+                badOption(key, "must be an integer in [1, 255], got " + value.dump());
+            o.maxLayers = value.get<int>();
+        } else if (key == "max_steps") {
+            if (!value.is_number_integer() || value.get<long long>() < 1 || value.get<long long>() > 0xffffffffll)
+                badOption(key, "must be an integer in [1, 4294967295], got " + value.dump());
+            o.maxSteps = value.get<std::uint64_t>();
+        } else if (key == "early_termination") {
+            if (!value.is_number() || !(value.get<double>() > 0.0 && value.get<double>() <= 1.0))
+                badOption(key, "must be an opacity in (0, 1] (1 = off), got " + value.dump());
+            o.earlyTermination = value.get<double>();
+        } else {
+            badOption(key, std::string("unknown option for harc (known: ") + kKnownOptions + ")");
+        }
+    }
+    if (options.contains("full_table") && o.integration != HarcOptions::Integration::Full)
+        badOption("full_table", "applies only to \"integration\": \"full\"");
+    return o;
+}
+
+double longestTetEdge(const TetMesh& mesh)
+{
+    double longest2 = 0.0;
+    for (const glm::uvec4& t : mesh.tets)
+        for (int a = 0; a < 4; ++a)
+            for (int b = a + 1; b < 4; ++b) {
+                const glm::dvec3 e = mesh.points[t[a]] - mesh.points[t[b]];
+                longest2 = std::max(longest2, glm::dot(e, e));
+            }
+    return std::sqrt(longest2);
+}
+
+std::vector<cl_float4> packHarcTets(const TetMesh& mesh, const TetTopology& topology, const glm::dvec3& shift)
+{
+    std::vector<cl_float4> out(mesh.tets.size() * 5);
+    for (std::size_t t = 0; t < mesh.tets.size(); ++t) {
+        const glm::uvec4 v = mesh.tets[t];
+        const glm::dvec3 x0 = mesh.points[v[0]] - shift;
+        // Barycentric coordinates: (b1, b2, b3) = M^-1 (x - x0), M = [x1 - x0, x2 - x0, x3 - x0]; b0 = 1 - Σ.
+        const glm::dmat3 m(mesh.points[v[1]] - shift - x0, mesh.points[v[2]] - shift - x0,
+                           mesh.points[v[3]] - shift - x0);
+        const glm::dmat3 inv = glm::inverse(m);
+        glm::dvec3 h[4];
+        double k[4];
+        for (int i = 1; i < 4; ++i) {
+            h[i] = glm::dvec3(inv[0][i - 1], inv[1][i - 1], inv[2][i - 1]);  // row i-1 of M^-1
+            k[i] = -glm::dot(h[i], x0);
+        }
+        h[0] = -(h[1] + h[2] + h[3]);
+        k[0] = 1.0 - (k[1] + k[2] + k[3]);
+        glm::dvec3 g(0.0);
+        double g0 = 0.0;
+        for (int i = 0; i < 4; ++i) {  // s(x) = Σ s_i b_i(x): Eq. 6's gradient and scalar term
+            g += mesh.scalars[v[i]] * h[i];
+            g0 += mesh.scalars[v[i]] * k[i];
+        }
+        cl_float4* o = &out[5 * t];
+        for (int i = 0; i < 3; ++i)
+            o[i] = toCl4(h[i], k[i]);
+        o[3] = toCl4(g, g0);
+        // Across face i: the neighbor n and the face of n that is this face, as n * 4 + face (the walk
+        // needs both and this saves it a second, dependent load per step), or -1 on the boundary.
+        cl_int adj[4];
+        for (int i = 0; i < 4; ++i) {
+            const std::int32_t n = topology.neighbor[t][i];
+            adj[i] = -1;
+            if (n >= 0)
+                for (int j = 0; j < 4; ++j)
+                    if (topology.neighbor[n][j] == static_cast<std::int32_t>(t))
+                        adj[i] = n * 4 + j;
+        }
+        std::memcpy(&o[4], adj, sizeof adj);
+    }
+    return out;
+}
+
+HarcEntryLists buildHarcEntryLists(const TetMesh& mesh, const TetTopology& topology, const Camera& camera,
+                                   int width, int height)
+{
+    struct Hit {
+        std::uint32_t pixel;
+        float lambda;
+        std::int32_t code;
+    };
+    const glm::dvec3 f = camera.forward(), r = camera.right(), u = camera.up();
+    const PixelRays rays(camera, width, height);
+    const double aspect = static_cast<double>(width) / height;
+    const double scale = camera.parallel ? camera.parallelScale : std::tan(glm::radians(camera.viewAngle) * 0.5);
+    // Boundary faces in chunks over the host's threads, each thread with its own hits; the per-pixel
+    // sort below (by λ, then face) makes the result independent of which thread found what.
+    constexpr std::size_t kChunk = 256;
+    const std::size_t faceCount = topology.boundary.size();
+    std::atomic<std::size_t> nextChunk{0};
+    std::mutex merge;
+    std::vector<Hit> hits;
+    runOnThreads(0, static_cast<int>((faceCount + kChunk - 1) / kChunk), [&] {
+        std::vector<Hit> local;
+        for (std::size_t begin; (begin = nextChunk.fetch_add(kChunk)) < faceCount;) {
+            const std::size_t end = std::min(begin + kChunk, faceCount);
+            for (std::size_t i = begin; i < end; ++i) {
+                const TetTopology::BoundaryFace& bf = topology.boundary[i];
+                const std::array<glm::dvec3, 3> p = outwardFace(mesh, bf.tet, bf.face);
+                const glm::dvec3 normal = glm::cross(p[1] - p[0], p[2] - p[0]);
+                // Pixel bounding box of the face (whole image if a corner is at or behind the eye plane).
+                double x0 = 0.0, x1 = width - 1.0, y0 = 0.0, y1 = height - 1.0;
+                bool clipped = false;
+                double minX = 1e300, maxX = -1e300, minY = 1e300, maxY = -1e300;
+                for (const glm::dvec3& q : p) {
+                    const glm::dvec3 rel = q - camera.position;
+                    double sx = glm::dot(rel, r), sy = glm::dot(rel, u);
+                    if (!camera.parallel) {
+                        const double z = glm::dot(rel, f);
+                        if (!(z > 1e-12)) {
+                            clipped = true;
+                            break;
+                        }
+                        sx /= z;
+                        sy /= z;
+                    }
+                    const double px = (sx / (scale * aspect) + 1.0) * 0.5 * width - 0.5;
+                    const double py = (1.0 - sy / scale) * 0.5 * height - 0.5;
+                    minX = std::min(minX, px);
+                    maxX = std::max(maxX, px);
+                    minY = std::min(minY, py);
+                    maxY = std::max(maxY, py);
+                }
+                if (!clipped) {
+                    x0 = std::max(x0, std::floor(minX) - 1.0);
+                    x1 = std::min(x1, std::ceil(maxX) + 1.0);
+                    y0 = std::max(y0, std::floor(minY) - 1.0);
+                    y1 = std::min(y1, std::ceil(maxY) + 1.0);
+                }
+                const glm::dvec3 e1 = p[1] - p[0], e2 = p[2] - p[0];
+                for (int y = static_cast<int>(y0); y <= static_cast<int>(y1); ++y)
+                    for (int x = static_cast<int>(x0); x <= static_cast<int>(x1); ++x) {
+                        const Ray ray = rays.at(x, y);
+                        if (!(glm::dot(normal, ray.direction) < 0.0))
+                            continue;  // back face (or edge-on) for this ray
+                        // Möller–Trumbore, edges included with a small margin so that no ray slips between
+                        // two faces that share an edge (a duplicate is skipped by the walk).
+                        const glm::dvec3 pv = glm::cross(ray.direction, e2);
+                        const double det = glm::dot(e1, pv);
+                        if (det == 0.0)
+                            continue;
+                        const double inv = 1.0 / det;
+                        const glm::dvec3 tv0 = ray.origin - p[0];
+                        const double bu = glm::dot(tv0, pv) * inv;
+                        const glm::dvec3 qv = glm::cross(tv0, e1);
+                        const double bv = glm::dot(ray.direction, qv) * inv;
+                        constexpr double kMargin = 1e-7;
+                        if (bu < -kMargin || bv < -kMargin || bu + bv > 1.0 + kMargin)
+                            continue;
+                        const double lambda = glm::dot(e2, qv) * inv;
+                        if (!(lambda >= 0.0))
+                            continue;
+                        local.push_back({static_cast<std::uint32_t>(y * width + x), static_cast<float>(lambda),
+                                         static_cast<std::int32_t>(bf.tet * 4 + bf.face)});
+                    }
+            }
+        }
+        const std::lock_guard<std::mutex> lock(merge);
+        hits.insert(hits.end(), local.begin(), local.end());
+    });
+    HarcEntryLists lists;
+    const std::size_t pixels = static_cast<std::size_t>(width) * height;
+    lists.offsets.assign(pixels + 1, 0);
+    for (const Hit& h : hits)
+        ++lists.offsets[h.pixel + 1];
+    for (std::size_t p = 0; p < pixels; ++p)
+        lists.offsets[p + 1] += lists.offsets[p];
+    std::vector<Hit> sorted(hits.size());
+    std::vector<cl_uint> fill(lists.offsets.begin(), lists.offsets.end() - 1);
+    for (const Hit& h : hits)
+        sorted[fill[h.pixel]++] = h;
+    lists.entries.resize(sorted.size());
+    for (std::size_t p = 0; p < pixels; ++p) {
+        const auto b = sorted.begin() + lists.offsets[p], e = sorted.begin() + lists.offsets[p + 1];
+        std::sort(b, e, [](const Hit& a, const Hit& c) {
+            return a.lambda != c.lambda ? a.lambda < c.lambda : a.code < c.code;
+        });
+        for (auto it = b; it != e; ++it) {
+            cl_int bits;
+            std::memcpy(&bits, &it->lambda, sizeof bits);
+            lists.entries[it - sorted.begin()] = cl_int2{{bits, it->code}};
+        }
+    }
+    return lists;
+}
+
+std::unique_ptr<Renderer> makeHarcRenderer(Device& device, const Scene& scene, const TetMesh& mesh,
+                                           const TetTopology& topology)
+{
+    return std::make_unique<HarcRenderer>(device, scene, mesh, topology);
+}
+
+}  // namespace clvr

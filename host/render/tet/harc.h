@@ -1,0 +1,75 @@
+// host/render/tet/harc.h — hardware-assisted ray casting of tetrahedral meshes with partial
+// pre-integration (seeds/001_cd12fd6b76f9cf96.txt §3–4, Figure 6), kernels/harc.cl. One work-item
+// per pixel walks the mesh through the cell adjacency from the first boundary front face its ray
+// crosses; each cell's segment is split at the transfer function's control points and each piece is
+// integrated by Eq. 2–4 (ψ from host/optics/psi_table.h); or, with "integration": "full" (HARC-Full), each
+// whole segment is looked up in a 3D pre-integration table (host/optics/preintegration_table.h). Non-convex
+// meshes: a per-pixel list of boundary front-face crossings sorted by depth, so a ray that leaves the
+// mesh re-enters at the next one.
+// docs/harc.md.
+#pragma once
+
+#include "host/model/camera.h"
+#include "host/model/mesh.h"
+#include "host/render/renderer.h"
+
+#include <CL/opencl.hpp>
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace clvr {
+
+struct HarcOptions {
+    enum class Integration { Partial, Average, Full };
+    Integration integration = Integration::Partial;
+    int fullScalarSamples = 64;     // "full_table": [NS, NL], the (s_f, s_b, l) table is NS x NS x NL
+    int fullLengthSamples = 64;
+    std::uint64_t maxSteps = 0;     // per ray; 0 = the default, 4 * cbrt(tets) + 10000
+    double earlyTermination = 1.0;  // stop once A >= this; 1.0 = off (the paper's benchmarks)
+    // Where the per-pixel entry lists come from: the raster stage (depth peeling of the boundary front
+    // faces, host/render/tet/harc_entry.h, as seeds/001 §3-4) or exact ray/face intersection on the host.
+    enum class Entry { Raster, Host };
+    Entry entry = Entry::Host;
+    int maxLayers = 64;  // raster entry: peeling layers per frame (1..255); rays past them are counted
+};
+
+// Reads the scene's "options" for harc: "integration" ("partial" | "average" | "full"), "full_table"
+// ([NS, NL], integers in [2, 512], at most kMaxFullTableBytes, only with "full"), "max_steps" (integer
+// >= 1), "early_termination" (opacity in (0, 1]), "entry" ("raster" | "host"), "max_layers" (integer
+// in [1, 255]). InputError naming the key for unknown keys, wrong
+// types and values out of range.
+HarcOptions parseHarcOptions(const nlohmann::json& options);
+
+// The largest full pre-integration table "full_table" may ask for (16 bytes per entry): 256 MiB, e.g.
+// 256 x 256 x 256 or 512 x 512 x 64. It is built on the host at every transfer-function change.
+inline constexpr std::uint64_t kMaxFullTableBytes = std::uint64_t(256) << 20;
+
+// The longest segment a ray can have inside one cell of the mesh: its longest tetrahedron edge (a
+// tetrahedron's diameter is the distance between two of its vertices). World units; the l range of
+// the full pre-integration table.
+double longestTetEdge(const TetMesh& mesh);
+
+// The device layout, 5 float4 = 80 bytes per tetrahedron (kernels/harc.cl describes it): three
+// barycentric planes (the fourth is 1 minus their sum), the gradient and scalar term of Eq. 6, and the
+// adjacency. Coordinates are relative to `shift` (the mesh's bounding-box center, for float precision).
+inline constexpr std::size_t kHarcBytesPerTet = 5 * sizeof(cl_float4);
+std::vector<cl_float4> packHarcTets(const TetMesh& mesh, const TetTopology& topology, const glm::dvec3& shift);
+
+// Per pixel of a width x height image, the crossings of its ray (Camera::ray, λ >= 0) with boundary
+// faces that face the ray (outward normal . d < 0), sorted by λ: entries[offsets[p] .. offsets[p+1])
+// = (λ as float bits, tet * 4 + face).
+struct HarcEntryLists {
+    std::vector<cl_uint> offsets;  // width * height + 1
+    std::vector<cl_int2> entries;
+};
+HarcEntryLists buildHarcEntryLists(const TetMesh& mesh, const TetTopology& topology, const Camera& camera,
+                                   int width, int height);
+
+// Renderer for "harc" on a mesh that checkMesh() has normalized, with its topology. Throws InputError
+// for bad options or an empty mesh, DeviceError when the mesh does not fit on the device.
+std::unique_ptr<Renderer> makeHarcRenderer(Device& device, const Scene& scene, const TetMesh& mesh,
+                                           const TetTopology& topology);
+
+}  // namespace clvr

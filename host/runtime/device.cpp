@@ -1,0 +1,303 @@
+// host/runtime/device.cpp — device choice, program build and cache, named launches, checked buffers.
+#include "host/runtime/device.h"
+
+#include "host/runtime/embedded_kernels.h"
+#include "host/runtime/errors.h"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+
+namespace clvr {
+namespace {
+
+std::string lower(std::string s)
+{
+    std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+    return s;
+}
+
+std::string typeName(cl_device_type type)
+{
+    if (type & CL_DEVICE_TYPE_GPU)
+        return "GPU";
+    if (type & CL_DEVICE_TYPE_CPU)
+        return "CPU";
+    if (type & CL_DEVICE_TYPE_ACCELERATOR)
+        return "accelerator";
+    return "other";
+}
+
+struct Found {
+    DeviceListing listing;
+    cl::Device device;
+};
+
+std::vector<Found> enumerate()
+{
+    std::vector<cl::Platform> platforms;
+    // The ICD loader returns CL_PLATFORM_NOT_FOUND_KHR (-1001) when no platform is installed.
+    cl_uint count = 0;
+    if (clGetPlatformIDs(0, nullptr, &count) != CL_SUCCESS || count == 0)
+        return {};
+    cl::Platform::get(&platforms);
+    std::vector<Found> found;
+    for (const cl::Platform& platform : platforms) {
+        std::vector<cl::Device> devices;
+        try {
+            platform.getDevices(CL_DEVICE_TYPE_ALL, &devices);
+        } catch (const cl::Error&) {  // CL_DEVICE_NOT_FOUND: a platform without devices
+            continue;
+        }
+        for (const cl::Device& d : devices) {
+            DeviceListing l;
+            l.index = static_cast<int>(found.size());
+            l.platform = platform.getInfo<CL_PLATFORM_NAME>();
+            l.name = d.getInfo<CL_DEVICE_NAME>();
+            l.version = d.getInfo<CL_DEVICE_VERSION>();
+            l.type = typeName(d.getInfo<CL_DEVICE_TYPE>());
+            l.computeUnits = d.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>();
+            l.globalMemBytes = d.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
+            l.maxAllocBytes = d.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
+            // Strip the trailing NULs some drivers leave in info strings.
+            for (std::string* s : {&l.platform, &l.name, &l.version})
+                s->erase(std::find(s->begin(), s->end(), '\0'), s->end());
+            found.push_back({l, d});
+        }
+    }
+    return found;
+}
+
+const Found& pick(const std::vector<Found>& found, const std::string& spec)
+{
+    if (found.empty())
+        throw DeviceError("no OpenCL device found (is an ICD such as pocl-opencl-icd installed?)");
+    std::string rule = spec;
+    std::string source = "--device";
+    if (rule.empty()) {
+        if (const char* env = std::getenv("CLVR_DEVICE"); env && *env) {
+            rule = env;
+            source = "CLVR_DEVICE";
+        }
+    }
+    if (rule.empty()) {
+        for (const Found& f : found)
+            if (f.listing.type == "CPU")
+                return f;
+        return found.front();
+    }
+    if (std::all_of(rule.begin(), rule.end(), [](unsigned char c) { return std::isdigit(c); })) {
+        const unsigned long index = std::stoul(rule);
+        if (index >= found.size())
+            throw DeviceError(source + " " + rule + ": there are only " + std::to_string(found.size()) +
+                              " OpenCL devices (see clvr info)");
+        return found[index];
+    }
+    for (const Found& f : found)
+        if (lower(f.listing.name).find(lower(rule)) != std::string::npos ||
+            lower(f.listing.platform).find(lower(rule)) != std::string::npos)
+            return f;
+    throw DeviceError(source + " \"" + rule + "\" matches no OpenCL device (see clvr info)");
+}
+
+// $CLVR_DEVICE_MEMORY_LIMIT: bytes with an optional K, M or G suffix (powers of 1024); 0 when unset.
+cl_ulong memoryLimitFromEnvironment()
+{
+    const char* env = std::getenv("CLVR_DEVICE_MEMORY_LIMIT");
+    if (!env || !*env)
+        return 0;
+    const std::string text(env);
+    std::size_t used = 0;
+    unsigned long long value = 0;
+    try {
+        value = std::stoull(text, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    unsigned shift = 0;
+    if (used > 0 && used + 1 == text.size()) {
+        switch (std::toupper(static_cast<unsigned char>(text.back()))) {
+        case 'K': shift = 10; break;
+        case 'M': shift = 20; break;
+        case 'G': shift = 30; break;
+        default: used = 0;
+        }
+        if (used)
+            used = text.size();
+    }
+    if (used != text.size() || value == 0 || value > (~0ull >> shift))
+        throw InputError("CLVR_DEVICE_MEMORY_LIMIT \"" + text + "\": want a positive byte count like 512M or 2G");
+    return static_cast<cl_ulong>(value) << shift;
+}
+
+std::string mib(cl_ulong bytes)
+{
+    return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB";
+}
+
+}  // namespace
+
+std::vector<DeviceListing> listDevices()
+{
+    std::vector<DeviceListing> out;
+    for (const Found& f : enumerate())
+        out.push_back(f.listing);
+    return out;
+}
+
+DeviceListing chooseDevice(const std::string& spec)
+{
+    return pick(enumerate(), spec).listing;
+}
+
+Device::Device(const std::string& spec)
+{
+    const std::vector<Found> found = enumerate();
+    const Found& chosen = pick(found, spec);
+    listing_ = chosen.listing;
+    // A user-set cap on device memory (shared GPUs on a cluster node; tests of the out-of-memory path).
+    if (const cl_ulong limit = memoryLimitFromEnvironment()) {
+        listing_.globalMemBytes = std::min(listing_.globalMemBytes, limit);
+        listing_.maxAllocBytes = std::min(listing_.maxAllocBytes, limit);
+    }
+    device_ = chosen.device;
+    context_ = cl::Context(device_);
+    queue_ = cl::CommandQueue(context_, device_, CL_QUEUE_PROFILING_ENABLE);
+}
+
+std::string Device::description() const
+{
+    return listing_.name + " (" + listing_.version + "), " + std::to_string(listing_.computeUnits) +
+           " compute units";
+}
+
+cl::Program Device::program(std::string_view label, std::string_view source, std::string_view options)
+{
+    auto key = std::make_tuple(std::string(label), std::string(source), std::string(options));
+    if (auto it = programs_.find(key); it != programs_.end())
+        return it->second;
+
+    cl::Program program(context_, std::string(source));
+    const auto start = std::chrono::steady_clock::now();
+    cl_int status = CL_SUCCESS;
+    try {
+        status = program.build({device_}, std::string(options).c_str());
+    } catch (const cl::Error& e) {
+        status = e.err();
+    }
+    compileMs_ += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    std::string log;
+    try {
+        log = program.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device_);
+        log.erase(std::find(log.begin(), log.end(), '\0'), log.end());
+    } catch (const cl::Error&) {
+    }
+    if (status != CL_SUCCESS) {
+        throw BuildError("building " + std::string(label) + " for \"" + listing_.name + "\" (" + listing_.version +
+                             ") with \"" + std::string(options) + "\" failed: " + clErrorName(status),
+                         log.empty() ? "(the compiler left no log)" : log);
+    }
+    if (log.find_first_not_of(" \t\r\n") != std::string::npos)
+        warnings_.push_back(std::string(label) + ": " + log);
+    programs_.emplace(std::move(key), program);
+    return program;
+}
+
+cl::Kernel Device::kernel(std::string_view file, std::string_view kernelName, std::string_view fragmentProgram,
+                          std::string_view extraOptions)
+{
+    const auto& kernels = embeddedKernels();
+    const auto it = std::find_if(kernels.begin(), kernels.end(), [&](const EmbeddedKernel& k) { return k.name == file; });
+    if (it == kernels.end())
+        throw DeviceError("no embedded kernel file kernels/" + std::string(file));
+    // The fragment program goes after the file, so it can use everything the file includes;
+    // the file declares the functions the fragment program must define.
+    std::string source(it->source);
+    if (!fragmentProgram.empty()) {
+        source += "\n#line 1 \"fragment program\"\n";
+        source += fragmentProgram;
+        source += '\n';
+    }
+    std::string options(kBuildOptions);
+    if (!extraOptions.empty())
+        options += " " + std::string(extraOptions);
+    cl::Program prog = program("kernels/" + std::string(file), source, options);
+    try {
+        return cl::Kernel(prog, std::string(kernelName).c_str());
+    } catch (const cl::Error& e) {
+        throw DeviceError("kernels/" + std::string(file) + " has no kernel \"" + std::string(kernelName) +
+                          "\": " + clErrorName(e.err()));
+    }
+}
+
+void Device::enqueue(std::string name, const cl::Kernel& kernel, const cl::NDRange& global)
+{
+    cl::Event event;
+    try {
+        queue_.enqueueNDRangeKernel(kernel, cl::NullRange, global, cl::NullRange, nullptr, &event);
+    } catch (const cl::Error& e) {
+        if (e.err() == CL_MEM_OBJECT_ALLOCATION_FAILURE || e.err() == CL_OUT_OF_RESOURCES ||
+            e.err() == CL_OUT_OF_HOST_MEMORY)
+            throw DeviceError("out of device memory running \"" + name + "\" on " + listing_.name + ": " +
+                              clErrorName(e.err()));
+        throw DeviceError("launching \"" + name + "\" failed: " + clErrorName(e.err()));
+    }
+    pending_.emplace_back(std::move(name), std::move(event));
+}
+
+void Device::launch(std::string name, const cl::Kernel& kernel, std::size_t count)
+{
+    const std::size_t padded = std::max<std::size_t>(64, (count + 63) / 64 * 64);
+    enqueue(std::move(name), kernel, cl::NDRange(padded));
+}
+
+void Device::launch(std::string name, const cl::Kernel& kernel, std::size_t width, std::size_t height)
+{
+    const std::size_t w = std::max<std::size_t>(8, (width + 7) / 8 * 8);
+    const std::size_t h = std::max<std::size_t>(8, (height + 7) / 8 * 8);
+    enqueue(std::move(name), kernel, cl::NDRange(w, h));
+}
+
+std::vector<PassTime> Device::takePassTimes()
+{
+    queue_.finish();
+    std::vector<PassTime> out;
+    out.reserve(pending_.size());
+    for (auto& [name, event] : pending_) {
+        const cl_ulong start = event.getProfilingInfo<CL_PROFILING_COMMAND_START>();
+        const cl_ulong end = event.getProfilingInfo<CL_PROFILING_COMMAND_END>();
+        out.push_back({name, static_cast<double>(end - start) * 1e-6});
+    }
+    pending_.clear();
+    return out;
+}
+
+cl::Buffer Device::buffer(std::string_view what, std::size_t bytes, cl_mem_flags flags, const void* host)
+{
+    if (bytes > listing_.maxAllocBytes || bytes > listing_.globalMemBytes)
+        throw DeviceError("out of device memory: " + std::string(what) + " needs " + mib(bytes) + ", " +
+                          listing_.name + " allows " + mib(listing_.maxAllocBytes) + " per buffer and has " +
+                          mib(listing_.globalMemBytes));
+    // Zero-sized buffers are invalid in OpenCL: allocate at least 4 bytes. CL_MEM_COPY_HOST_PTR then
+    // reads the whole allocation, so a shorter host block is copied into a zero-padded one first.
+    constexpr std::size_t kMinBytes = 4;
+    std::array<unsigned char, kMinBytes> padded{};
+    if ((flags & CL_MEM_COPY_HOST_PTR) != 0 && bytes < kMinBytes) {
+        if (bytes > 0)
+            std::memcpy(padded.data(), host, bytes);
+        host = padded.data();
+    }
+    try {
+        return cl::Buffer(context_, flags, std::max(bytes, kMinBytes), const_cast<void*>(host));
+    } catch (const cl::Error& e) {
+        const bool noMemory = e.err() == CL_MEM_OBJECT_ALLOCATION_FAILURE || e.err() == CL_OUT_OF_RESOURCES ||
+                              e.err() == CL_OUT_OF_HOST_MEMORY || e.err() == CL_INVALID_BUFFER_SIZE;
+        throw DeviceError(std::string(noMemory ? "out of device memory: " : "") + "allocating " + mib(bytes) +
+                          " for " + std::string(what) + " on " + listing_.name + " failed: " + clErrorName(e.err()));
+    }
+}
+
+}  // namespace clvr

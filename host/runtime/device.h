@@ -1,0 +1,114 @@
+// host/runtime/device.h — the OpenCL runtime: device choice, context and queue, the program cache,
+// named launches with per-pass timing, and checked buffer allocation.
+#pragma once
+
+#include <CL/opencl.hpp>
+
+#include <cstddef>
+#include <map>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <tuple>
+#include <vector>
+
+namespace clvr {
+
+// One device as `clvr info` lists it; `index` is what `--device N` takes.
+struct DeviceListing {
+    int index = 0;
+    std::string platform;  // "Portable Computing Language"
+    std::string name;      // "pthread-skylake-avx512"
+    std::string version;   // "OpenCL 3.0 PoCL 3.1 ..."
+    std::string type;      // "CPU", "GPU", "accelerator"
+    cl_uint computeUnits = 0;
+    cl_ulong globalMemBytes = 0;
+    cl_ulong maxAllocBytes = 0;
+};
+
+// Every device of every platform, in platform order. Empty if there is no OpenCL platform.
+std::vector<DeviceListing> listDevices();
+
+// The rule of DESIGN.md: `spec` (an index into listDevices() or a case-insensitive substring of
+// the platform or device name) if not empty, else $CLVR_DEVICE, else the first CPU device, else
+// the first device. Throws DeviceError when nothing matches or there is no device at all.
+DeviceListing chooseDevice(const std::string& spec);
+
+// Compiler options used for every program (STYLE.md: no fast-math, no mad-enable).
+inline constexpr std::string_view kBuildOptions = "-cl-std=CL1.2";
+
+struct PassTime {
+    std::string name;  // the launch name, as --stats reports it
+    double ms = 0.0;   // device time from the profiling events
+};
+
+class Device {
+public:
+    // Opens the device chooseDevice(spec) names, with a profiling in-order queue. $CLVR_DEVICE_MEMORY_LIMIT
+    // (bytes, or with a K/M/G suffix) caps the memory buffer() allows; InputError if it is malformed.
+    explicit Device(const std::string& spec = "");
+
+    const cl::Context& context() const { return context_; }
+    const cl::Device& device() const { return device_; }
+    cl::CommandQueue& queue() { return queue_; }
+    const DeviceListing& listing() const { return listing_; }
+    // "pthread-skylake-avx512 (OpenCL 3.0 PoCL 3.1 ...), 2 compute units"
+    std::string description() const;
+
+    // A fresh cl::Kernel (setArg on a shared one races) from the cached program built from the
+    // embedded kernels/<file>, with `fragmentProgram` (OpenCL C defining functions that the
+    // file declares and its kernels call) appended after it, and `extraOptions` appended to kBuildOptions. Throws BuildError with the
+    // whole log when the build fails; a non-empty log on success goes to warnings().
+    cl::Kernel kernel(std::string_view file, std::string_view kernelName,
+                      std::string_view fragmentProgram = {}, std::string_view extraOptions = {});
+
+    // Builds (or fetches) a program from arbitrary source; `label` names it in errors.
+    cl::Program program(std::string_view label, std::string_view source, std::string_view options);
+
+    // Milliseconds spent in clBuildProgram so far (cache hits cost nothing).
+    double compileMs() const { return compileMs_; }
+    const std::vector<std::string>& warnings() const { return warnings_; }
+
+    // Enqueues `kernel` with a name that --stats reports. A 1D count is padded up to a multiple
+    // of 64 and a 2D range to multiples of 8 (PoCL has no non-uniform work-groups), so kernels
+    // take their real extent as an argument and return early past it.
+    void launch(std::string name, const cl::Kernel& kernel, std::size_t count);
+    void launch(std::string name, const cl::Kernel& kernel, std::size_t width, std::size_t height);
+
+    // Waits for the queue, then returns and forgets the device times of launches since the last call.
+    std::vector<PassTime> takePassTimes();
+
+    // A device buffer of `bytes`, optionally initialized from `host`. Throws DeviceError naming
+    // `what` if it exceeds the device's largest allocation or its global memory.
+    cl::Buffer buffer(std::string_view what, std::size_t bytes, cl_mem_flags flags = CL_MEM_READ_WRITE,
+                      const void* host = nullptr);
+
+    template <typename T>
+    cl::Buffer upload(std::string_view what, const std::vector<T>& data, cl_mem_flags flags = CL_MEM_READ_ONLY)
+    {
+        return buffer(what, data.size() * sizeof(T), flags | CL_MEM_COPY_HOST_PTR,
+                      const_cast<T*>(data.data()));
+    }
+    template <typename T>
+    std::vector<T> download(const cl::Buffer& buffer, std::size_t count)
+    {
+        std::vector<T> out(count);
+        if (count)
+            queue_.enqueueReadBuffer(buffer, CL_TRUE, 0, count * sizeof(T), out.data());
+        return out;
+    }
+
+private:
+    void enqueue(std::string name, const cl::Kernel& kernel, const cl::NDRange& global);
+
+    DeviceListing listing_;
+    cl::Device device_;
+    cl::Context context_;
+    cl::CommandQueue queue_;
+    std::map<std::tuple<std::string, std::string, std::string>, cl::Program> programs_;
+    std::vector<std::pair<std::string, cl::Event>> pending_;
+    std::vector<std::string> warnings_;
+    double compileMs_ = 0.0;
+};
+
+}  // namespace clvr

@@ -1,0 +1,154 @@
+// tests/support/test_util.cpp — shared test device, image metrics, failure images, RNG.
+#include "tests/support/test_util.h"
+
+#include "host/io/image_io.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <unistd.h>
+
+namespace clvr::test {
+
+Device& device()
+{
+    static std::unique_ptr<Device> instance = std::make_unique<Device>("");
+    return *instance;
+}
+
+std::string sharedData(const std::string& relative)
+{
+    return std::string(CLVR_SHARED_DATA_DIR) + "/" + relative;
+}
+
+std::string repoData(const std::string& relative)
+{
+    return std::string(CLVR_SOURCE_DIR) + "/data/" + relative;
+}
+
+ImageError imageError(const Image4f& actual, const Image4d& expected)
+{
+    ImageError e;
+    const std::size_t n = std::min(actual.pixelCount(), expected.pixelCount());
+    for (std::size_t i = 0; i < n; ++i) {
+        for (int c = 0; c < 4; ++c) {
+            const double a = actual.pixels()[i][c];
+            const double d = std::abs(a - expected.pixels()[i][c]);
+            if (std::isnan(a) || std::isnan(d)) {
+                ++e.nanCount;
+                continue;
+            }
+            e.maxAbs[c] = std::max(e.maxAbs[c], d);
+            e.meanAbs[c] += d;
+        }
+    }
+    if (n)
+        e.meanAbs /= static_cast<double>(n);
+    return e;
+}
+
+testing::AssertionResult imagesNear(const Image4f& actual, const Image4d& expected, Tolerance tolerance)
+{
+    if (actual.width() != expected.width() || actual.height() != expected.height())
+        return testing::AssertionFailure() << "size " << actual.width() << "x" << actual.height() << ", want "
+                                           << expected.width() << "x" << expected.height();
+    const ImageError e = imageError(actual, expected);
+    std::ostringstream msg;
+    bool ok = e.nanCount == 0;
+    static const char* kChannel = "rgba";
+    for (int c = 0; c < 4; ++c) {
+        const bool channelOk = e.maxAbs[c] <= tolerance.maxAbs && e.meanAbs[c] <= tolerance.meanAbs;
+        ok = ok && channelOk;
+        if (!channelOk) {
+            // Locate the worst pixel of this channel.
+            double worst = -1.0;
+            int wx = 0, wy = 0;
+            std::size_t over = 0;
+            for (int y = 0; y < actual.height(); ++y)
+                for (int x = 0; x < actual.width(); ++x) {
+                    const double d = std::abs(double(actual.at(x, y)[c]) - expected.at(x, y)[c]);
+                    if (d > tolerance.maxAbs)
+                        ++over;
+                    if (d > worst) {
+                        worst = d;
+                        wx = x;
+                        wy = y;
+                    }
+                }
+            msg << "color." << kChannel[c] << ": max |diff| " << e.maxAbs[c] << " at (" << wx << ", " << wy
+                << "): got " << actual.at(wx, wy)[c] << ", want " << expected.at(wx, wy)[c] << "; mean "
+                << e.meanAbs[c] << "; " << over << " of " << actual.pixelCount() << " pixels over "
+                << tolerance.maxAbs << " (mean limit " << tolerance.meanAbs << ")\n";
+        }
+    }
+    if (ok)
+        return testing::AssertionSuccess();
+    msg << "NaN " << e.nanCount << "\n";
+    const testing::TestInfo* info = testing::UnitTest::GetInstance()->current_test_info();
+    const std::string dir = std::string("test_output/") + (info ? std::string(info->test_suite_name()) + "." + info->name() : "unknown");
+    std::filesystem::create_directories(dir);
+    Image4f expectedF(expected.width(), expected.height()), diff(expected.width(), expected.height());
+    for (std::size_t i = 0; i < expected.pixelCount(); ++i) {
+        expectedF.pixels()[i] = glm::vec4(expected.pixels()[i]);
+        diff.pixels()[i] = glm::abs(actual.pixels()[i] - expectedF.pixels()[i]);
+        diff.pixels()[i].a = 1.0f;
+    }
+    writeImage(dir + "/actual.exr", actual);
+    writeImage(dir + "/expected.exr", expectedF);
+    writeImage(dir + "/diff.exr", diff);
+    msg << "wrote " << dir << "/{actual,expected,diff}.exr";
+    return testing::AssertionFailure() << msg.str();
+}
+
+TempDir::TempDir()
+{
+    static int counter = 0;
+    const testing::TestInfo* info = testing::UnitTest::GetInstance()->current_test_info();
+    path_ = std::filesystem::temp_directory_path() /
+            ("clvr-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) + "-" +
+             (info ? std::string(info->name()) : std::string("x")));
+    std::filesystem::create_directories(path_);
+}
+
+TempDir::~TempDir()
+{
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+}
+
+void writeFile(const std::filesystem::path& path, const std::string& bytes)
+{
+    std::ofstream out(path, std::ios::binary);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    ASSERT_TRUE(out.good()) << path;
+}
+
+std::string readFile(const std::filesystem::path& path)
+{
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+std::uint64_t Rng::next()
+{
+    std::uint64_t z = (state_ += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+}
+
+double Rng::uniform(double lo, double hi)
+{
+    return lo + (hi - lo) * (static_cast<double>(next() >> 11) * 0x1.0p-53);
+}
+
+int Rng::integer(int lo, int hi)
+{
+    return lo + static_cast<int>(next() % static_cast<std::uint64_t>(hi - lo + 1));
+}
+
+}  // namespace clvr::test

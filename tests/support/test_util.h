@@ -1,0 +1,92 @@
+// tests/support/test_util.h — what every suite shares: the test device, image comparison with stated
+// tolerances (NaN never passes, failure images written), seeded randomness, data paths.
+#pragma once
+
+#include "host/model/camera.h"
+#include "host/runtime/device.h"
+#include "host/model/image.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+namespace clvr::test {
+
+// CLVR_DEVICE, else the first CPU device (PoCL); opened once per process.
+Device& device();
+
+// ../shared/data/<relative>, and the repository's own data/<relative>.
+std::string sharedData(const std::string& relative);
+std::string repoData(const std::string& relative);
+
+struct Tolerance {
+    double maxAbs = 0.0;   // per channel, every pixel
+    double meanAbs = 0.0;  // per channel, averaged over the image
+};
+
+struct ImageError {
+    glm::dvec4 maxAbs{0.0};
+    glm::dvec4 meanAbs{0.0};
+    std::size_t nanCount = 0;
+};
+ImageError imageError(const Image4f& actual, const Image4d& expected);
+
+// Per channel max and mean absolute error against `expected`; fails on NaN or size mismatch.
+// On failure writes test_output/<suite>.<test>/{actual,expected,diff}.exr and says so.
+testing::AssertionResult imagesNear(const Image4f& actual, const Image4d& expected, Tolerance tolerance);
+
+// A fresh directory under the system temporary directory (named after the running test), removed
+// with everything in it when it goes out of scope. Tests write malformed files here, never in the repo.
+class TempDir {
+public:
+    TempDir();
+    ~TempDir();
+    TempDir(const TempDir&) = delete;
+    TempDir& operator=(const TempDir&) = delete;
+    std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
+    const std::filesystem::path& path() const { return path_; }
+
+private:
+    std::filesystem::path path_;
+};
+
+// Whole-file binary write (asserting success) and read.
+void writeFile(const std::filesystem::path& path, const std::string& bytes);
+std::string readFile(const std::filesystem::path& path);
+
+// A small deterministic generator (splitmix64): the same numbers on every standard library.
+class Rng {
+public:
+    explicit Rng(std::uint64_t seed) : state_(seed) {}
+    std::uint64_t next();
+    double uniform(double lo = 0.0, double hi = 1.0);  // [lo, hi)
+    int integer(int lo, int hi);                       // [lo, hi]
+
+private:
+    std::uint64_t state_;
+};
+
+// The two cameras of tests/slice3d_test.cpp that most regular-grid tests share, looking at the origin
+// (a volume in [-1, 1]^3): perspective from (1.2, 1.6, 3.7), 28 degrees off the z axis, with this view
+// angle; parallel from (3.5, 1.0, 1.9), z up, 32 degrees off the x axis, with this parallel scale.
+inline Camera obliquePerspectiveCamera(double viewAngle)
+{
+    Camera c;
+    c.position = {1.2, 1.6, 3.7};
+    c.viewAngle = viewAngle;
+    return c;
+}
+
+inline Camera obliqueParallelCamera(double parallelScale)
+{
+    Camera c;
+    c.position = {3.5, 1.0, 1.9};
+    c.viewUp = {0.0, 0.0, 1.0};
+    c.parallel = true;
+    c.parallelScale = parallelScale;
+    return c;
+}
+
+}  // namespace clvr::test
