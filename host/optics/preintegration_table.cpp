@@ -2,7 +2,7 @@
 #include "host/optics/preintegration_table.h"
 
 #include "host/runtime/parallel.h"
-#include "host/reference/tet_reference.h"
+#include "host/optics/segment_integral.h"
 
 #include <algorithm>
 #include <atomic>

@@ -38,7 +38,7 @@ struct PreintegrationTable {
 };
 
 // Builds the table over s in [sLo, sHi] (sHi > sLo) and l in [0, lMax] (lMax > 0), 2 <= NS, NL. Every
-// entry is the exact integral of host/reference/tet_reference.h (the segment cut at the control points, each
+// entry is the exact integral of host/optics/segment_integral.h (the segment cut at the control points, each
 // piece in closed form, in double), rounded to float. `threads` host threads (<= 0: one per hardware
 // thread) share the l slices.
 PreintegrationTable buildPreintegrationTable(const TransferFunction& tf, double sLo, double sHi, double lMax,

@@ -11,6 +11,7 @@
 #include "host/model/image.h"
 #include "host/model/mesh.h"
 #include "host/model/scene.h"
+#include "host/optics/segment_integral.h"
 #include "host/model/transfer_function.h"
 
 #include <glm/glm.hpp>
@@ -20,38 +21,7 @@
 
 namespace clvr {
 
-// ---- one linear piece -------------------------------------------------------------------------------
-
-// The two transfer-function-free terms of a linear piece of optical depths a = tau_f l (front, the end
-// nearer the eye) and b = tau_b l (back): zeta = exp(-(a + b)/2) (Eq. 3) and
-// psi = ∫0^1 exp(-∫0^t (a (1-u) + b u) du) dt (Eq. 4, written from the front), with their complements
-// computed without cancellation.
-struct PsiZeta {
-    double psi = 1.0;
-    double zeta = 1.0;
-    double oneMinusPsi = 0.0;   // 1 - psi
-    double psiMinusZeta = 0.0;  // psi - zeta
-    double oneMinusZeta = 0.0;  // 1 - zeta: the piece's opacity
-};
-// a, b >= 0 and finite (optical depths, dimensionless). Relative error a few 1e-16 (see docs).
-PsiZeta psiZeta(double a, double b);
-
-// A linear piece of length l (world units) whose extinction goes from tauF (front) to tauB (back) and
-// emitted color from colorF to colorB: premultiplied color C_b (psi - zeta) + C_f (1 - psi) in rgb and
-// opacity 1 - zeta in a. Composite front to back as I += T * rgb, T *= 1 - a.
-glm::dvec4 integrateLinearPiece(glm::dvec3 colorF, double tauF, glm::dvec3 colorB, double tauB, double l);
-
 // ---- geometry ---------------------------------------------------------------------------------------
-
-// A ray's passage through one tetrahedron: ray parameters (world units along the unit direction) and
-// the linearly interpolated scalar at both ends.
-struct TetSegment {
-    std::uint32_t tet = 0;
-    double lambdaIn = 0.0;
-    double lambdaOut = 0.0;
-    double sIn = 0.0;
-    double sOut = 0.0;
-};
 
 // Face planes of every tetrahedron and a uniform grid over their bounding boxes. Each face's plane is
 // computed from its three points in ascending index order, so the two tetrahedra that share a face hold
@@ -103,9 +73,6 @@ struct TetReferenceOptions {
     int threads = 2;                      // std::thread workers over rows (<= 0: hardware_concurrency)
     TetReferenceStats* stats = nullptr;   // filled when not null
 };
-
-// The composited (I.r, I.g, I.b, A) of one ray's segments, front to back (no background).
-glm::dvec4 integrateSegments(const std::vector<TetSegment>& segments, const TransferFunction& tf);
 
 // Integrates every pixel of an image.width x image.height image; the pixel is rgb = I + (1 - A) *
 // background, a = A (DESIGN.md). Only the ray part in front of the camera (lambda >= 0) counts.

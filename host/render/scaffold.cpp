@@ -1,0 +1,55 @@
+// host/render/scaffold.cpp — the renderer scaffold's checks, read-back and frame bookkeeping.
+#include "host/render/scaffold.h"
+
+#include "host/runtime/errors.h"
+
+#include <numeric>
+#include <string>
+#include <vector>
+
+namespace clvr {
+
+void checkGridVolume(const Volume& volume, std::string_view technique)
+{
+    volume.validate();
+    if (volume.voxelCount() > 0xffffffffull)
+        throw InputError(volume.source + ": " + std::string(technique) +
+                         " takes at most 2^32 - 1 grid points (32-bit voxel indices)");
+}
+
+Camera frameCamera(const Scene& scene, const glm::dvec3& lo, const glm::dvec3& hi)
+{
+    Camera camera = scene.camera ? *scene.camera : fitCamera(lo, hi);
+    camera.validate();
+    if (scene.image.width < 1 || scene.image.height < 1)
+        throw InputError("image: width and height must be >= 1");
+    return camera;
+}
+
+double msSince(std::chrono::steady_clock::time_point t0)
+{
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+Image4f readImage(Device& device, const cl::Buffer& buffer, int width, int height)
+{
+    Image4f image(width, height);
+    const std::size_t pixels = static_cast<std::size_t>(width) * height;
+    device.queue().enqueueReadBuffer(buffer, CL_TRUE, 0, pixels * sizeof(glm::vec4), image.pixels().data());
+    return image;
+}
+
+std::uint64_t sumCounts(Device& device, const cl::Buffer& buffer, std::size_t count)
+{
+    const std::vector<cl_uint> counts = device.download<cl_uint>(buffer, count);
+    return std::accumulate(counts.begin(), counts.end(), std::uint64_t(0));
+}
+
+void finishFrame(Device& device, const FrameClock& clock, FrameStats& stats)
+{
+    for (PassTime& t : device.takePassTimes())
+        stats.passes.push_back(std::move(t));
+    stats.frameMs = clock.ms();
+}
+
+}  // namespace clvr
