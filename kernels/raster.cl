@@ -220,23 +220,28 @@ __attribute__((always_inline)) void clvr_shade(global const ClTriangle* t, long 
 
 /* One work-item per CLVR_PIXELS_PER_ITEM horizontally adjacent pixels of the viewport rectangle
  * (rect_*, clipped to the frame buffer): independent pixels give the CPU instruction-level
- * parallelism and share each triangle's loads. Tiles of CLVR_TILE_SIZE pixels start at the
- * rectangle's corner, so a work-item's pixels share a tile; tile t lists triangle indices
- * tile_tris[tile_start[t] .. tile_start[t+1]) in submission order. fragment_counts[row] receives
- * the covered-pixel count of that rectangle row. Pixels outside scissor (x0, y0, x1, y1: GL's scissor
- * rectangle, ends exclusive; the viewport rectangle when the test is off) are skipped. */
+ * parallelism and share each triangle's loads. Tiles of 2^tile_w_log2 x 2^tile_h_log2 pixels (the
+ * width a multiple of CLVR_PIXELS_PER_ITEM; the host picks the shape) start at the rectangle's corner,
+ * so a work-item's pixels share a tile; tile t lists triangle indices
+ * tile_tris[tile_start[tile_base + t] .. tile_start[tile_base + t + 1]) in submission order (one
+ * buffer holds the tile lists of every pass of a batch, and one uniforms buffer their uniforms,
+ * this pass's from uniform_base). fragment_counts[row] accumulates the
+ * covered-pixel count of that rectangle row over launches until the host reads and clears it. Pixels
+ * outside a triangle's col/row bounds (which include GL's scissor rectangle) are never its fragments. */
 kernel void raster_fragments(global float4* color, global float* depth, global uchar* stencil, const int fb_width,
-                             const int rect_x, const int rect_y, const int rect_w, const int rect_h, const int4 scissor,
-                             const int tiles_x, global const ClTriangle* tris, global const uint* tile_start,
-                             global const uint* tile_tris, const ClFragmentState fs, const ClBlendState bs,
-                             constant float4* uniforms, global const float* buffer0, global const float* buffer1,
-                             global const float* buffer2, global const float* buffer3,
+                             const int rect_x, const int rect_y, const int rect_w, const int rect_h,
+                             const int tile_w_log2, const int tile_h_log2, const int tiles_x, const uint tile_base, global const ClTriangle* tris,
+                             global const uint* tile_start, global const uint* tile_tris, const ClFragmentState fs,
+                             const ClBlendState bs, constant float4* uniforms, const uint uniform_base,
+                             global const float* buffer0,
+                             global const float* buffer1, global const float* buffer2, global const float* buffer3,
                              global uint* fragment_counts)
 {
     CLVR_GUARD_2D((rect_w + CLVR_PIXELS_PER_ITEM - 1) / CLVR_PIXELS_PER_ITEM, rect_h);
     const int gx0 = (int)get_global_id(0) * CLVR_PIXELS_PER_ITEM;
     const int gy = (int)get_global_id(1);
-    const int tile = (gy / CLVR_TILE_SIZE) * tiles_x + gx0 / CLVR_TILE_SIZE;
+    /* Shifts, not divisions: an integer division per work-item was the launch's largest cost. */
+    const uint tile = tile_base + (uint)((gy >> tile_h_log2) * tiles_x + (gx0 >> tile_w_log2));
     const uint begin = tile_start[tile];
     const uint end = tile_start[tile + 1];
     if (begin == end)
@@ -244,9 +249,8 @@ kernel void raster_fragments(global float4* color, global float* depth, global u
 
     const int px0 = rect_x + gx0;
     const int py = rect_y + gy;
-    if (py < scissor.y || py >= scissor.w)
-        return;
     const int count = min(CLVR_PIXELS_PER_ITEM, rect_w - gx0);
+    const int px1 = px0 + count - 1;  /* last pixel of this work-item */
     const size_t pixel0 = (size_t)py * (size_t)fb_width + (size_t)px0;
     const int sx0 = px0 * CLVR_SUBPIXEL_SCALE + CLVR_SUBPIXEL_SCALE / 2;  /* first pixel center */
     const int sy = py * CLVR_SUBPIXEL_SCALE + CLVR_SUBPIXEL_SCALE / 2;
@@ -256,7 +260,7 @@ kernel void raster_fragments(global float4* color, global float* depth, global u
     resources.buffer[1] = buffer1;
     resources.buffer[2] = buffer2;
     resources.buffer[3] = buffer3;
-    resources.uniforms = uniforms;
+    resources.uniforms = uniforms + uniform_base;
     const ClvrBlend blend = clvr_blend_setup(&bs);
     const int4 write_mask = (int4)((fs.color_mask & CLVR_MASK_R) ? -1 : 0, (fs.color_mask & CLVR_MASK_G) ? -1 : 0,
                                    (fs.color_mask & CLVR_MASK_B) ? -1 : 0, (fs.color_mask & CLVR_MASK_A) ? -1 : 0);
@@ -275,6 +279,9 @@ kernel void raster_fragments(global float4* color, global float* depth, global u
 
     for (uint i = begin; i < end; ++i) {
         global const ClTriangle* t = tris + tile_tris[i];
+        const int col_min = t->col_min, col_max = t->col_max;
+        if (py < t->row_min || py > t->row_max || px1 < col_min || px0 > col_max)
+            continue;
         /* e0: edge 0->1 (opposite vertex 2), e1: edge 1->2 (opposite 0), e2: edge 2->0 (opposite 1);
          * one pixel to the right adds -(y_b - y_a) * CLVR_SUBPIXEL_SCALE. */
         long e0 = clvr_edge(t->x[0], t->y[0], t->x[1], t->y[1], sx0, sy);
@@ -285,9 +292,10 @@ kernel void raster_fragments(global float4* color, global float* depth, global u
         const long step2 = -(long)(t->y[0] - t->y[2]) * CLVR_SUBPIXEL_SCALE;
 #pragma unroll
         for (int p = 0; p < CLVR_PIXELS_PER_ITEM; ++p) {
-            /* Top-left rule: a pixel center on an edge belongs to the triangle only for a top or left edge. */
-            if (p < count && px0 + p >= scissor.x && px0 + p < scissor.z && e0 + t->bias[0] >= 0 &&
-                e1 + t->bias[1] >= 0 && e2 + t->bias[2] >= 0) {
+            /* Top-left rule: a pixel center on an edge belongs to the triangle only for a top or left
+             * edge. col_max is inside the rectangle, so p < count holds for every pixel that passes. */
+            if (px0 + p >= col_min && px0 + p <= col_max && e0 + t->bias[0] >= 0 && e1 + t->bias[1] >= 0 &&
+                e2 + t->bias[2] >= 0) {
                 ++covered;
                 clvr_shade(t, e0, e1, e2, px0 + p, py, &fs, &bs, &blend, write_mask, &resources, &c[p], &d[p], &s[p]);
             }
@@ -337,4 +345,6 @@ kernel void raster_layout_probe(global uint* out)
     CLVR_PROBE_OFFSET(16, ClTriangle, attr_over_w);
     CLVR_PROBE_SIZE(17, ClTexture);
     CLVR_PROBE_OFFSET(18, ClTexture, border);
+    CLVR_PROBE_OFFSET(19, ClTriangle, col_min);
+    CLVR_PROBE_OFFSET(20, ClTriangle, row_max);
 }

@@ -99,7 +99,10 @@ typedef struct {
     cl_int bias[3];     /* fill rule: 0 for a top or left edge (i -> i+1), -1 otherwise */
     cl_uint front_facing;
     cl_float inv_area;  /* 1 / twice the area, in subpixel units squared */
-    cl_float pad[5];
+    /* Pixels whose centers can be covered, clipped to the draw's viewport and scissor rectangle (ends
+     * inclusive): a work-item skips the triangle outside them, and no pixel outside is ever visited. */
+    cl_int col_min, col_max, row_min, row_max;
+    cl_uint pad0;
     cl_float4 depth;    /* window depth of vertices 0..2 in .x .y .z */
     cl_float4 inv_w;    /* 1 / clip w of vertices 0..2 in .x .y .z */
     cl_float4 attr_over_w[3][CLVR_MAX_ATTRIBUTES]; /* attribute / clip w, per vertex */

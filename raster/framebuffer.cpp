@@ -23,7 +23,7 @@ Framebuffer::Framebuffer(Device& device, int width, int height, bool withAccum)
     : width_(width), height_(height), hasAccum_(withAccum)
 {
     if (width < 1 || height < 1 || width > 16384 || height > 16384)
-        throw InputError("frame buffer size " + std::to_string(width) + "x" + std::to_string(height) +
+        throw InternalError("frame buffer size " + std::to_string(width) + "x" + std::to_string(height) +
                          " is outside 1..16384");
     const std::size_t n = pixelCount();
     color_ = device.buffer("frame buffer color", n * sizeof(cl_float4));
@@ -36,7 +36,7 @@ Framebuffer::Framebuffer(Device& device, int width, int height, bool withAccum)
 cl::Buffer& Framebuffer::accum()
 {
     if (!hasAccum_)
-        throw DeviceError("the frame buffer was created without an accumulation buffer");
+        throw InternalError("the frame buffer was created without an accumulation buffer");
     return accum_;
 }
 
@@ -71,7 +71,7 @@ Image4f Framebuffer::readColor(Device& device)
 void Framebuffer::writeColor(Device& device, const Image4f& image)
 {
     if (image.width() != width_ || image.height() != height_)
-        throw DeviceError("writeColor: image size differs from the frame buffer");
+        throw InternalError("writeColor: image size differs from the frame buffer");
     device.queue().enqueueWriteBuffer(color_, CL_TRUE, 0, pixelCount() * sizeof(cl_float4), image.pixels().data());
 }
 
@@ -83,7 +83,7 @@ std::vector<float> Framebuffer::readDepth(Device& device)
 void Framebuffer::writeDepth(Device& device, const std::vector<float>& depth)
 {
     if (depth.size() != pixelCount())
-        throw DeviceError("writeDepth: size differs from the frame buffer");
+        throw InternalError("writeDepth: size differs from the frame buffer");
     device.queue().enqueueWriteBuffer(depth_, CL_TRUE, 0, pixelCount() * sizeof(float), depth.data());
 }
 
@@ -95,7 +95,7 @@ std::vector<std::uint8_t> Framebuffer::readStencil(Device& device)
 void Framebuffer::writeStencil(Device& device, const std::vector<std::uint8_t>& stencil)
 {
     if (stencil.size() != pixelCount())
-        throw DeviceError("writeStencil: size differs from the frame buffer");
+        throw InternalError("writeStencil: size differs from the frame buffer");
     device.queue().enqueueWriteBuffer(stencil_, CL_TRUE, 0, pixelCount(), stencil.data());
 }
 
@@ -109,7 +109,7 @@ Image4f Framebuffer::readAccum(Device& device)
 void Framebuffer::copyFrom(Device& device, Framebuffer& other)
 {
     if (other.width_ != width_ || other.height_ != height_)
-        throw DeviceError("copyFrom: frame buffers differ in size");
+        throw InternalError("copyFrom: frame buffers differ in size");
     const std::size_t n = pixelCount();
     device.queue().enqueueCopyBuffer(other.color_, color_, 0, 0, n * sizeof(cl_float4));
     device.queue().enqueueCopyBuffer(other.depth_, depth_, 0, 0, n * sizeof(float));

@@ -13,6 +13,8 @@ namespace clvr::raster {
 
 class Framebuffer {
 public:
+    // InternalError unless both sizes are in 1..16384 (scenes check image sizes before); the size checks of
+    // write*() and copyFrom() are InternalErrors too.
     Framebuffer(Device& device, int width, int height, bool withAccum = false);
 
     int width() const { return width_; }
@@ -23,7 +25,7 @@ public:
     cl::Buffer& color() { return color_; }      // float4 per pixel
     cl::Buffer& depth() { return depth_; }      // float per pixel
     cl::Buffer& stencil() { return stencil_; }  // uchar per pixel
-    cl::Buffer& accum();                        // float4 per pixel; DeviceError if created without
+    cl::Buffer& accum();                        // float4 per pixel; InternalError if created without
 
     // GL's clears (glClearColor/glClearDepth/glClearStencil + glClear), on the device.
     void clearColor(Device& device, glm::vec4 value);

@@ -70,10 +70,10 @@ void drawPixels(Device& device, Framebuffer& dst, const Image4f& src, glm::ivec2
 {
     if (src.width() < 1 || src.height() < 1 ||
         src.pixelCount() != static_cast<std::size_t>(src.width()) * static_cast<std::size_t>(src.height()))
-        throw InputError("draw pixels: source image " + std::to_string(src.width()) + "x" +
+        throw InternalError("draw pixels: source image " + std::to_string(src.width()) + "x" +
                          std::to_string(src.height()) + " is empty or inconsistent");
     if (static_cast<std::uint32_t>(blend) > static_cast<std::uint32_t>(DrawPixelsBlend::Max))
-        throw InputError("draw pixels: blend " + std::to_string(static_cast<std::uint32_t>(blend)) + " is unknown");
+        throw InternalError("draw pixels: blend " + std::to_string(static_cast<std::uint32_t>(blend)) + " is unknown");
     validate(xf);
     // Entirely outside: nothing to draw (and no int overflow of x + offset.x in the kernel).
     const std::int64_t x0 = offset.x, y0 = offset.y;
@@ -112,7 +112,7 @@ void pixelTexture(Device& device, Framebuffer& fb, const Texture& texture3d)
 void accumulate(Device& device, Framebuffer& fb, AccumOp op, float value)
 {
     if (static_cast<std::uint32_t>(op) > static_cast<std::uint32_t>(AccumOp::Add))
-        throw InputError("accum op " + std::to_string(static_cast<std::uint32_t>(op)) + " is unknown");
+        throw InternalError("accum op " + std::to_string(static_cast<std::uint32_t>(op)) + " is unknown");
     cl::Kernel kernel = device.kernel("pixel_transfer.cl", "accum");
     kernel.setArg(0, fb.color());
     kernel.setArg(1, fb.accum());

@@ -56,7 +56,7 @@ enum class DrawPixelsBlend : std::uint32_t {
 // gradientless shading (seeds/000 §3). Each source pixel goes through `xf`, then through
 // `pixelTexture` if given (its RGB used as 3D coordinates, as pixelTexture() below), then blends
 // into dst's color. Pixels landing outside dst are dropped. Depth, stencil and the fragment tests
-// are not involved. InputError for an empty or inconsistent src. Launch "draw pixels".
+// are not involved. InternalError for an empty or inconsistent src or an unknown blend. Launch "draw pixels".
 void drawPixels(Device& device, Framebuffer& dst, const Image4f& src, glm::ivec2 offset, const PixelTransfer& xf,
                 DrawPixelsBlend blend = DrawPixelsBlend::Replace, const Texture* pixelTexture = nullptr);
 
@@ -67,8 +67,8 @@ void pixelTexture(Device& device, Framebuffer& fb, const Texture& texture3d);
 
 // glAccum(op, value) on fb.accum() (GL 1.2 §4.2.4), per pixel c (color) and a (accum), RGBA:
 //   Accum: a += value c    Load: a = value c    Return: c = value a    Mult: a *= value    Add: a += value
-// Not clamped (GL clamps Return for fixed-point color buffers only). DeviceError if fb has no
-// accumulation buffer. Launch "accum".
+// Not clamped (GL clamps Return for fixed-point color buffers only). InternalError if fb has no
+// accumulation buffer or op is unknown. Launch "accum".
 enum class AccumOp : std::uint32_t { Accum, Load, Return, Mult, Add };
 void accumulate(Device& device, Framebuffer& fb, AccumOp op, float value);
 

@@ -1,7 +1,8 @@
 // raster/rasterizer.h — the ordered triangle rasterizer and GL's per-fragment operations
 // (DESIGN.md, raster stage; the exact rules are in docs/raster.md). Triangles are clipped, set up
-// and binned to screen tiles on the host in submission order; one work-item per pixel then walks
-// its tile's list in that order, so blending is exactly ordered and two runs give identical bits.
+// and binned to screen tiles on the host in submission order; one work-item per 8 pixels of a row
+// then walks its tile's list in that order, so blending is exactly ordered and two runs give identical
+// bits. Rasterizer and DrawBatch (below) make many draws cheap; raster::draw is the one-shot form.
 #pragma once
 
 #include "host/runtime/device.h"
@@ -12,6 +13,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -35,6 +37,8 @@ enum class Topology { Triangles, TriangleStrip, TriangleFan };
 // nearZ, farZ: glDepthRange, clamped to [0,1].
 struct Viewport { int x = 0, y = 0, width = -1, height = -1; float nearZ = 0.0f, farZ = 1.0f; };
 
+struct CompiledFragmentProgram;  // raster/rasterizer.cpp: the raster kernel built for one source
+
 // The per-fragment work of a technique, compiled into the raster kernel (cached by Device). `source`
 // is OpenCL C defining
 //     int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* color);
@@ -44,6 +48,10 @@ struct FragmentProgram {
     std::string source;
     std::array<cl::Buffer, 4> buffers;  // r->buffer[i]; null ones are bound to a dummy
     std::vector<glm::vec4> uniforms;    // r->uniforms[i], up to kMaxUniforms
+    // Filled by the first draw with this program and shared by its copies: the built raster kernel, so
+    // that later draws never look the (often 20 KB) source up again. Set `source` before the first draw;
+    // to draw another source, use another FragmentProgram (a source of another length is rebuilt).
+    mutable std::shared_ptr<const CompiledFragmentProgram> compiled;
 };
 
 // GL's scissor test (glScissor): with `test`, only pixels inside the rectangle (x, y its top-left pixel,
@@ -66,9 +74,76 @@ struct DrawStats {
     std::uint64_t fragments = 0;  // covered pixels inside the viewport, before any test or discard
 };
 
-// Draws `vertices` into fb in submission order. Throws InputError for bad counts or state.
+// One draw, then its stats: a Rasterizer made for this call, so it allocates and reads back every time.
+// Renderers that draw often keep a Rasterizer (below). InternalError for state out of range (more than
+// kMaxClipPlanes planes or kMaxUniforms uniforms, an empty viewport, a negative scissor).
 DrawStats draw(Device& device, Framebuffer& fb, const DrawState& state, Topology topology,
                const std::vector<Vertex>& vertices, const FragmentProgram& program = {});
+
+#define CLVR_RASTER_BATCHES 1  // Rasterizer and DrawBatch exist (tools/bench_raster.cpp compiles without)
+
+struct SetUpDraws;    // raster/rasterizer.cpp: draws set up and binned on the host, not yet launched
+struct RasterScratch;  // raster/rasterizer.cpp: device buffers, host staging and counters kept across draws
+
+// The raster stage for many draws (docs/raster.md, "Many draws"): one per renderer, for the device's
+// lifetime. A draw costs in proportion to its triangles: programs are looked up once per
+// FragmentProgram, buffers persist (grown geometrically), and nothing is read back until takeStats().
+// Draws run in submission order on the device's in-order queue, after whatever was enqueued before them
+// (clears, other passes). Not for use by several threads at once. Fragment counts are 32-bit per row:
+// take the stats at least once a frame.
+class Rasterizer {
+public:
+    explicit Rasterizer(Device& device);
+    ~Rasterizer();
+    Rasterizer(const Rasterizer&) = delete;
+    Rasterizer& operator=(const Rasterizer&) = delete;
+
+    // Sets up and bins `vertices` on the host and enqueues the fragment launch; returns without waiting.
+    // The same bits as raster::draw.
+    void draw(Framebuffer& fb, const DrawState& state, Topology topology, const std::vector<Vertex>& vertices,
+              const FragmentProgram& program = {});
+
+    // Triangles and fragments of every draw and batch since the last call (or since construction). Waits
+    // for the queue: the fragment count is a device counter.
+    DrawStats takeStats();
+
+    Device& device() { return device_; }
+
+private:
+    friend class DrawBatch;
+    const CompiledFragmentProgram& compiled(const FragmentProgram& program);
+    void submit(Framebuffer& fb, SetUpDraws& draws);
+
+    Device& device_;
+    FragmentProgram defaultProgram_;  // kDefaultFragmentProgram, for draws with an empty source
+    std::unique_ptr<RasterScratch> scratch_;
+    std::unique_ptr<SetUpDraws> immediate_;  // draw()'s one-draw batch, reused
+};
+
+// Many draws into one frame buffer as one submission: each add() sets up and bins its triangles on the
+// host, flush() uploads them once and launches one fragment pass per run of consecutive draws that
+// share fragment program, buffers, uniforms, viewport and fragment state (a state change starts a new
+// pass, so it takes effect exactly where it was added). Every pixel sees its fragments in add() order,
+// so a batch gives the same bits as the same draws one by one. Nothing enqueued between add() and
+// flush() (a clear, say) runs after the batch's draws: flush first. Draws not flushed are dropped.
+class DrawBatch {
+public:
+    DrawBatch(Rasterizer& rasterizer, Framebuffer& fb);
+    ~DrawBatch();
+    DrawBatch(const DrawBatch&) = delete;
+    DrawBatch& operator=(const DrawBatch&) = delete;
+
+    void add(const DrawState& state, Topology topology, const std::vector<Vertex>& vertices,
+             const FragmentProgram& program = {});
+    // Enqueues every draw added since the last flush, in order; returns without waiting.
+    void flush();
+    std::size_t pendingDraws() const;
+
+private:
+    Rasterizer& rasterizer_;
+    Framebuffer& fb_;
+    std::unique_ptr<SetUpDraws> draws_;
+};
 
 // The triangles of a list, strip or fan as vertex index triples, in GL's order and winding
 // (strip triangle i is (i, i+1, i+2) for even i, (i+1, i, i+2) for odd i; fan: (0, i+1, i+2)).

@@ -17,14 +17,14 @@ void validate(const TextureDesc& d, std::size_t texelCount)
     if (!size(d.width) || !size(d.height) || !size(d.depth))
         throw InputError("texture size " + shape + ": every size must be in 1..65536");
     if (d.channels != 1 && d.channels != 4)
-        throw InputError("texture " + shape + ": channels must be 1 or 4");
+        throw InternalError("texture " + shape + ": channels must be 1 or 4");
     if (d.filter != Filter::Nearest && d.filter != Filter::Linear)
-        throw InputError("texture filter " + std::to_string(static_cast<std::uint32_t>(d.filter)) + " is unknown");
+        throw InternalError("texture filter " + std::to_string(static_cast<std::uint32_t>(d.filter)) + " is unknown");
     if (d.wrap != Wrap::ClampToEdge && d.wrap != Wrap::ClampToBorder)
-        throw InputError("texture wrap " + std::to_string(static_cast<std::uint32_t>(d.wrap)) + " is unknown");
+        throw InternalError("texture wrap " + std::to_string(static_cast<std::uint32_t>(d.wrap)) + " is unknown");
     const std::uint64_t want = static_cast<std::uint64_t>(d.width) * d.height * d.depth * d.channels;
     if (want != texelCount)
-        throw InputError("texture " + shape + " needs " + std::to_string(want) + " floats, got " +
+        throw InternalError("texture " + shape + " needs " + std::to_string(want) + " floats, got " +
                          std::to_string(texelCount));
 }
 

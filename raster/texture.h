@@ -26,14 +26,15 @@ struct TextureDesc {
     glm::vec4 border{0.0f};
 };
 
-// Throws InputError unless every size is in 1..65536, channels is 1 or 4, filter and wrap are known
-// values and texelCount == width * height * depth * channels.
+// Throws InputError unless every size is in 1..65536 (sizes can come from a data file), and
+// InternalError unless channels is 1 or 4, filter and wrap are known values and texelCount ==
+// width * height * depth * channels (the caller's own description).
 void validate(const TextureDesc& desc, std::size_t texelCount);
 
 // The texels live in one read-only device buffer: float, x fastest, then y, then z, channels interleaved.
 class Texture {
 public:
-    // Validates (InputError), then uploads (DeviceError if the device cannot hold it).
+    // Validates (InputError, InternalError), then uploads (DeviceError if the device cannot hold it).
     Texture(Device& device, const TextureDesc& desc, const std::vector<float>& texels);
 
     const TextureDesc& desc() const { return desc_; }

@@ -55,6 +55,8 @@ TEST(Layout, DeviceAndHostAgreeOnEveryClStruct)
         {"offsetof(ClTriangle, attr_over_w)", offsetof(ClTriangle, attr_over_w)},
         {"sizeof(ClTexture)", sizeof(ClTexture)},
         {"offsetof(ClTexture, border)", offsetof(ClTexture, border)},
+        {"offsetof(ClTriangle, col_min)", offsetof(ClTriangle, col_min)},
+        {"offsetof(ClTriangle, row_max)", offsetof(ClTriangle, row_max)},
     };
     for (std::size_t i = 0; i < std::size(want); ++i)
         EXPECT_EQ(got[i], want[i].second) << want[i].first << ": device " << got[i] << ", host " << want[i].second;

@@ -329,14 +329,14 @@ TEST(PixelTransfer, BadInputsThrow)
 {
     clvr::Device& device = clvr::test::device();
     Framebuffer fb(device, 5, 4);
-    EXPECT_THROW(clvr::raster::accumulate(device, fb, AccumOp::Load, 1.0f), clvr::DeviceError) << "no accum buffer";
-    EXPECT_THROW(clvr::raster::drawPixels(device, fb, Image4f(), {0, 0}, PixelTransfer{}), clvr::InputError);
+    EXPECT_THROW(clvr::raster::accumulate(device, fb, AccumOp::Load, 1.0f), clvr::InternalError) << "no accum buffer";
+    EXPECT_THROW(clvr::raster::drawPixels(device, fb, Image4f(), {0, 0}, PixelTransfer{}), clvr::InternalError);
     PixelTransfer huge;
     huge.lookup = std::array<std::vector<float>, 4>{};
     (*huge.lookup)[2].resize((std::size_t(1) << 20) + 1);
     EXPECT_THROW(clvr::raster::applyPixelTransfer(device, fb, huge), clvr::InputError);
     Framebuffer withAccum(device, 5, 4, true);
-    EXPECT_THROW(clvr::raster::accumulate(device, withAccum, static_cast<AccumOp>(9), 1.0f), clvr::InputError);
+    EXPECT_THROW(clvr::raster::accumulate(device, withAccum, static_cast<AccumOp>(9), 1.0f), clvr::InternalError);
 }
 
 }  // namespace

@@ -592,7 +592,7 @@ TEST(RasterScissor, VisitsOnlyTheRectangleWithUnchangedValues)
     EXPECT_LT(some.fragments, all.fragments);
     EXPECT_EQ(some.fragments, inside);
     s.scissor = {true, 0, 0, -1, 4};
-    EXPECT_THROW(raster::draw(device, part, s, raster::Topology::Triangles, tri), clvr::InputError);
+    EXPECT_THROW(raster::draw(device, part, s, raster::Topology::Triangles, tri), clvr::InternalError);
     device.takePassTimes();
 }
 
@@ -798,6 +798,241 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
             const int i = int(4 * (y + 0.5) / h) * 4 + int(4 * (x + 0.5) / w);
             ASSERT_EQ(image.at(x, y), glm::vec4(float(i))) << x << "," << y;
         }
+    device.takePassTimes();
+}
+
+// A fragment program whose color is uniform 0 plus attribute 0 times uniform 1: draws that differ only
+// in uniforms are different passes, and a wrong uniform base shows in the color.
+raster::FragmentProgram uniformProgram(Rng& rng)
+{
+    raster::FragmentProgram p;
+    p.source = R"(
+int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* color)
+{
+    *color = r->uniforms[0] + f->attr[0] * r->uniforms[1];
+    return 1;
+}
+)";
+    p.uniforms = {randomVec4(rng, -0.5, 0.5), randomVec4(rng, 0.5, 1.5)};
+    return p;
+}
+
+struct RandomDraw {
+    raster::DrawState state;
+    raster::Topology topology;
+    std::vector<raster::Vertex> vertices;
+    raster::FragmentProgram program;
+};
+
+// Random draws as RasterConformance makes them, plus scissors, a second fragment program with
+// per-draw uniforms, and runs of draws that repeat the previous state (one pass in a batch).
+std::vector<RandomDraw> randomDraws(Rng& rng, int count, int width, int height)
+{
+    std::vector<RandomDraw> draws;
+    const raster::FragmentProgram textured = uniformProgram(rng);
+    for (int d = 0; d < count; ++d) {
+        RandomDraw r;
+        if (!draws.empty() && rng.integer(0, 2) == 0) {  // same state and program as the previous draw
+            r.state = draws.back().state;
+            r.program = draws.back().program;
+        } else {
+            r.state.fragment = randomState(rng);
+            for (int p = rng.integer(0, 2); p > 0; --p)
+                r.state.clipPlanes.push_back(glm::vec4(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-0.3, 0.3)));
+            if (rng.integer(0, 2) == 0)
+                r.state.viewport = {rng.integer(-8, 8), rng.integer(-8, 8), rng.integer(10, width), rng.integer(10, height),
+                                    float(rng.uniform(0, 0.3)), float(rng.uniform(0.6, 1.0))};
+            if (rng.integer(0, 3) == 0)
+                r.state.scissor = {true, rng.integer(-4, width / 2), rng.integer(-4, height / 2), rng.integer(0, width),
+                                   rng.integer(0, height)};
+            if (rng.integer(0, 1) == 0) {
+                r.program = textured;
+                r.program.uniforms[1] = randomVec4(rng, 0.5, 1.5);
+            }
+        }
+        r.topology = static_cast<raster::Topology>(rng.integer(0, 2));
+        r.vertices = randomVertices(rng, rng.integer(3, 30));
+        draws.push_back(std::move(r));
+    }
+    return draws;
+}
+
+TEST(RasterBatch, SameBitsAsTheDrawsOneByOneAndMatchesReference)
+{
+    clvr::Device& device = clvr::test::device();
+    Rng rng(77);
+    const int sizes[][2] = {{37, 23}, {61, 45}};
+    std::size_t passes = 0;
+    for (int round = 0; round < 6; ++round) {
+        SCOPED_TRACE("round " + std::to_string(round));
+        const int width = sizes[round % 2][0], height = sizes[round % 2][1];
+        const Scene scene = randomScene(rng, width, height);
+        const std::vector<RandomDraw> draws = randomDraws(rng, 24, width, height);
+        raster::Framebuffer single(device, width, height), batched(device, width, height);
+        load(device, single, scene);
+        load(device, batched, scene);
+        raster::DrawStats one;
+        for (const RandomDraw& d : draws) {
+            const raster::DrawStats s = raster::draw(device, single, d.state, d.topology, d.vertices, d.program);
+            one.triangles += s.triangles;
+            one.fragments += s.fragments;
+        }
+        device.takePassTimes();  // from here on, only the batch's launches
+        raster::Rasterizer rasterizer(device);
+        raster::DrawBatch batch(rasterizer, batched);
+        for (const RandomDraw& d : draws)
+            batch.add(d.state, d.topology, d.vertices, d.program);
+        EXPECT_EQ(batch.pendingDraws(), draws.size());
+        batch.flush();
+        EXPECT_EQ(batch.pendingDraws(), 0u);
+        expectIdentical(device, single, batched);
+        const raster::DrawStats all = rasterizer.takeStats();
+        EXPECT_EQ(all.triangles, one.triangles);
+        EXPECT_EQ(all.fragments, one.fragments);
+        EXPECT_GT(all.fragments, 0u);
+        const raster::DrawStats none = rasterizer.takeStats();
+        EXPECT_EQ(none.triangles + none.fragments, 0u) << "takeStats() starts counting again";
+        for (const auto& pass : device.takePassTimes())
+            passes += pass.name == "raster: fragments";
+
+        // The CPU reference, draw by draw, with RasterConformance's tolerances and tie rule.
+        ref::Planes want = load(scene);
+        TieFinder ties(std::size_t(width) * height);
+        for (const RandomDraw& d : draws) {
+            markTies(ties, want, d.state, d.topology, d.vertices);
+            // The reference has no scissor test; a pixel outside it changes nothing, as a discarded fragment.
+            const raster::Scissor& sc = d.state.scissor;
+            const bool programmed = !d.program.source.empty();
+            const glm::dvec4 u0 = programmed ? glm::dvec4(d.program.uniforms[0]) : glm::dvec4(0.0);
+            const glm::dvec4 u1 = programmed ? glm::dvec4(d.program.uniforms[1]) : glm::dvec4(1.0);
+            ref::draw(want, d.state, d.topology, d.vertices, [&](const ref::Fragment& f, glm::dvec4& color) {
+                const double x = f.window.x, y = f.window.y;
+                if (sc.test && !(x >= sc.x && x < sc.x + sc.width && y >= sc.y && y < sc.y + sc.height))
+                    return false;
+                color = programmed ? u0 + f.attributes[0] * u1 : f.attributes[0];
+                return true;
+            });
+        }
+        EXPECT_TRUE(planesNear(batched, device, want, ties.ties));
+    }
+    // Runs of equal state share a pass, state changes start one: fewer launches than draws, more than rounds.
+    EXPECT_LT(passes, 6u * 24u);
+    EXPECT_GT(passes, 6u * 2u);
+}
+
+// A full-screen quad drawn four times in one batch, each with other state: the result is only right if
+// every state applies to its own draw, in order.
+TEST(RasterBatch, StateChangesTakeEffectInOrder)
+{
+    clvr::Device& device = clvr::test::device();
+    const int w = 29, h = 17;
+    auto quad = [&](glm::vec4 color, float z) {
+        std::vector<raster::Vertex> v;
+        for (glm::vec2 p : {glm::vec2(-1, -1), glm::vec2(1, -1), glm::vec2(1, 1), glm::vec2(-1, -1), glm::vec2(1, 1), glm::vec2(-1, 1)}) {
+            raster::Vertex x;
+            x.position = glm::vec4(p, z, 1.0f);
+            x.attributes[0] = color;
+            v.push_back(x);
+        }
+        return v;
+    };
+    raster::DrawState replace;                    // 1: color := (0.5, 0, 0, 1), depth := 0.5, stencil := 1 on the left
+    replace.fragment.depth.test = true;
+    replace.fragment.depth.func = raster::CompareFunc::Always;
+    replace.fragment.stencil.test = true;
+    replace.fragment.stencil.ref = 1;
+    replace.fragment.stencil.dppass = raster::StencilOp::Replace;
+    replace.scissor = {true, 0, 0, 10, h};
+    raster::DrawState additive = additiveOnes();  // 2: + (0.25, 0.125, 0, 0) where stencil == 1
+    additive.fragment.stencil.test = true;
+    additive.fragment.stencil.func = raster::CompareFunc::Equal;
+    additive.fragment.stencil.ref = 1;
+    raster::DrawState greenOnly;                  // 3: only green := 1, only in front of depth 0.5
+    greenOnly.fragment.colorMask = {false, true, false, false};
+    greenOnly.fragment.depth.test = true;
+    greenOnly.fragment.depth.func = raster::CompareFunc::Less;
+    raster::FragmentProgram blue;                 // 4: another program: blue := uniform, left of column 5
+    blue.source = R"(
+int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* color)
+{
+    *color = (float4)(0.0f, 0.0f, r->uniforms[0].z, 0.0f);
+    return f->window.x < 5.0f;
+}
+)";
+    blue.uniforms = {glm::vec4(0.0f, 0.0f, 0.75f, 0.0f)};
+    raster::DrawState maxBlend;
+    maxBlend.fragment.blend.enabled = true;
+    maxBlend.fragment.blend.rgbEquation = maxBlend.fragment.blend.alphaEquation = raster::BlendEquation::Max;
+
+    raster::Framebuffer fb(device, w, h);
+    fb.clearColor(device, glm::vec4(0.0f));
+    fb.clearDepth(device, 1.0f);
+    fb.clearStencil(device, 0);
+    raster::Rasterizer rasterizer(device);
+    raster::DrawBatch batch(rasterizer, fb);
+    batch.add(replace, raster::Topology::Triangles, quad({0.5f, 0.0f, 0.0f, 1.0f}, 0.0f));
+    batch.add(additive, raster::Topology::Triangles, quad({0.25f, 0.125f, 0.0f, 0.0f}, 0.0f));
+    batch.add(greenOnly, raster::Topology::Triangles, quad({9.0f, 1.0f, 9.0f, 9.0f}, -0.5f));
+    batch.add(maxBlend, raster::Topology::Triangles, quad({}, 0.0f), blue);
+    batch.flush();
+    const clvr::Image4f image = fb.readColor(device);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const bool left = x < 10;
+            const glm::vec4 want(left ? 0.75f : 0.0f, left ? 1.0f : 1.0f, x < 5 ? 0.75f : 0.0f, left ? 1.0f : 0.0f);
+            ASSERT_EQ(image.at(x, y), want) << x << "," << y;
+        }
+    const raster::DrawStats stats = rasterizer.takeStats();
+    EXPECT_EQ(stats.triangles, 8u);
+    EXPECT_EQ(stats.fragments, std::uint64_t(10 * h + 3 * w * h)) << "covered pixels, before any test or discard";
+    device.takePassTimes();
+}
+
+TEST(RasterRasterizer, BuildsEachFragmentProgramOnceAndRebuildsAChangedOne)
+{
+    clvr::Device& device = clvr::test::device();
+    raster::Framebuffer fb(device, 16, 16);
+    std::vector<raster::Vertex> tri = {windowVertex(0, 0, 16, 16), windowVertex(64, 0, 16, 16), windowVertex(0, 64, 16, 16)};
+    raster::FragmentProgram program;
+    program.source = "int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* color)\n"
+                     "{ *color = (float4)(1.0f, 0.0f, 0.0f, 1.0f); return 1; }\n";
+    raster::Rasterizer rasterizer(device);
+    rasterizer.draw(fb, raster::DrawState{}, raster::Topology::Triangles, tri, program);
+    ASSERT_TRUE(program.compiled);
+    const auto* first = program.compiled.get();
+    const raster::FragmentProgram copy = program;
+    rasterizer.draw(fb, raster::DrawState{}, raster::Topology::Triangles, tri, copy);
+    EXPECT_EQ(program.compiled.get(), first);
+    EXPECT_EQ(copy.compiled.get(), first) << "a copy shares the built kernel";
+    EXPECT_EQ(fb.readColor(device).at(3, 3), glm::vec4(1.0f, 0.0f, 0.0f, 1.0f));
+
+    program.source = "int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* color)\n"
+                     "{ *color = (float4)(0.0f, 1.0f, 0.0f, 1.0f); return 1; } /* green */\n";
+    rasterizer.draw(fb, raster::DrawState{}, raster::Topology::Triangles, tri, program);
+    EXPECT_NE(program.compiled.get(), first);
+    EXPECT_EQ(fb.readColor(device).at(3, 3), glm::vec4(0.0f, 1.0f, 0.0f, 1.0f)) << "a source of another length is rebuilt";
+    device.takePassTimes();
+}
+
+TEST(RasterRasterizer, StateOutOfRangeIsAnInternalError)
+{
+    clvr::Device& device = clvr::test::device();
+    raster::Framebuffer fb(device, 8, 8);
+    const std::vector<raster::Vertex> tri = {windowVertex(0, 0, 8, 8), windowVertex(8, 0, 8, 8), windowVertex(0, 8, 8, 8)};
+    raster::Rasterizer rasterizer(device);
+    raster::DrawState planes;
+    planes.clipPlanes.assign(raster::kMaxClipPlanes + 1, glm::vec4(0, 0, 0, 1));
+    EXPECT_THROW(rasterizer.draw(fb, planes, raster::Topology::Triangles, tri), clvr::InternalError);
+    raster::FragmentProgram uniforms;
+    uniforms.uniforms.resize(raster::kMaxUniforms + 1);
+    EXPECT_THROW(rasterizer.draw(fb, raster::DrawState{}, raster::Topology::Triangles, tri, uniforms), clvr::InternalError);
+    raster::DrawState empty;
+    empty.viewport.width = 0;
+    EXPECT_THROW(rasterizer.draw(fb, empty, raster::Topology::Triangles, tri), clvr::InternalError);
+    raster::DrawBatch batch(rasterizer, fb);
+    EXPECT_THROW(batch.add(empty, raster::Topology::Triangles, tri), clvr::InternalError);
+    EXPECT_THROW(raster::assembleTriangles(static_cast<raster::Topology>(7), 3), clvr::InternalError);
+    EXPECT_EQ(rasterizer.takeStats().triangles, 0u) << "nothing was drawn";
     device.takePassTimes();
 }
 

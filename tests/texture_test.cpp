@@ -248,17 +248,17 @@ TEST(Texture, ClampToBorderBlendsTowardsTheBorderInTheOuterHalfTexel)
         EXPECT_EQ(got[i], glm::vec4(want[i])) << "u = " << coords[i].x;
 }
 
-TEST(Texture, BadShapesAreInputErrors)
+TEST(Texture, BadSizesAreInputErrorsBadDescriptionsInternalErrors)
 {
     clvr::Device& device = clvr::test::device();
     EXPECT_THROW(Texture(device, TextureDesc{0, 1, 1, 1}, {}), clvr::InputError);
     EXPECT_THROW(Texture(device, TextureDesc{4, 0, 1, 1}, {}), clvr::InputError);
-    EXPECT_THROW(Texture(device, TextureDesc{4, 1, 1, 3}, std::vector<float>(12)), clvr::InputError);
-    EXPECT_THROW(Texture(device, TextureDesc{4, 2, 1, 4}, std::vector<float>(31)), clvr::InputError);
-    EXPECT_THROW(Texture(device, TextureDesc{4, 2, 1, 1}, std::vector<float>(9)), clvr::InputError);
+    EXPECT_THROW(Texture(device, TextureDesc{4, 1, 1, 3}, std::vector<float>(12)), clvr::InternalError);
+    EXPECT_THROW(Texture(device, TextureDesc{4, 2, 1, 4}, std::vector<float>(31)), clvr::InternalError);
+    EXPECT_THROW(Texture(device, TextureDesc{4, 2, 1, 1}, std::vector<float>(9)), clvr::InternalError);
     TextureDesc bad{2, 1, 1, 1};
     bad.filter = static_cast<Filter>(7);
-    EXPECT_THROW(Texture(device, bad, std::vector<float>(2)), clvr::InputError);
+    EXPECT_THROW(Texture(device, bad, std::vector<float>(2)), clvr::InternalError);
     const Texture ok(device, TextureDesc{3, 2, 2, 4}, std::vector<float>(48));
     EXPECT_EQ(ok.bytes(), 48u * sizeof(float));
     EXPECT_EQ(ok.toCl().depth, 2u);

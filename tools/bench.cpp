@@ -15,6 +15,7 @@
 #include "host/session.h"
 #include "host/io/volume_io.h"
 #include "tools/bench_mesh.h"
+#include "tools/bench_raster.h"
 #include "tools/ceiling.h"
 
 #if __has_include("raster/rasterizer.h")
@@ -442,6 +443,8 @@ nlohmann::json rasterBench(Device& device)
 
 int bench(const BenchOptions& options)
 {
+    if (options.suite == "raster" && options.scenes.empty())
+        return benchRaster(options);
     std::vector<fs::path> scenes(options.scenes.begin(), options.scenes.end());
     if (scenes.empty())
         for (const std::string& name : benchSuiteScenes(options.suite))

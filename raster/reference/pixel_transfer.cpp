@@ -109,7 +109,7 @@ Image4d pixelTexture(const Image4f& color, const TextureData& texture3d)
 void accumulate(Image4d& color, Image4d& accum, AccumOp op, double value)
 {
     if (color.pixelCount() != accum.pixelCount())
-        throw InputError("accumulate: color and accumulation planes differ in size");
+        throw InternalError("accumulate: color and accumulation planes differ in size");
     for (std::size_t i = 0; i < color.pixelCount(); ++i) {
         glm::dvec4& c = color.pixels()[i];
         glm::dvec4& a = accum.pixels()[i];

@@ -64,7 +64,7 @@ glm::dvec4 sampleTexture(const TextureDesc& desc, const std::vector<float>& texe
 {
     validate(desc, texels.size());
     if (dimensions < 1 || dimensions > 3)
-        throw InputError("texture dimensions " + std::to_string(dimensions) + " is not 1, 2 or 3");
+        throw InternalError("texture dimensions " + std::to_string(dimensions) + " is not 1, 2 or 3");
     const Sampler s{desc, texels};
     const int ny = dimensions >= 2 ? desc.height : 1;  // an unused axis samples row/slice 0
     const int nz = dimensions >= 3 ? desc.depth : 1;

@@ -62,6 +62,8 @@ private:
     std::unique_ptr<raster::Framebuffer> framebuffer_;
     raster::FragmentProgram fragmentProgram_;
     ClSlice3dUniforms fragmentUniforms_{};
+    raster::Rasterizer rasterizer_{device_};      // slice polygons: its stats are the frame's samples
+    raster::Rasterizer clipRasterizer_{device_};  // the clip mesh's stencil passes, not counted
     cl::Kernel overBackground_;
     // Clipping (raster path): the closed mesh and its farthest eye depth.
     std::optional<ClipMesh> clipMesh_;
@@ -339,8 +341,10 @@ Image4f Slice3dRenderer::renderRaster(FrameStats& stats)
     raster::DrawStats drawStats;
     if (clipMesh_)
         drawStats = drawClipped(vertices, firsts, state, viewProjection);
-    else if (!vertices.empty())
-        drawStats = raster::draw(device_, *framebuffer_, state, raster::Topology::Triangles, vertices, fragmentProgram_);
+    else if (!vertices.empty()) {
+        rasterizer_.draw(*framebuffer_, state, raster::Topology::Triangles, vertices, fragmentProgram_);
+        drawStats = rasterizer_.takeStats();
+    }
     const std::size_t pixels = framebuffer_->pixelCount();
     overBackground_.setArg(0, framebuffer_->color());
     overBackground_.setArg(1, static_cast<cl_int>(pixels));
@@ -404,7 +408,6 @@ raster::DrawStats Slice3dRenderer::drawClipped(const std::vector<raster::Vertex>
     slice.fragment.stencil.func = raster::CompareFunc::Equal;
     slice.fragment.stencil.ref = inverse ? 0 : 1;
 
-    raster::DrawStats total;
     const glm::dmat4 planeToClip = glm::transpose(glm::inverse(viewProjection));
     for (int i = 0; i < plan_.count; ++i) {
         if (firsts[i] == firsts[i + 1])
@@ -427,16 +430,14 @@ raster::DrawStats Slice3dRenderer::drawClipped(const std::vector<raster::Vertex>
             // Keep dot(forward, p) >= offset: the part of the mesh behind the slice plane. As
             // raster::clipPlaneFromWorld, but in double (offset may be large next to the box).
             back.clipPlanes = front.clipPlanes = {glm::vec4(planeToClip * glm::dvec4(camera_.forward(), -offset))};
-            raster::draw(device_, *framebuffer_, back, raster::Topology::Triangles, mesh);
+            clipRasterizer_.draw(*framebuffer_, back, raster::Topology::Triangles, mesh);
             if (twoPass)
-                raster::draw(device_, *framebuffer_, front, raster::Topology::Triangles, mesh);
+                clipRasterizer_.draw(*framebuffer_, front, raster::Topology::Triangles, mesh);
         }
-        const raster::DrawStats d =
-            raster::draw(device_, *framebuffer_, sliceHere, raster::Topology::Triangles, polygon, fragmentProgram_);
-        total.triangles += d.triangles;
-        total.fragments += d.fragments;
+        rasterizer_.draw(*framebuffer_, sliceHere, raster::Topology::Triangles, polygon, fragmentProgram_);
     }
-    return total;
+    clipRasterizer_.takeStats();  // resets its counters
+    return rasterizer_.takeStats();
 }
 
 }  // namespace
