@@ -108,7 +108,7 @@ Frame Session::render()
     if (frame.stats.passes.empty())
         frame.stats.passes = device_->takePassTimes();
     if (frame.image.width() != scene_.image.width || frame.image.height() != scene_.image.height)
-        throw DeviceError("the renderer returned a " + std::to_string(frame.image.width()) + "x" +
+        throw InternalError("the renderer returned a " + std::to_string(frame.image.width()) + "x" +
                           std::to_string(frame.image.height()) + " image for a " +
                           std::to_string(scene_.image.width) + "x" + std::to_string(scene_.image.height) +
                           " scene");

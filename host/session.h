@@ -59,7 +59,7 @@ public:
     Session(const Session&) = delete;
     Session& operator=(const Session&) = delete;
 
-    // Renders one frame with the current camera. Blocks until done. DeviceError if the renderer returns an
+    // Renders one frame with the current camera. Blocks until done. InternalError if the renderer returns an
     // image of another size than the scene's.
     Frame render();
     // The camera of the following frames (validated: InputError); recreates the renderer (see above).

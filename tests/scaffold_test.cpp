@@ -88,16 +88,17 @@ TEST(Scaffold, ReadImageAndSumCountsReturnWhatTheDeviceHolds)
     EXPECT_EQ(sumCounts(device, counters, counts.size()), expectedSum);
 }
 
-TEST(Scaffold, FinishFrameAppendsPassTimesAfterTheRenderersOwn)
+TEST(Scaffold, FinishFramePutsTheHostPassesFirstAndReplacesAnEarlierFramesPasses)
 {
     Device& device = test::device();
     device.takePassTimes();  // what earlier tests left
     FrameStats stats;
-    stats.passes.push_back({"host pass", 1.5});
+    stats.passes.push_back({"an earlier frame's pass", 9.0});
     const FrameClock clock;
-    finishFrame(device, clock, stats);
-    ASSERT_GE(stats.passes.size(), 1u);
+    finishFrame(device, clock, stats, {{"host pass", 1.5}});
+    ASSERT_EQ(stats.passes.size(), 1u);  // no device launch since takePassTimes
     EXPECT_EQ(stats.passes.front().name, "host pass");
+    EXPECT_EQ(stats.passes.front().ms, 1.5);
     EXPECT_GE(stats.frameMs, 0.0);
     EXPECT_TRUE(device.takePassTimes().empty());
 }

@@ -11,6 +11,7 @@
 #include "host/io/image_io.h"
 #include "host/reference/reference_integral.h"
 #include "host/render/renderer.h"
+#include "host/render/grid/slice3d.h"
 #include "host/render/grid/stack2d.h"
 #include "tests/support/clip_reference.h"
 #include "tests/support/test_util.h"
@@ -283,6 +284,8 @@ TEST(Stack2dClip, MovingTheClipBetweenFramesGivesTheImageOfANewRenderer)
     }
     auto unclipped = makeRenderer(test::device(), makeScene(perspectiveCamera(), json(), 1), marschnerLobb41());
     EXPECT_THROW(setStack2dClipPlacement(*unclipped, offset), InputError);
+    // Asking a stack2d renderer for slice3d's placement is a programming error, not bad input.
+    EXPECT_THROW(setSlice3dClipPlacement(*unclipped, offset), InternalError);
 }
 
 // Iso-surfaces: a clipped sample is no hit. The surface 0.5 of "sphere" (1 - |p|) is the sphere of

@@ -220,7 +220,7 @@ TetTopology buildTopology(const TetMesh& mesh)
         const glm::uvec4 c = mesh.tets[t];
         for (std::uint32_t f = 0; f < 4; ++f) {
             if (c[f] >= n || c[(f + 1) % 4] >= n || c[(f + 2) % 4] >= n || c[(f + 3) % 4] >= n)
-                throw InputError(cellName(mesh, t) + " has a point index out of range (call checkMesh first)");
+                throw InternalError(cellName(mesh, t) + " has a point index out of range (call checkMesh first)");
             std::uint32_t v[3] = {weld[c[(f + 1) % 4]], weld[c[(f + 2) % 4]], weld[c[(f + 3) % 4]]};
             if (v[0] > v[1])
                 std::swap(v[0], v[1]);

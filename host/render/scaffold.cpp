@@ -45,8 +45,9 @@ std::uint64_t sumCounts(Device& device, const cl::Buffer& buffer, std::size_t co
     return std::accumulate(counts.begin(), counts.end(), std::uint64_t(0));
 }
 
-void finishFrame(Device& device, const FrameClock& clock, FrameStats& stats)
+void finishFrame(Device& device, const FrameClock& clock, FrameStats& stats, std::vector<PassTime> hostPasses)
 {
+    stats.passes = std::move(hostPasses);
     for (PassTime& t : device.takePassTimes())
         stats.passes.push_back(std::move(t));
     stats.frameMs = clock.ms();

@@ -17,6 +17,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string_view>
+#include <vector>
 
 namespace clvr {
 
@@ -49,8 +50,8 @@ Image4f readImage(Device& device, const cl::Buffer& buffer, int width, int heigh
 // The sum of `count` 32-bit per-pixel counters in `buffer` (samples taken, steps, ...), read back blocking.
 std::uint64_t sumCounts(Device& device, const cl::Buffer& buffer, std::size_t count);
 
-// Ends a frame's bookkeeping: the device's pass times since the last frame appended to stats.passes and
-// the frame's wall time in stats.frameMs.
-void finishFrame(Device& device, const FrameClock& clock, FrameStats& stats);
+// Ends a frame's bookkeeping: stats.passes becomes `hostPasses` (timed by the renderer itself, e.g. host
+// stages) followed by the device's pass times since the last frame, and stats.frameMs the frame's wall time.
+void finishFrame(Device& device, const FrameClock& clock, FrameStats& stats, std::vector<PassTime> hostPasses = {});
 
 }  // namespace clvr

@@ -2,6 +2,7 @@
 // (kernels/blend.cl: blend_render).
 #include "host/render/grid/blend.h"
 
+#include "host/render/scaffold.h"
 #include "host/runtime/errors.h"
 #include "host/render/camera_args.h"
 #include "host/render/options_util.h"
@@ -11,9 +12,7 @@
 #include "host/render/transfer_function_upload.h"
 #include "kernels/blend_params.h"
 
-#include <chrono>
 #include <cmath>
-#include <numeric>
 
 namespace clvr {
 namespace {
@@ -44,16 +43,11 @@ private:
 BlendRenderer::BlendRenderer(Device& device, const Scene& scene, const Volume& volume)
     : device_(device), options_(parseBlendOptions(scene.options)), image_(scene.image), lighting_(scene.lighting)
 {
-    volume.validate();
-    if (volume.voxelCount() > 0xffffffffull)
-        throw InputError(volume.source + ": blend takes at most 2^32 - 1 grid points (32-bit voxel indices)");
+    checkGridVolume(volume, "blend");
     dims_ = volume.dims;
     origin_ = volume.origin;
     spacing_ = volume.spacing;
-    camera_ = scene.camera ? *scene.camera : fitCamera(volume.boundsMin(), volume.boundsMax());
-    camera_.validate();
-    if (image_.width < 1 || image_.height < 1)
-        throw InputError("image: width and height must be >= 1");
+    camera_ = frameCamera(scene, volume.boundsMin(), volume.boundsMax());
     // the same slab planning as slice3d
     plan_ = planSlices(camera_, volume.boundsMin(), volume.boundsMax(), options_.slices, options_.sliceSpacing);
 
@@ -78,7 +72,7 @@ void BlendRenderer::setTransferFunction(const TransferFunction& tf)
 
 Image4f BlendRenderer::render(FrameStats& stats)
 {
-    const auto start = std::chrono::steady_clock::now();
+    const FrameClock clock;
     ClBlendParams params{};
     params.camera = toClCamera(camera_, image_.width, image_.height);
     params.dims = cl_int4{{dims_.x, dims_.y, dims_.z, 0}};
@@ -106,14 +100,10 @@ Image4f BlendRenderer::render(FrameStats& stats)
     device_.launch("blend: shade slices, blend back to front", kernel_, image_.width, image_.height);
 
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
-    Image4f image(image_.width, image_.height);
-    device_.queue().enqueueReadBuffer(out_, CL_TRUE, 0, pixels * sizeof(glm::vec4), image.pixels().data());
-    const std::vector<cl_uint> counts = device_.download<cl_uint>(samples_, pixels);
-    const std::vector<cl_uint> skipped = device_.download<cl_uint>(skipped_, pixels);
-    stats.passes = device_.takePassTimes();
-    stats.frameMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    stats.samples = std::accumulate(counts.begin(), counts.end(), std::uint64_t(0));
-    const std::uint64_t below = std::accumulate(skipped.begin(), skipped.end(), std::uint64_t(0));
+    Image4f image = readImage(device_, out_, image_.width, image_.height);
+    stats.samples = sumCounts(device_, samples_, pixels);
+    const std::uint64_t below = sumCounts(device_, skipped_, pixels);
+    finishFrame(device_, clock, stats);
     stats.extra["samples_shaded"] = stats.samples - below;
     stats.extra["samples_below_threshold"] = below;
     stats.extra["slices"] = plan_.count;

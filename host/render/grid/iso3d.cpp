@@ -3,6 +3,7 @@
 // program under the alpha and depth tests, the color-matrix copy, and kernels/iso3d.cl: iso3d_finish.
 #include "host/render/grid/iso3d.h"
 
+#include "host/render/scaffold.h"
 #include "host/runtime/embedded_kernels.h"
 #include "host/runtime/errors.h"
 #include "host/render/options_util.h"
@@ -74,16 +75,11 @@ Iso3dRendererImpl::Iso3dRendererImpl(Device& device, const Scene& scene, const V
 {
     if (!scene.iso)
         throw InputError("iso: technique iso3d needs \"iso\": {\"value\": ...}, and the scene has none");
-    volume.validate();
-    if (volume.voxelCount() > 0xffffffffull)
-        throw InputError(volume.source + ": iso3d takes at most 2^32 - 1 grid points (32-bit voxel indices)");
+    checkGridVolume(volume, "iso3d");
     lo_ = volume.boundsMin();
     hi_ = volume.boundsMax();
-    camera_ = scene.camera ? *scene.camera : fitCamera(lo_, hi_);
-    camera_.validate();
+    camera_ = frameCamera(scene, lo_, hi_);
     iso_ = isoSurface(scene, camera_);
-    if (image_.width < 1 || image_.height < 1)
-        throw InputError("image: width and height must be >= 1");
     plan_ = planSlices(camera_, lo_, hi_, options_.slices, options_.sliceSpacing);
 
     origin_ = volume.origin;
@@ -196,7 +192,7 @@ void Iso3dRendererImpl::setTransferFunction(const TransferFunction& tf)
 
 Image4f Iso3dRendererImpl::render(FrameStats& stats)
 {
-    const auto start = std::chrono::steady_clock::now();
+    const FrameClock clock;
     // The slice polygons, nearest first, fanned into one triangle list; as slice3d's raster path.
     const glm::dvec3 forward = camera_.forward();
     nearZ_ = 0.5 * plan_.depth(0);
@@ -338,8 +334,7 @@ Image4f Iso3dRendererImpl::render(FrameStats& stats)
     device_.launch("iso3d: finish", finish_, pixels);
     Image4f image = framebuffer_->readColor(device_);
 
-    stats.passes = device_.takePassTimes();
-    stats.frameMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    finishFrame(device_, clock, stats);
     stats.samples = drawStats.fragments;
     stats.extra["slices"] = plan_.count;
     stats.extra["slice_spacing"] = plan_.deltaS;

@@ -2,6 +2,7 @@
 // and the one launch of the planes technique (kernels/planes.cl: planes_render).
 #include "host/render/grid/planes.h"
 
+#include "host/render/scaffold.h"
 #include "host/runtime/errors.h"
 #include "host/render/camera_args.h"
 #include "host/render/options_util.h"
@@ -48,18 +49,13 @@ PlanesRenderer::PlanesRenderer(Device& device, const Scene& scene, const Volume&
     : device_(device), options_(parsePlanesOptions(scene.options)), image_(scene.image),
       lighting_(scene.lighting)
 {
-    volume.validate();
-    if (volume.voxelCount() > 0xffffffffull)
-        throw InputError(volume.source + ": planes takes at most 2^32 - 1 grid points (32-bit voxel indices)");
+    checkGridVolume(volume, "planes");
     dims_ = volume.dims;
     origin_ = volume.origin;
     spacing_ = volume.spacing;
     lo_ = volume.boundsMin();
     hi_ = volume.boundsMax();
-    camera_ = scene.camera ? *scene.camera : fitCamera(lo_, hi_);
-    camera_.validate();
-    if (image_.width < 1 || image_.height < 1)
-        throw InputError("image: width and height must be >= 1");
+    camera_ = frameCamera(scene, lo_, hi_);
     if (options_.sampleSpacing == 0.0)
         options_.sampleSpacing = 0.5 * std::min({spacing_.x, spacing_.y, spacing_.z});
     if (glm::length(hi_ - lo_) / options_.sampleSpacing > kMaxSamplesPerRay)
@@ -98,7 +94,7 @@ void PlanesRenderer::setTransferFunction(const TransferFunction& tf)
 
 Image4f PlanesRenderer::render(FrameStats& stats)
 {
-    const auto start = std::chrono::steady_clock::now();
+    const FrameClock clock;
     ClPlanesParams params{};
     params.camera = toClCamera(camera_, image_.width, image_.height);
     params.dims = cl_int4{{dims_.x, dims_.y, dims_.z, 0}};
@@ -128,15 +124,11 @@ Image4f PlanesRenderer::render(FrameStats& stats)
     device_.launch("planes: cast, shade, composite", kernel_, image_.width, image_.height);
 
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
-    Image4f image(image_.width, image_.height);
-    device_.queue().enqueueReadBuffer(out_, CL_TRUE, 0, pixels * sizeof(glm::vec4), image.pixels().data());
-    const std::vector<cl_uint> counts = device_.download<cl_uint>(samples_, pixels);
-    const std::vector<cl_uint> skipped = device_.download<cl_uint>(skipped_, pixels);
+    Image4f image = readImage(device_, out_, image_.width, image_.height);
+    stats.samples = sumCounts(device_, samples_, pixels);
+    const std::uint64_t below = sumCounts(device_, skipped_, pixels);
     const std::vector<cl_uchar> stopped = device_.download<cl_uchar>(terminated_, pixels);
-    stats.passes = device_.takePassTimes();
-    stats.frameMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    stats.samples = std::accumulate(counts.begin(), counts.end(), std::uint64_t(0));
-    const std::uint64_t below = std::accumulate(skipped.begin(), skipped.end(), std::uint64_t(0));
+    finishFrame(device_, clock, stats);
     stats.extra["samples_shaded"] = stats.samples - below;
     stats.extra["samples_below_threshold"] = below;
     stats.extra["rays_terminated"] = std::accumulate(stopped.begin(), stopped.end(), std::uint64_t(0));

@@ -3,6 +3,7 @@
 // path through raster::draw with kernels/slice3d.cl as fragment program.
 #include "host/render/grid/slice3d.h"
 
+#include "host/render/scaffold.h"
 #include "host/runtime/embedded_kernels.h"
 #include "host/runtime/errors.h"
 #include "host/render/camera_args.h"
@@ -18,7 +19,6 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <numeric>
 
 namespace clvr {
 namespace {
@@ -77,18 +77,13 @@ private:
 Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volume& volume)
     : device_(device), options_(parseSlice3dOptions(scene.options)), image_(scene.image)
 {
-    volume.validate();
-    if (volume.voxelCount() > 0xffffffffull)
-        throw InputError(volume.source + ": slice3d takes at most 2^32 - 1 grid points (32-bit voxel indices)");
+    checkGridVolume(volume, "slice3d");
     dims_ = volume.dims;
     origin_ = volume.origin;
     spacing_ = volume.spacing;
     lo_ = volume.boundsMin();
     hi_ = volume.boundsMax();
-    camera_ = scene.camera ? *scene.camera : fitCamera(lo_, hi_);
-    camera_.validate();
-    if (image_.width < 1 || image_.height < 1)
-        throw InputError("image: width and height must be >= 1");
+    camera_ = frameCamera(scene, lo_, hi_);
     plan_ = planSlices(camera_, lo_, hi_, options_);
     if (options_.clip) {
         clipMesh_ = loadClipMesh(options_.clip->mesh, scene.baseDir);
@@ -277,13 +272,10 @@ Image4f Slice3dRenderer::renderFused(FrameStats& stats)
     device_.launch("slice3d: fused", fused_, image_.width, image_.height);
 
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
-    Image4f image(image_.width, image_.height);
-    device_.queue().enqueueReadBuffer(out_, CL_FALSE, 0, pixels * sizeof(glm::vec4), image.pixels().data());
-    const std::vector<cl_uint> counts = device_.download<cl_uint>(samples_, pixels);
-    const std::vector<cl_uint> skippedCounts = device_.download<cl_uint>(skipped_, pixels);
+    Image4f image = readImage(device_, out_, image_.width, image_.height);
     // samples: inside the box (taken + stepped over), as without skipping; the skipped ones apart.
-    stats.samples = std::accumulate(counts.begin(), counts.end(), std::uint64_t(0));
-    const std::uint64_t skipped = std::accumulate(skippedCounts.begin(), skippedCounts.end(), std::uint64_t(0));
+    stats.samples = sumCounts(device_, samples_, pixels);
+    const std::uint64_t skipped = sumCounts(device_, skipped_, pixels);
     stats.extra["samples_skipped"] = skipped;
     stats.extra["samples_taken"] = stats.samples - skipped;
     stats.extra["empty_space_skipping"] = skip;
@@ -673,7 +665,7 @@ void setSlice3dClipPlacement(Renderer& renderer, const glm::dvec3& offset, const
 {
     auto* slice3d = dynamic_cast<Slice3dRenderer*>(&renderer);
     if (!slice3d)
-        throw InputError("setSlice3dClipPlacement: the renderer is not slice3d");
+        throw InternalError("setSlice3dClipPlacement: the renderer is not slice3d");
     slice3d->setClipPlacement(offset, matrix);
 }
 

@@ -2,6 +2,7 @@
 // rendering of the spherical technique (pixel textures on spherical domains, seeds/000 §2.2).
 #include "host/render/grid/spherical.h"
 
+#include "host/render/scaffold.h"
 #include "host/runtime/errors.h"
 #include "host/render/camera_args.h"
 #include "host/render/options_util.h"
@@ -11,7 +12,6 @@
 #include "raster/texture.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -215,13 +215,10 @@ SphericalRenderer::SphericalRenderer(Device& device, const Scene& scene, const V
         throw InputError("lights: technique spherical renders unshaded (no \"lights\")");
     if (scene.iso)
         throw InputError("iso: technique spherical renders no iso-surfaces (no \"iso\")");
-    volume.validate();
+    checkGridVolume(volume, "spherical");
     dims_ = volume.dims;
     const SphericalDomain& d = options_.domain;
-    camera_ = scene.camera ? *scene.camera : fitCamera(d.center - d.rMax, d.center + d.rMax);
-    camera_.validate();
-    if (imageSpec_.width < 1 || imageSpec_.height < 1)
-        throw InputError("image: width and height must be >= 1");
+    camera_ = frameCamera(scene, d.center - d.rMax, d.center + d.rMax);
     shells_ = planShells(options_);
     texturedTransfer_ = composeTextureMap(options_.transfer, dims_);
     raster::validate(texturedTransfer_);
@@ -313,7 +310,7 @@ void SphericalRenderer::renderPass(std::size_t shellIndex, bool back)
 
 Image4f SphericalRenderer::render(FrameStats& stats)
 {
-    const auto start = std::chrono::steady_clock::now();
+    const FrameClock clock;
     drawStats_ = {};
     image_->clearColor(device_, glm::vec4(0.0f));
     // Back to front along every ray: the far hits of concentric spheres lie beyond all near hits
@@ -330,8 +327,7 @@ Image4f SphericalRenderer::render(FrameStats& stats)
     overBackground_.setArg(2, f4(imageSpec_.background));
     device_.launch("spherical: over background", overBackground_, pixels);
     Image4f image = image_->readColor(device_);
-    stats.passes = device_.takePassTimes();
-    stats.frameMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    finishFrame(device_, clock, stats);
     stats.samples = drawStats_.fragments;  // one texture sample per covered pixel of a hemisphere
     stats.extra["shells"] = shells_.size();
     stats.extra["segments"] = options_.segments;

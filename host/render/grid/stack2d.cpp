@@ -3,6 +3,7 @@
 // kernels/stack2d.cl as fragment program, then the background pass of slice3d.
 #include "host/render/grid/stack2d.h"
 
+#include "host/render/scaffold.h"
 #include "host/runtime/embedded_kernels.h"
 #include "host/runtime/errors.h"
 #include "host/render/camera_args.h"
@@ -18,10 +19,8 @@
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <limits>
-#include <numeric>
 #include <optional>
 
 namespace clvr {
@@ -114,16 +113,13 @@ private:
 Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volume& volume)
     : device_(device), options_(parseStack2dOptions(scene.options)), image_(scene.image), lighting_(scene.lighting)
 {
-    volume.validate();
+    checkGridVolume(volume, "stack2d");
     dims_ = volume.dims;
     origin_ = volume.origin;
     spacing_ = volume.spacing;
     lo_ = volume.boundsMin();
     hi_ = volume.boundsMax();
-    camera_ = scene.camera ? *scene.camera : fitCamera(lo_, hi_);
-    camera_.validate();
-    if (image_.width < 1 || image_.height < 1)
-        throw InputError("image: width and height must be >= 1");
+    camera_ = frameCamera(scene, lo_, hi_);
     if (scene.iso) {
         Iso iso;
         iso.value = scene.iso->value;
@@ -286,7 +282,7 @@ void Stack2dRenderer::setTransferFunction(const TransferFunction& tf)
 
 Image4f Stack2dRenderer::render(FrameStats& stats)
 {
-    const auto start = std::chrono::steady_clock::now();
+    const FrameClock clock;
     // Near and far planes around the box's eye-depth range; depth is not tested, so only the near
     // plane matters: it removes what lies behind the camera (perspective) or in front of its image
     // plane (parallel: depth 0, as the reference integral counts the ray from there).
@@ -405,8 +401,7 @@ Image4f Stack2dRenderer::render(FrameStats& stats)
         device_.launch("stack2d: over background", overBackground_, pixels);
     }
     Image4f image = framebuffer_->readColor(device_);
-    stats.passes = device_.takePassTimes();
-    stats.frameMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    finishFrame(device_, clock, stats);
     // One sample per fragment of a quad; with several slices per polygon at most `count` per fragment
     // (fewer where the enlarged quad covers pixels outside some of its slices): an upper bound.
     std::uint64_t samples = drawStats.fragments;
@@ -538,7 +533,7 @@ void setStack2dClipPlacement(Renderer& renderer, const glm::dvec3& offset, const
 {
     auto* stack2d = dynamic_cast<Stack2dRenderer*>(&renderer);
     if (!stack2d)
-        throw InputError("setStack2dClipPlacement: the renderer is not stack2d");
+        throw InternalError("setStack2dClipPlacement: the renderer is not stack2d");
     stack2d->setClipPlacement(offset, matrix);
 }
 

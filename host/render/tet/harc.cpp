@@ -2,6 +2,7 @@
 // harc renderer (kernels/harc.cl: harc_render).
 #include "host/render/tet/harc.h"
 
+#include "host/render/scaffold.h"
 #include "host/runtime/errors.h"
 #include "host/render/camera_args.h"
 #include "host/render/options_util.h"
@@ -80,15 +81,12 @@ HarcRenderer::HarcRenderer(Device& device, const Scene& scene, const TetMesh& me
         throw InputError(mesh.source + ": harc needs a mesh with at least one tetrahedron");
     if (mesh.tets.size() >= (std::size_t(1) << 29))
         throw InputError(mesh.source + ": harc takes fewer than 2^29 tetrahedra (tet * 4 + face in 31 bits)");
-    if (topology.neighbor.size() != mesh.tets.size())
-        throw InputError(mesh.source + ": topology does not match the mesh");
-    if (image_.width < 1 || image_.height < 1)
-        throw InputError("image: width and height must be >= 1");
+    if (topology.neighbor.size() != mesh.tets.size())  // makeMeshRenderer builds it from this mesh
+        throw InternalError(mesh.source + ": topology does not match the mesh");
     glm::dvec3 lo, hi;
     meshBounds(mesh, lo, hi);
     shift_ = 0.5 * (lo + hi);
-    camera_ = scene.camera ? *scene.camera : fitCamera(lo, hi);
-    camera_.validate();
+    camera_ = frameCamera(scene, lo, hi);
 
     tetCount_ = mesh.tets.size();
     pointCount_ = mesh.points.size();
@@ -153,13 +151,13 @@ void HarcRenderer::setTransferFunction(const TransferFunction& tf)
 
 Image4f HarcRenderer::render(FrameStats& stats)
 {
-    const auto start = std::chrono::steady_clock::now();
+    const FrameClock clock;
     // Entry points: the boundary front faces' crossings per pixel, sorted by depth, every frame.
     HarcRasterEntryStats peel;
     const HarcEntryLists lists = rasterEntries_
                                      ? rasterEntries_->build(camera_, peel)
                                      : buildHarcEntryLists(mesh_, topology_, camera_, image_.width, image_.height);
-    const double entryMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    const double entryMs = clock.ms();
     const cl::Buffer offsets = device_.upload("harc entry offsets", lists.offsets);
     std::vector<cl_int2> entries = lists.entries;
     if (entries.empty())
@@ -202,8 +200,7 @@ Image4f HarcRenderer::render(FrameStats& stats)
     device_.launch("harc: walk", kernel_, image_.width, image_.height);
 
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
-    Image4f image(image_.width, image_.height);
-    device_.queue().enqueueReadBuffer(out_, CL_FALSE, 0, pixels * sizeof(glm::vec4), image.pixels().data());
+    Image4f image = readImage(device_, out_, image_.width, image_.height);
     const std::vector<cl_uint> counts = device_.download<cl_uint>(stats_, pixels * 3);
     std::uint64_t steps = 0, bounded = 0, pieces = 0;
     for (std::size_t p = 0; p < pixels; ++p) {
@@ -211,18 +208,16 @@ Image4f HarcRenderer::render(FrameStats& stats)
         bounded += counts[3 * p + 1];
         pieces += counts[3 * p + 2];
     }
-    std::vector<PassTime> deviceTimes = device_.takePassTimes();
+    // The host's entry stage first (with raster entries the peeling draws' own device passes are among
+    // the device's; this is the whole entry stage, draws, read-backs and the host's compaction included).
+    std::vector<PassTime> hostPasses;
     if (rasterEntries_) {
-        // The peeling draws' own device passes are in deviceTimes; this is the whole entry stage,
-        // draws, read-backs and the host's compaction included.
-        stats.passes.push_back({"harc: entry lists (raster, all layers)", entryMs});
-        stats.passes.push_back({"harc: entry lists (raster) host compaction", peel.compactMs});
+        hostPasses.push_back({"harc: entry lists (raster, all layers)", entryMs});
+        hostPasses.push_back({"harc: entry lists (raster) host compaction", peel.compactMs});
     } else {
-        stats.passes.push_back({"harc: entry lists (host)", entryMs});
+        hostPasses.push_back({"harc: entry lists (host)", entryMs});
     }
-    for (PassTime& t : deviceTimes)
-        stats.passes.push_back(std::move(t));
-    stats.frameMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    finishFrame(device_, clock, stats, std::move(hostPasses));
     stats.extra["points"] = pointCount_;
     stats.extra["tets"] = tetsRead_;
     stats.extra["tets_rendered"] = tetCount_;

@@ -24,7 +24,7 @@ std::string fragmentSource()
     for (const EmbeddedKernel& k : embeddedKernels())
         if (k.name == "harc_entry.cl")
             return "#define CLVR_HARC_ENTRY_FRAGMENT 1\n" + std::string(k.source);
-    throw DeviceError("kernels/harc_entry.cl is not embedded in this build");
+    throw InternalError("kernels/harc_entry.cl is not embedded in this build");
 }
 
 double msSince(std::chrono::steady_clock::time_point t0)
