@@ -5,17 +5,7 @@
 #ifndef CLVR_RASTER_STATE_H
 #define CLVR_RASTER_STATE_H
 
-#ifdef __OPENCL_C_VERSION__
-#ifndef CLVR_CL_TYPES
-#define CLVR_CL_TYPES
-typedef uint cl_uint;
-typedef float4 cl_float4;
-#endif
-typedef int cl_int;
-typedef float cl_float;
-#else
-#include <CL/cl_platform.h>
-#endif
+#include "cl_types.h"  /* cl_uint, cl_float4, ... on both sides */
 
 #define CLVR_MAX_ATTRIBUTES 4
 #define CLVR_MAX_UNIFORMS 64

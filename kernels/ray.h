@@ -17,17 +17,7 @@
 #ifndef CLVR_RAY_H
 #define CLVR_RAY_H
 
-/* No bool, size_t or float3 across the boundary (STYLE.md §3); the typedefs share the guards of
- * kernels/texture.h so that either header may come first. */
-#ifdef __OPENCL_C_VERSION__
-#ifndef CLVR_CL_TYPES
-#define CLVR_CL_TYPES
-typedef uint cl_uint;
-typedef float4 cl_float4;
-#endif
-#else
-#include <CL/cl_platform.h>
-#endif
+#include "cl_types.h"  /* cl_uint, cl_float4, ... on both sides */
 
 /* The camera as rays need it: an orthonormal frame and the image plane's extent. */
 typedef struct {

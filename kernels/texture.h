@@ -11,17 +11,7 @@
 #ifndef CLVR_TEXTURE_H
 #define CLVR_TEXTURE_H
 
-/* No bool, size_t or float3 across the boundary (STYLE.md §3). The typedefs are guarded so that
- * other shared headers can define the same names with the same guard. */
-#ifdef __OPENCL_C_VERSION__
-#ifndef CLVR_CL_TYPES
-#define CLVR_CL_TYPES
-typedef uint cl_uint;
-typedef float4 cl_float4;
-#endif
-#else
-#include <CL/cl_platform.h>
-#endif
+#include "cl_types.h"  /* cl_uint, cl_float4, ... on both sides */
 
 #define CLVR_FILTER_NEAREST 0u
 #define CLVR_FILTER_LINEAR 1u
