@@ -27,11 +27,6 @@ using nlohmann::json;
 
 constexpr double kTauMax = 8.0;  // of mlTransferFunction
 
-TransferFunction mlTransferFunction()
-{
-    return TransferFunction({{0.0, {0, 0, 0}, 0.0}, {0.5, {1, 0.5, 0}, 4.0}, {1.0, {1, 1, 1}, kTauMax}});
-}
-
 // The cameras of tests/slice3d_test.cpp.
 Camera perspectiveCamera()
 {
@@ -59,7 +54,7 @@ Scene makeScene(const Camera& camera, const json& clipTexture, const std::string
     s.baseDir = baseDir;
     s.camera = camera;
     s.image = ImageSpec{64, 64, {0.1, 0.2, 0.3}};
-    s.transferFunction = mlTransferFunction();
+    s.transferFunction = test::designTransferFunction(kTauMax);
     s.options = {{"slices", kSlices}, {"path", path}, {"clip_texture", clipTexture}};
     return s;
 }

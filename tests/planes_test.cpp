@@ -62,16 +62,6 @@ Scene makeScene(const Camera& camera, json options, bool shaded = true, int size
     return s;
 }
 
-Image4f render(const Scene& scene, const Volume& volume, FrameStats* statsOut = nullptr)
-{
-    auto renderer = makeRenderer(test::device(), scene, volume);
-    FrameStats stats;
-    Image4f image = renderer->render(stats);
-    if (statsOut)
-        *statsOut = stats;
-    return image;
-}
-
 Image4d shadedReference(const Scene& scene, const Volume& volume)
 {
     static const std::vector<glm::vec4> gradients = sobelGradientVolume(volume);
@@ -132,7 +122,7 @@ TEST(PlanesOptions, BadOptionsThrowInputErrorNamingTheKey)
     expectInputError({{"reflectance_map_size", 0}}, "options.reflectance_map_size");
     expectInputError({{"reflectance_map_size", 1025}}, "options.reflectance_map_size");
     expectInputError({{"reflectance_map_size", 8.5}}, "options.reflectance_map_size");
-    EXPECT_THROW(render(makeScene(perspectiveCamera(), {{"sample_spacing", 1e-7}}), sphere33()), InputError);
+    EXPECT_THROW(test::renderScene(makeScene(perspectiveCamera(), {{"sample_spacing", 1e-7}}), sphere33()), InputError);
 }
 
 // ---- against the reference -------------------------------------------------------------------
@@ -146,7 +136,7 @@ TEST(Planes, ShadedMatchesReferenceBothCameras)
 {
     for (const Camera& camera : {perspectiveCamera(), parallelCamera()}) {
         const Scene scene = makeScene(camera, {{"early_termination", 1.0}, {"reflectance_map_size", 256}});
-        const Image4f image = render(scene, sphere33());
+        const Image4f image = test::renderScene(scene, sphere33());
         const Image4d expected = shadedReference(scene, sphere33());
         report(camera.parallel ? "shaded parallel" : "shaded perspective", image, expected);
         const double mapBound = reflectanceMapBound(scene.lighting, 256);
@@ -160,7 +150,7 @@ TEST(Planes, ShadedMatchesReferenceBothCameras)
 TEST(Planes, UnshadedMatchesReference)
 {
     const Scene scene = makeScene(perspectiveCamera(), {{"early_termination", 1.0}}, false);
-    const Image4f image = render(scene, sphere33());
+    const Image4f image = test::renderScene(scene, sphere33());
     const Image4d expected = shadedReference(scene, sphere33());
     report("unshaded", image, expected);
     EXPECT_TRUE(test::imagesNear(image, expected, {.maxAbs = 5e-3, .meanAbs = 5e-4}));
@@ -174,8 +164,8 @@ TEST(Planes, ErrorFallsWithSampleSpacing)
     Scene fine = coarse;
     fine.options["sample_spacing"] = 0.0625;
     const Image4d expected = shadedReference(coarse, sphere33());
-    const test::ImageError ec = test::imageError(render(coarse, sphere33()), expected);
-    const test::ImageError ef = test::imageError(render(fine, sphere33()), expected);
+    const test::ImageError ec = test::imageError(test::renderScene(coarse, sphere33()), expected);
+    const test::ImageError ef = test::imageError(test::renderScene(fine, sphere33()), expected);
     std::printf("[ measured ] mean rgb error at spacing 0.25: %.2e, at 0.0625: %.2e\n", ec.meanAbs.r, ef.meanAbs.r);
     EXPECT_LT(ef.meanAbs.r, ec.meanAbs.r / 3.0);
 }
@@ -200,8 +190,8 @@ TEST(Planes, EarlyTerminationWithinBound)
     Scene on = off;
     on.options["early_termination"] = 0.9;
     FrameStats statsOff, statsOn;
-    const Image4f a = render(off, sphere33(), &statsOff);
-    const Image4f b = render(on, sphere33(), &statsOn);
+    const Image4f a = test::renderScene(off, sphere33(), &statsOff);
+    const Image4f b = test::renderScene(on, sphere33(), &statsOn);
     EXPECT_GT(statsOn.extra["rays_terminated"].get<std::uint64_t>(), 0u);
     EXPECT_EQ(statsOff.extra["rays_terminated"].get<std::uint64_t>(), 0u);
     EXPECT_LT(statsOn.samples, statsOff.samples);
@@ -222,8 +212,8 @@ TEST(Planes, OpacityThresholdWithinBound)
     const double t = 0.02;
     on.options["opacity_threshold"] = t;
     FrameStats statsOff, statsOn;
-    const Image4f a = render(off, sphere33(), &statsOff);
-    const Image4f b = render(on, sphere33(), &statsOn);
+    const Image4f a = test::renderScene(off, sphere33(), &statsOff);
+    const Image4f b = test::renderScene(on, sphere33(), &statsOn);
     const auto below = statsOn.extra["samples_below_threshold"].get<std::uint64_t>();
     EXPECT_GT(below, statsOff.extra["samples_below_threshold"].get<std::uint64_t>());
     Image4d expected(a.width(), a.height());
@@ -244,8 +234,8 @@ TEST(Planes, ReflectanceMapSizeWithinItsBound)
     const Scene fine = makeScene(perspectiveCamera(), {{"early_termination", 1.0}, {"reflectance_map_size", 1024}});
     Scene coarse = fine;
     coarse.options["reflectance_map_size"] = 4;
-    const Image4f a = render(fine, sphere33());
-    const Image4f b = render(coarse, sphere33());
+    const Image4f a = test::renderScene(fine, sphere33());
+    const Image4f b = test::renderScene(coarse, sphere33());
     Image4d expected(a.width(), a.height());
     for (std::size_t i = 0; i < a.pixelCount(); ++i)
         expected.pixels()[i] = glm::dvec4(a.pixels()[i]);
@@ -292,7 +282,7 @@ TEST(Planes, AsymmetricBlobLandsUpperLeftLitFromUpperLeft)
         scene.image.background = glm::dvec3(0.0);
         scene.transferFunction = TransferFunction({{0.3, {1, 1, 1}, 0.0}, {0.4, {1, 1, 1}, 60.0}});
         scene.lighting.lights = {{glm::normalize(glm::dvec3(-1.0, 1.0, 1.0)), glm::dvec3(1.0)}};
-        const Image4f image = render(scene, v);
+        const Image4f image = test::renderScene(scene, v);
         std::filesystem::create_directories("test_output");
         writeImage(std::string("test_output/planes_blob_") + (camera.parallel ? "parallel" : "perspective") + ".png", image);
         double alpha[2][2] = {}, light = 0.0, dark = 0.0, sum = 0.0;

@@ -22,11 +22,6 @@ namespace {
 
 using nlohmann::json;
 
-TransferFunction mlTransferFunction()
-{
-    return TransferFunction({{0.0, {0, 0, 0}, 0.0}, {0.5, {1, 0.5, 0}, 4.0}, {1.0, {1, 1, 1}, 8.0}});
-}
-
 // The cameras of tests/slice3d_test.cpp, for the convex meshes.
 Camera perspectiveCamera()
 {
@@ -71,7 +66,7 @@ Scene makeScene(const Camera& camera, const json& clip, int slices = kSlices)
     s.baseDir = test::repoData("scenes");  // so "../surfaces/torus.off" resolves as in a scene file
     s.camera = camera;
     s.image = ImageSpec{64, 64, {0.1, 0.2, 0.3}};
-    s.transferFunction = mlTransferFunction();
+    s.transferFunction = test::designTransferFunction();
     s.options = {{"slices", slices}, {"clip", clip}};
     return s;
 }

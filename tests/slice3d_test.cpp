@@ -24,12 +24,6 @@ namespace {
 
 using nlohmann::json;
 
-TransferFunction mlTransferFunction()
-{
-    // DESIGN.md's example: s in [0,1], tau per world unit (the box is 2 wide).
-    return TransferFunction({{0.0, {0, 0, 0}, 0.0}, {0.5, {1, 0.5, 0}, 4.0}, {1.0, {1, 1, 1}, 8.0}});
-}
-
 Camera perspectiveCamera()
 {
     return test::obliquePerspectiveCamera(40.0);
@@ -50,16 +44,6 @@ Scene makeScene(const Camera& camera, const TransferFunction& tf, int size, json
     s.transferFunction = tf;
     s.options = std::move(options);
     return s;
-}
-
-Image4f renderScene(const Scene& scene, const Volume& volume, FrameStats* statsOut = nullptr)
-{
-    auto renderer = makeRenderer(test::device(), scene, volume);
-    FrameStats stats;
-    Image4f image = renderer->render(stats);
-    if (statsOut)
-        *statsOut = stats;
-    return image;
 }
 
 Image4d reference(const Scene& scene, const Volume& volume)
@@ -206,7 +190,7 @@ TEST(Slice3dOptions, BadOptionsThrowInputErrorNamingTheKey)
 
 TEST(Slice3dOptions, MakeRendererRejectsUnknownTechniqueAndMissingVolume)
 {
-    Scene scene = makeScene(perspectiveCamera(), mlTransferFunction(), 16);
+    Scene scene = makeScene(perspectiveCamera(), test::designTransferFunction(), 16);
     scene.technique = "raytrace";
     try {
         makeRenderer(test::device(), scene, marschnerLobb41());
@@ -226,7 +210,7 @@ TEST(Slice3dOptions, MakeRendererRejectsUnknownTechniqueAndMissingVolume)
 
 TEST(Slice3dRenderer, ResidentBytesAreFloat32Volume)
 {
-    auto renderer = makeRenderer(test::device(), makeScene(perspectiveCamera(), mlTransferFunction(), 16),
+    auto renderer = makeRenderer(test::device(), makeScene(perspectiveCamera(), test::designTransferFunction(), 16),
                                  marschnerLobb41());
     // 4 bytes per grid point, plus the packed transfer function (3 points: 4 + 12 + 12 floats), plus
     // one empty-space byte per brick (40 cells per axis: 10^3 bricks of 4^3 cells).
@@ -249,7 +233,7 @@ TEST(Slice3dEmptySpace, TauZeroOnFollowsThePiecewiseLinearTau)
     EXPECT_TRUE(tauZeroOn(tf, 0.8f, 0.85f));
     EXPECT_TRUE(tauZeroOn(tf, 0.8f, 100.0f));   // above s_{n-1}: tau_{n-1} = 0 held
     EXPECT_FALSE(tauZeroOn(tf, 0.79f, 0.85f));
-    const TransferFunction ml = mlTransferFunction();  // tau 0 only at s = 0
+    const TransferFunction ml = test::designTransferFunction();  // tau 0 only at s = 0
     EXPECT_TRUE(tauZeroOn(ml, -1.0f, 0.0f));
     EXPECT_FALSE(tauZeroOn(ml, 0.0f, 1e-6f));
 }
@@ -317,7 +301,7 @@ TEST(Slice3dRenderer, NativeIntegerVoxelsGiveTheFloat32ImageBitForBit)
             FrameStats nativeStats, floatStats;
             auto renderer = makeRenderer(test::device(), makeScene(perspectiveCamera(), tf, 53, options), v);
             const Image4f native = renderer->render(nativeStats);
-            const Image4f f32 = renderScene(makeScene(perspectiveCamera(), tf, 53, asFloat), v, &floatStats);
+            const Image4f f32 = test::renderScene(makeScene(perspectiveCamera(), tf, 53, asFloat), v, &floatStats);
             const std::string type = scale == 255.0f ? "uint8" : "uint16";
             EXPECT_EQ(nativeStats.extra["voxel_type"], type);
             EXPECT_EQ(floatStats.extra["voxel_type"], "float32");
@@ -357,7 +341,7 @@ TEST(Slice3dEmptySpace, SkippingIsBitIdenticalToTheFullLoop)
     };
     const Case cases[] = {{"sphere", &sphere, sphereTf, true},
                           {"ml threshold", &marschnerLobb41(), mlThreshold, true},
-                          {"ml usual", &marschnerLobb41(), mlTransferFunction(), false}};
+                          {"ml usual", &marschnerLobb41(), test::designTransferFunction(), false}};
     const json orders[] = {{{"slices", 96}},
                            {{"slices", 96}, {"order", "front-to-back"}},
                            {{"slices", 128}, {"order", "front-to-back"}, {"early_termination", 0.9}}};
@@ -367,8 +351,8 @@ TEST(Slice3dEmptySpace, SkippingIsBitIdenticalToTheFullLoop)
                 json on = base, off = base;
                 off["empty_space_skipping"] = false;
                 FrameStats withStats, withoutStats;
-                const Image4f with = renderScene(makeScene(camera, c.tf, 61, on), *c.volume, &withStats);
-                const Image4f without = renderScene(makeScene(camera, c.tf, 61, off), *c.volume, &withoutStats);
+                const Image4f with = test::renderScene(makeScene(camera, c.tf, 61, on), *c.volume, &withStats);
+                const Image4f without = test::renderScene(makeScene(camera, c.tf, 61, off), *c.volume, &withoutStats);
                 const std::string label = std::string(c.name) + (camera.parallel ? " parallel " : " perspective ") +
                                           base.dump();
                 ASSERT_EQ(with.pixelCount(), without.pixelCount());
@@ -434,7 +418,7 @@ double maxSliceLength(const Scene& scene, const Volume& volume)
 void checkAgainstReference(const Scene& scene, const Volume& volume, double tauMax, const char* label)
 {
     FrameStats stats;
-    const Image4f image = renderScene(scene, volume, &stats);
+    const Image4f image = test::renderScene(scene, volume, &stats);
     writePng(std::string("slice3d_") + label, image);
     const Image4d want = reference(scene, volume);
     const double delta = maxSliceLength(scene, volume);
@@ -451,13 +435,13 @@ void checkAgainstReference(const Scene& scene, const Volume& volume, double tauM
 
 TEST(Slice3dFused, MarschnerLobbPerspectiveMatchesReference)
 {
-    checkAgainstReference(makeScene(perspectiveCamera(), mlTransferFunction(), 64), marschnerLobb41(), 8.0,
+    checkAgainstReference(makeScene(perspectiveCamera(), test::designTransferFunction(), 64), marschnerLobb41(), 8.0,
                           "ml41_perspective");
 }
 
 TEST(Slice3dFused, MarschnerLobbParallelMatchesReference)
 {
-    checkAgainstReference(makeScene(parallelCamera(), mlTransferFunction(), 64), marschnerLobb41(), 8.0,
+    checkAgainstReference(makeScene(parallelCamera(), test::designTransferFunction(), 64), marschnerLobb41(), 8.0,
                           "ml41_parallel");
 }
 
@@ -485,13 +469,13 @@ TEST(Slice3dFused, HeadsqMatchesReference)
 // gives 8; measured ~9).
 TEST(Slice3dFused, ErrorFallsWithSliceCount)
 {
-    const Scene base = makeScene(perspectiveCamera(), mlTransferFunction(), 48);
+    const Scene base = makeScene(perspectiveCamera(), test::designTransferFunction(), 48);
     const Image4d want = reference(base, marschnerLobb41());
     std::vector<double> meanErrors;
     for (int n : {32, 64, 128, 256}) {
         Scene scene = base;
         scene.options = {{"slices", n}};
-        const test::ImageError e = test::imageError(renderScene(scene, marschnerLobb41()), want);
+        const test::ImageError e = test::imageError(test::renderScene(scene, marschnerLobb41()), want);
         report(("ml41 perspective 48x48, slices " + std::to_string(n)).c_str(), e);
         meanErrors.push_back(maxChannel(e.meanAbs));
     }
@@ -505,11 +489,11 @@ TEST(Slice3dFused, ErrorFallsWithSliceCount)
 TEST(Slice3dFused, BackToFrontEqualsFrontToBack)
 {
     for (const Camera& camera : {perspectiveCamera(), parallelCamera()}) {
-        Scene scene = makeScene(camera, mlTransferFunction(), 64);
+        Scene scene = makeScene(camera, test::designTransferFunction(), 64);
         FrameStats btfStats, ftbStats;
-        const Image4f btf = renderScene(scene, marschnerLobb41(), &btfStats);
+        const Image4f btf = test::renderScene(scene, marschnerLobb41(), &btfStats);
         scene.options = {{"order", "front-to-back"}};
-        const Image4f ftb = renderScene(scene, marschnerLobb41(), &ftbStats);
+        const Image4f ftb = test::renderScene(scene, marschnerLobb41(), &ftbStats);
         report("back-to-front vs front-to-back", test::imageError(ftb, toDouble(btf)));
         EXPECT_TRUE(test::imagesNear(ftb, toDouble(btf), {.maxAbs = 5e-5, .meanAbs = 5e-6}));
         EXPECT_EQ(btfStats.samples, ftbStats.samples);
@@ -522,11 +506,11 @@ TEST(Slice3dFused, BackToFrontEqualsFrontToBack)
 TEST(Slice3dFused, EarlyTerminationChangesPixelsByAtMostOneMinusThreshold)
 {
     const double threshold = 0.9;
-    Scene scene = makeScene(perspectiveCamera(), mlTransferFunction(), 64, {{"order", "front-to-back"}});
+    Scene scene = makeScene(perspectiveCamera(), test::designTransferFunction(), 64, {{"order", "front-to-back"}});
     FrameStats fullStats, ertStats;
-    const Image4f full = renderScene(scene, marschnerLobb41(), &fullStats);
+    const Image4f full = test::renderScene(scene, marschnerLobb41(), &fullStats);
     scene.options["early_termination"] = threshold;
-    const Image4f ert = renderScene(scene, marschnerLobb41(), &ertStats);
+    const Image4f ert = test::renderScene(scene, marschnerLobb41(), &ertStats);
     const test::ImageError e = test::imageError(ert, toDouble(full));
     report("early termination 0.9 vs none", e);
     EXPECT_TRUE(test::imagesNear(ert, toDouble(full), {.maxAbs = 1.0 - threshold + 1e-5, .meanAbs = 1.0 - threshold}));
@@ -550,11 +534,11 @@ TEST(Slice3dRaster, MatchesFused)
 {
     for (const Camera& camera : {perspectiveCamera(), parallelCamera()}) {
         for (const char* order : {"back-to-front", "front-to-back"}) {
-            Scene scene = makeScene(camera, mlTransferFunction(), 64, {{"slices", 64}, {"order", order}});
+            Scene scene = makeScene(camera, test::designTransferFunction(), 64, {{"slices", 64}, {"order", order}});
             FrameStats fusedStats, rasterStats;
-            const Image4f fused = renderScene(scene, marschnerLobb41(), &fusedStats);
+            const Image4f fused = test::renderScene(scene, marschnerLobb41(), &fusedStats);
             scene.options["path"] = "raster";
-            const Image4f raster = renderScene(scene, marschnerLobb41(), &rasterStats);
+            const Image4f raster = test::renderScene(scene, marschnerLobb41(), &rasterStats);
             writePng(std::string("slice3d_raster_") + (camera.parallel ? "parallel" : "perspective"), raster);
             const test::ImageError e = test::imageError(raster, toDouble(fused));
             report((std::string("raster vs fused, 64 slices, ") + order).c_str(), e);
@@ -580,16 +564,16 @@ TEST(Slice3dFused, CameraInsideVolumeMatchesReference)
     camera.position = {0.2, 0.1, 0.45};
     camera.focalPoint = {-0.1, -0.2, -1.0};
     camera.viewAngle = 70.0;
-    const Scene scene = makeScene(camera, mlTransferFunction(), 48, {{"slice_spacing", 0.008}});
+    const Scene scene = makeScene(camera, test::designTransferFunction(), 48, {{"slice_spacing", 0.008}});
     checkAgainstReference(scene, marschnerLobb41(), 8.0, "ml41_inside");
     FrameStats stats;
     Scene raster = scene;
     raster.options["path"] = "raster";
-    const Image4f fused = renderScene(scene, marschnerLobb41(), &stats);
+    const Image4f fused = test::renderScene(scene, marschnerLobb41(), &stats);
     ASSERT_EQ(stats.passes.size(), 1u);
     EXPECT_EQ(stats.passes[0].name, "slice3d: fused");
     EXPECT_DOUBLE_EQ(stats.extra["slice_spacing"].get<double>(), 0.008);
-    const Image4f viaRaster = renderScene(raster, marschnerLobb41());
+    const Image4f viaRaster = test::renderScene(raster, marschnerLobb41());
     const test::ImageError e = test::imageError(viaRaster, toDouble(fused));
     report("camera inside: raster vs fused", e);
     EXPECT_TRUE(test::imagesNear(viaRaster, toDouble(fused),
@@ -600,12 +584,12 @@ TEST(Slice3dFused, CameraInsideVolumeMatchesReference)
 TEST(Slice3dRenderer, RendersAreBitIdentical)
 {
     for (const char* path : {"fused", "raster"}) {
-        const Scene scene = makeScene(perspectiveCamera(), mlTransferFunction(), 48, {{"slices", 48}, {"path", path}});
+        const Scene scene = makeScene(perspectiveCamera(), test::designTransferFunction(), 48, {{"slices", 48}, {"path", path}});
         auto renderer = makeRenderer(test::device(), scene, marschnerLobb41());
         FrameStats stats;
         const Image4f a = renderer->render(stats);
         const Image4f b = renderer->render(stats);
-        const Image4f c = renderScene(scene, marschnerLobb41());
+        const Image4f c = test::renderScene(scene, marschnerLobb41());
         ASSERT_EQ(a.pixelCount(), b.pixelCount());
         EXPECT_EQ(std::memcmp(a.pixels().data(), b.pixels().data(), a.pixelCount() * sizeof(glm::vec4)), 0) << path;
         EXPECT_EQ(std::memcmp(a.pixels().data(), c.pixels().data(), a.pixelCount() * sizeof(glm::vec4)), 0) << path;
@@ -621,7 +605,7 @@ TEST(Slice3dRenderer, TransferFunctionChangeBetweenFramesEqualsAFreshRenderer)
     static const Volume sphere = generateVolume("sphere", {33, 33, 33});
     const TransferFunction threshold({{0.0, {0, 0, 0}, 0.0}, {0.5, {0.3, 0.3, 1}, 0.0}, {1.0, {1, 1, 0.5}, 9.0}});
     const TransferFunction lower({{0.0, {0, 0, 0}, 0.0}, {0.2, {0.3, 0.3, 1}, 0.0}, {1.0, {1, 1, 0.5}, 9.0}});
-    const TransferFunction dense = mlTransferFunction();
+    const TransferFunction dense = test::designTransferFunction();
     for (const char* path : {"fused", "raster"}) {
         const json options = {{"slices", 48}, {"path", path}};
         auto renderer = makeRenderer(test::device(), makeScene(perspectiveCamera(), threshold, 40, options), sphere);
@@ -630,7 +614,7 @@ TEST(Slice3dRenderer, TransferFunctionChangeBetweenFramesEqualsAFreshRenderer)
         for (const TransferFunction* tf : {&lower, &dense, &threshold}) {
             renderer->setTransferFunction(*tf);
             const Image4f edited = renderer->render(stats);
-            const Image4f fresh = renderScene(makeScene(perspectiveCamera(), *tf, 40, options), sphere);
+            const Image4f fresh = test::renderScene(makeScene(perspectiveCamera(), *tf, 40, options), sphere);
             EXPECT_EQ(std::memcmp(edited.pixels().data(), fresh.pixels().data(), edited.pixelCount() * sizeof(glm::vec4)), 0)
                 << path << ", " << tf->points().size() << " control points";
             if (tf == &lower) {  // the edit shows: the shell adds to the image
@@ -663,7 +647,7 @@ TEST(Slice3dRenderer, AsymmetricBlobLandsUpperLeft)
     parallel.parallelScale = 1.2;
     for (const Camera& camera : {perspective, parallel})
         for (const char* path : {"fused", "raster"}) {
-            const Image4f image = renderScene(makeScene(camera, tf, 48, {{"slices", 64}, {"path", path}}, {0, 0, 0}), v);
+            const Image4f image = test::renderScene(makeScene(camera, tf, 48, {{"slices", 64}, {"path", path}}, {0, 0, 0}), v);
             writePng(std::string("slice3d_blob_") + path + (camera.parallel ? "_parallel" : "_perspective"), image);
             double quadrant[2][2] = {};
             for (int y = 0; y < 48; ++y)
@@ -683,7 +667,7 @@ TEST(Slice3dBenchmark, DISABLED_MarschnerLobb256Image512Slices256)
     for (const char* path : {"fused", "raster"}) {
         if (only && std::string(only) != path)
             continue;
-        const Scene scene = makeScene(perspectiveCamera(), mlTransferFunction(), 512, {{"slices", 256}, {"path", path}});
+        const Scene scene = makeScene(perspectiveCamera(), test::designTransferFunction(), 512, {{"slices", 256}, {"path", path}});
         auto renderer = makeRenderer(test::device(), scene, volume);
         std::vector<double> frame, device;
         FrameStats stats;

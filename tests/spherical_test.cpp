@@ -55,13 +55,6 @@ Scene makeScene(const Camera& camera, int size, json options = json::object())
     return s;
 }
 
-Image4f renderScene(const Scene& scene, const Volume& volume)
-{
-    auto renderer = makeRenderer(test::device(), scene, volume);
-    FrameStats stats;
-    return renderer->render(stats);
-}
-
 std::string optionError(const json& options)
 {
     try {
@@ -290,7 +283,7 @@ TEST(SphericalRender, ConvergesToTheReferenceIntegral)
     std::vector<Measured> errors;
     Image4f image;
     for (const int k : {8, 16, 32, 64}) {
-        image = renderScene(makeScene(obliqueCamera(), size, {{"shells", k + 1}, {"segments", 2 * k}}),
+        image = test::renderScene(makeScene(obliqueCamera(), size, {{"shells", k + 1}, {"segments", 2 * k}}),
                                           atmosphere());
         errors.push_back(measure(image, reference));
         std::printf("shells %3d segments %3d: max %.4f mean %.5f\n", k + 1, 2 * k, errors.back().maxAbs,
@@ -321,8 +314,8 @@ TEST(SphericalRender, RadialOpacityUnderestimatesObliquePaths)
     const json base = {{"shells", 33}, {"segments", 64}};
     json radial = base;
     radial["opacity"] = "radial";
-    const Measured path = measure(renderScene(makeScene(obliqueCamera(), size, base), atmosphere()), reference);
-    const Measured flat = measure(renderScene(makeScene(obliqueCamera(), size, radial), atmosphere()), reference);
+    const Measured path = measure(test::renderScene(makeScene(obliqueCamera(), size, base), atmosphere()), reference);
+    const Measured flat = measure(test::renderScene(makeScene(obliqueCamera(), size, radial), atmosphere()), reference);
     std::printf("path: max %.4f mean %.5f; radial: max %.4f mean %.5f\n", path.maxAbs, path.meanAbs, flat.maxAbs,
                 flat.meanAbs);
     EXPECT_GT(flat.meanAbs, 3.0 * path.meanAbs);
@@ -345,9 +338,9 @@ TEST(SphericalRender, BiasOnPhiEqualsRotatedData)
     const json base = {{"shells", 12}, {"segments", 32}};
     json biased = base;
     biased["bias"] = {0.25, 0.0, 0.0};
-    const Image4f viaBias = renderScene(makeScene(obliqueCamera(), size, biased), data);
-    const Image4f viaData = renderScene(makeScene(obliqueCamera(), size, base), rotated);
-    const Image4f plain = renderScene(makeScene(obliqueCamera(), size, base), data);
+    const Image4f viaBias = test::renderScene(makeScene(obliqueCamera(), size, biased), data);
+    const Image4f viaData = test::renderScene(makeScene(obliqueCamera(), size, base), rotated);
+    const Image4f plain = test::renderScene(makeScene(obliqueCamera(), size, base), data);
     Image4d want(size, size);
     for (std::size_t i = 0; i < want.pixelCount(); ++i)
         want.pixels()[i] = glm::dvec4(viaData.pixels()[i]);
@@ -375,7 +368,7 @@ TEST(SphericalRender, CameraInsideTheDomain)
     SphericalReferenceOptions o;
     const Image4d reference = sphericalReferenceIntegral(atmosphere(), atmosphereTransferFunction(), camera, scene.image,
                                                          SphericalDomain{}, raster::PixelTransfer{}, o);
-    const Image4f image = renderScene(scene, atmosphere());
+    const Image4f image = test::renderScene(scene, atmosphere());
     const Measured m = measure(image, reference);
     std::printf("inside: max %.4f mean %.5f\n", m.maxAbs, m.meanAbs);
     // Measured max 0.050, mean 0.00044; tolerances as the outside view's (max 0.2, mean 0.002).
@@ -399,7 +392,7 @@ TEST(SphericalRender, ParallelCameraFullBall)
     const SphericalOptions parsed = parseSphericalOptions(options);
     const Image4d reference = sphericalReferenceIntegral(atmosphere(), atmosphereTransferFunction(), camera, scene.image,
                                                          parsed.domain, raster::PixelTransfer{});
-    const Image4f image = renderScene(scene, atmosphere());
+    const Image4f image = test::renderScene(scene, atmosphere());
     const Measured m = measure(image, reference);
     std::printf("parallel, full ball: max %.4f mean %.5f\n", m.maxAbs, m.meanAbs);
     // Measured max 0.108, mean 0.0034 (129 shells, 256 segments: 0.076, 0.0016): the shell spacing is
@@ -430,7 +423,7 @@ TEST(SphericalRender, SetTransferFunctionEqualsNewRenderer)
     renderer->setTransferFunction(edited);
     const Image4f after = renderer->render(stats);
     scene.transferFunction = edited;
-    const Image4f fresh = renderScene(scene, atmosphere());
+    const Image4f fresh = test::renderScene(scene, atmosphere());
     EXPECT_EQ(std::memcmp(after.pixels().data(), fresh.pixels().data(), after.pixelCount() * sizeof(glm::vec4)), 0);
     EXPECT_NE(std::memcmp(after.pixels().data(), before.pixels().data(), after.pixelCount() * sizeof(glm::vec4)), 0);
 }
@@ -448,7 +441,7 @@ TEST(SphericalRender, SceneFileSelectsTheTechnique)
     const Scene scene = parseScene(text, "inline.json", ".");
     EXPECT_EQ(scene.technique, "spherical");
     const Volume volume = generateVolume("atmosphere", {17, 9, 6});
-    const Image4f image = renderScene(scene, volume);
+    const Image4f image = test::renderScene(scene, volume);
     double alpha = 0.0;
     for (const glm::vec4& p : image.pixels())
         alpha = std::max(alpha, double(p.a));
@@ -467,7 +460,7 @@ TEST(SphericalRender, AtmosphereSceneFileRenders)
                                    "volume.dims=[33,17,12]", "options.shells=48", "options.segments=96"});
     ASSERT_EQ(scene.technique, "spherical");
     const Volume volume = loadVolume(scene.volume, scene.baseDir);
-    const Image4f image = renderScene(scene, volume);
+    const Image4f image = test::renderScene(scene, volume);
     const SphericalOptions options = parseSphericalOptions(scene.options);
     const Image4d reference = sphericalReferenceIntegral(volume, scene.transferFunction, *scene.camera, scene.image,
                                                          options.domain, options.transfer);

@@ -38,11 +38,6 @@ IsoSpec isoAt(double value)
 constexpr double kTauMax = 8.0;  // of mlTransferFunction
 constexpr int kSize = 48;
 
-TransferFunction mlTransferFunction()
-{
-    return TransferFunction({{0.0, {0, 0, 0}, 0.0}, {0.5, {1, 0.5, 0}, 4.0}, {1.0, {1, 1, 1}, kTauMax}});
-}
-
 // The cameras of tests/stack2d_test.cpp (z stack, and x stack for the parallel one).
 Camera perspectiveCamera()
 {
@@ -69,7 +64,7 @@ Scene makeScene(const Camera& camera, const json& clipTexture, int slicesPerPoly
     s.baseDir = test::repoData("scenes");
     s.camera = camera;
     s.image = ImageSpec{kSize, kSize, {0.1, 0.2, 0.3}};
-    s.transferFunction = mlTransferFunction();
+    s.transferFunction = test::designTransferFunction(kTauMax);
     s.options = {{"intermediate", kIntermediate}, {"slices_per_polygon", slicesPerPolygon}};
     if (!clipTexture.is_null())
         s.options["clip_texture"] = clipTexture;

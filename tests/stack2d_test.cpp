@@ -22,11 +22,6 @@ namespace {
 
 using nlohmann::json;
 
-TransferFunction mlTransferFunction()
-{
-    // As tests/slice3d_test.cpp: s in [0,1], tau per world unit (the box is 2 wide).
-    return TransferFunction({{0.0, {0, 0, 0}, 0.0}, {0.5, {1, 0.5, 0}, 4.0}, {1.0, {1, 1, 1}, 8.0}});
-}
 constexpr double kTauMax = 8.0;
 
 Camera perspectiveCamera()  // the camera of tests/slice3d_test.cpp: 28 degrees off the z axis
@@ -45,7 +40,7 @@ Scene makeScene(const Camera& camera, int size, json options = json::object())
     s.technique = "stack2d";
     s.camera = camera;
     s.image = ImageSpec{size, size, {0.1, 0.2, 0.3}};
-    s.transferFunction = mlTransferFunction();
+    s.transferFunction = test::designTransferFunction();
     s.options = std::move(options);
     return s;
 }
@@ -54,16 +49,6 @@ const Volume& marschnerLobb41()
 {
     static const Volume v = generateVolume("marschner-lobb", {41, 41, 41});
     return v;
-}
-
-Image4f renderScene(const Scene& scene, const Volume& volume, FrameStats* statsOut = nullptr)
-{
-    auto renderer = makeRenderer(test::device(), scene, volume);
-    FrameStats stats;
-    Image4f image = renderer->render(stats);
-    if (statsOut)
-        *statsOut = stats;
-    return image;
 }
 
 // The reference of each camera, computed once per process (seconds each).
@@ -151,7 +136,7 @@ TEST(Stack2dAxis, RotatingTheCameraSwitchesTheStack)
         const double a = glm::radians(degrees[i]);
         c.position = {4.0 * std::sin(a), 0.3, 4.0 * std::cos(a)};
         FrameStats stats;
-        renderScene(makeScene(c, 8), marschnerLobb41(), &stats);
+        test::renderScene(makeScene(c, 8), marschnerLobb41(), &stats);
         EXPECT_EQ(stats.extra["axis"], expected[i]) << degrees[i] << " degrees";
     }
 }
@@ -201,7 +186,7 @@ struct Measured {
 
 Measured measure(const Camera& camera, int size, int intermediate)
 {
-    const Image4f image = renderScene(makeScene(camera, size, {{"intermediate", intermediate}}), marschnerLobb41());
+    const Image4f image = test::renderScene(makeScene(camera, size, {{"intermediate", intermediate}}), marschnerLobb41());
     Measured m;
     m.error = test::imageError(image, reference(camera, size));
     const double spacing = 2.0 / 40.0;
@@ -251,7 +236,7 @@ TEST(Stack2dRender, TwoRendersGiveIdenticalBits)
     FrameStats stats;
     const Image4f a = renderer->render(stats);
     const Image4f b = renderer->render(stats);
-    const Image4f c = renderScene(scene, marschnerLobb41());
+    const Image4f c = test::renderScene(scene, marschnerLobb41());
     ASSERT_EQ(a.pixels().size(), b.pixels().size());
     EXPECT_EQ(std::memcmp(a.pixels().data(), b.pixels().data(), a.pixels().size() * sizeof(glm::vec4)), 0);
     EXPECT_EQ(std::memcmp(a.pixels().data(), c.pixels().data(), a.pixels().size() * sizeof(glm::vec4)), 0);
@@ -268,7 +253,7 @@ TEST(Stack2dRender, NewTransferFunctionGivesTheImageOfANewRenderer)
     FrameStats stats;
     const Image4f a = renderer->render(stats);
     scene.transferFunction = other;
-    const Image4f b = renderScene(scene, marschnerLobb41());
+    const Image4f b = test::renderScene(scene, marschnerLobb41());
     EXPECT_EQ(std::memcmp(a.pixels().data(), b.pixels().data(), a.pixels().size() * sizeof(glm::vec4)), 0);
 }
 
@@ -313,7 +298,7 @@ TEST(Stack2dShaded, MatchesShadedReferenceAndErrorFallsWithIntermediateSlices)
             if (intermediate == 0)
                 first = scene;
             FrameStats stats;
-            const Image4f image = renderScene(scene, sphere33(), &stats);
+            const Image4f image = test::renderScene(scene, sphere33(), &stats);
             EXPECT_EQ(stats.extra["shaded"], true);
             const Image4d expected = shadedReference(first);
             const test::ImageError e = test::imageError(image, expected);
@@ -338,7 +323,7 @@ TEST(Stack2dShaded, LightsChangeTheImage)
     const Scene shaded = shadedScene(perspectiveCamera(), {{"intermediate", 1}});
     Scene unshaded = shaded;
     unshaded.lighting = Lighting{};
-    const Image4f a = renderScene(shaded, sphere33()), b = renderScene(unshaded, sphere33());
+    const Image4f a = test::renderScene(shaded, sphere33()), b = test::renderScene(unshaded, sphere33());
     Image4d bd(b.width(), b.height());
     for (std::size_t i = 0; i < b.pixelCount(); ++i)
         bd.pixels()[i] = glm::dvec4(b.pixels()[i]);
@@ -366,7 +351,7 @@ TEST(Stack2dIso, SphereSilhouetteAndShadeMatchTheAnalyticSurface)
         scene.transferFunction = TransferFunction();
         scene.iso = test::isoSpec(0.5, {0.4, 0.6, 1.0}, ambient, diffuse);
         FrameStats stats;
-        const Image4f image = renderScene(scene, sphere33(), &stats);
+        const Image4f image = test::renderScene(scene, sphere33(), &stats);
         EXPECT_EQ(stats.extra["iso"], true);
         int inside = 0, outside = 0;
         double maxShadeError = 0.0, meanShadeError = 0.0;
@@ -475,14 +460,14 @@ TEST(Stack2dPolygons, SeveralSlicesPerPolygonGiveTheImageOfOneQuadPerSlice)
         for (const int intermediate : {0, 1}) {
             FrameStats oneStats;
             const Image4f one =
-                renderScene(makeScene(camera, size, {{"intermediate", intermediate}}), marschnerLobb41(), &oneStats);
+                test::renderScene(makeScene(camera, size, {{"intermediate", intermediate}}), marschnerLobb41(), &oneStats);
             Image4d oned(size, size);
             for (std::size_t i = 0; i < one.pixelCount(); ++i)
                 oned.pixels()[i] = glm::dvec4(one.pixels()[i]);
             const double deltaMax = 2.0 / 40.0 / (intermediate + 1) / minCos(camera, size, stackAxis(camera));
             for (const int k : {2, 5}) {
                 FrameStats stats;
-                const Image4f image = renderScene(
+                const Image4f image = test::renderScene(
                     makeScene(camera, size, {{"intermediate", intermediate}, {"slices_per_polygon", k}}),
                     marschnerLobb41(), &stats);
                 const test::ImageError e = test::imageError(image, oned);
@@ -517,8 +502,8 @@ TEST(Stack2dPolygons, SeveralSlicesPerPolygonGiveTheImageOfOneQuadPerSlice)
 TEST(Stack2dPolygons, ShadedAndIsoSurfacesWithSeveralSlicesPerPolygon)
 {
     for (const Camera& camera : {perspectiveCamera(), parallelCamera()}) {
-        const Image4f a = renderScene(shadedScene(camera, {{"intermediate", 1}}), sphere33());
-        const Image4f b = renderScene(shadedScene(camera, {{"intermediate", 1}, {"slices_per_polygon", 4}}), sphere33());
+        const Image4f a = test::renderScene(shadedScene(camera, {{"intermediate", 1}}), sphere33());
+        const Image4f b = test::renderScene(shadedScene(camera, {{"intermediate", 1}, {"slices_per_polygon", 4}}), sphere33());
         Image4d ad(a.width(), a.height());
         for (std::size_t i = 0; i < a.pixelCount(); ++i)
             ad.pixels()[i] = glm::dvec4(a.pixels()[i]);
@@ -531,9 +516,9 @@ TEST(Stack2dPolygons, ShadedAndIsoSurfacesWithSeveralSlicesPerPolygon)
         Scene iso = makeScene(camera, 48, {{"intermediate", 3}});
         iso.transferFunction = TransferFunction();
         iso.iso = test::isoSpec(0.5, {0.4, 0.6, 1.0}, 0.15, 0.8);
-        const Image4f isoOne = renderScene(iso, sphere33());
+        const Image4f isoOne = test::renderScene(iso, sphere33());
         iso.options["slices_per_polygon"] = 6;
-        const Image4f isoSix = renderScene(iso, sphere33());
+        const Image4f isoSix = test::renderScene(iso, sphere33());
         int coverageDiffers = 0, covered = 0;
         double shadeMax = 0.0, shadeSum = 0.0;
         for (std::size_t i = 0; i < isoOne.pixelCount(); ++i) {

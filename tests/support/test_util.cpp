@@ -12,6 +12,21 @@
 
 namespace clvr::test {
 
+TransferFunction designTransferFunction(double tauAtOne)
+{
+    return TransferFunction({{0.0, {0, 0, 0}, 0.0}, {0.5, {1, 0.5, 0}, 4.0}, {1.0, {1, 1, 1}, tauAtOne}});
+}
+
+Image4f renderScene(const Scene& scene, const Volume& volume, FrameStats* stats)
+{
+    auto renderer = makeRenderer(device(), scene, volume);
+    FrameStats frame;
+    Image4f image = renderer->render(frame);
+    if (stats)
+        *stats = frame;
+    return image;
+}
+
 Device& device()
 {
     static std::unique_ptr<Device> instance = std::make_unique<Device>("");

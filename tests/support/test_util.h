@@ -3,6 +3,10 @@
 #pragma once
 
 #include "host/model/camera.h"
+#include "host/model/scene.h"
+#include "host/model/transfer_function.h"
+#include "host/model/volume.h"
+#include "host/render/renderer.h"
 #include "host/runtime/device.h"
 #include "host/model/image.h"
 #include "host/model/scene.h"
@@ -17,6 +21,14 @@ namespace clvr::test {
 
 // CLVR_DEVICE, else the first CPU device (PoCL); opened once per process.
 Device& device();
+
+// The transfer function of DESIGN.md's example scene on s in [0,1]: black and clear at 0, orange at 0.5
+// (tau 4 per world unit), white at 1 with extinction `tauAtOne` (8 in DESIGN.md).
+TransferFunction designTransferFunction(double tauAtOne = 8.0);
+
+// One frame of `scene` on `volume` from a new renderer on the test device; `stats`, when not null, gets
+// the frame's FrameStats.
+Image4f renderScene(const Scene& scene, const Volume& volume, FrameStats* stats = nullptr);
 
 // ../shared/data/<relative>, and the repository's own data/<relative>.
 std::string sharedData(const std::string& relative);
