@@ -14,9 +14,9 @@
 
 namespace clvr::raster {
 
-static_assert(sizeof(ClTriangle) == 288, "also probed on the device by tests/layout_test.cpp");
-static_assert(offsetof(ClTriangle, depth) == 64);
-static_assert(offsetof(ClTriangle, attr_over_w) == 96);
+static_assert(sizeof(ClTriangle) == 64, "one cache line; also probed on the device by tests/layout_test.cpp");
+static_assert(sizeof(ClTriangleVaryings) == 224);
+static_assert(offsetof(ClTriangleVaryings, attr_over_w) == 32);
 
 namespace {
 
@@ -194,6 +194,7 @@ struct Pass {
 struct SetUpDraws {
     int fbWidth = 0, fbHeight = 0;
     std::vector<ClTriangle> triangles;  // set up, in submission order
+    std::vector<ClTriangleVaryings> varyings;  // varyings[i] belongs to triangles[i]
     std::vector<Pass> passes;
     std::vector<cl_float4> uniforms;
     std::uint64_t setUp = 0;            // DrawStats::triangles: also those whose pixel box is empty
@@ -204,6 +205,7 @@ struct SetUpDraws {
     void clear()
     {
         triangles.clear();
+        varyings.clear();
         passes.clear();
         uniforms.clear();
         setUp = 0;
@@ -214,10 +216,12 @@ struct SetUpDraws {
 // Everything a Rasterizer keeps between draws. Host staging is uploaded without blocking, so it is
 // only refilled after the uploads that read it have completed (uploadsDone).
 struct RasterScratch {
-    cl::Buffer triangles, tileStarts, tileTris, uniforms, fragmentCounts, dummy;
-    std::size_t triangleBytes = 0, tileStartBytes = 0, tileTrisBytes = 0, uniformBytes = 0;
+    cl::Buffer triangles, varyings, tileStarts, tileTris, uniforms, fragmentCounts, dummy;
+    std::size_t triangleBytes = 0, varyingBytes = 0, tileStartBytes = 0, tileTrisBytes = 0, uniformBytes = 0;
     std::vector<ClTriangle> stagedTriangles;
+    std::vector<ClTriangleVaryings> stagedVaryings;
     std::vector<cl_uint> stagedTileStarts, stagedTileTris;
+    std::vector<std::array<cl_uint, 2>> binPairs;  // binPass's (tile, triangle) scratch
     std::vector<cl_float4> stagedUniforms;
     std::vector<cl::Event> uploads;
     std::size_t maxUniforms = 0;  // the device's constant buffer size in float4s
@@ -233,6 +237,21 @@ struct RasterScratch {
 };
 
 namespace {
+
+// Hands the (empty) triangle arrays of `from`, with their capacity, to `to`: a DrawBatch borrows the
+// Rasterizer's, so that a batch per frame does not grow its arrays from nothing (and fault in fresh
+// pages) every frame. Only the capacity moves; pending draws are never lost.
+void lendCapacity(SetUpDraws& from, SetUpDraws& to)
+{
+    if (!from.triangles.empty() || !from.varyings.empty())
+        return;
+    to.triangles.clear();
+    to.varyings.clear();
+    if (to.triangles.capacity() < from.triangles.capacity())
+        to.triangles.swap(from.triangles);
+    if (to.varyings.capacity() < from.varyings.capacity())
+        to.varyings.swap(from.varyings);
+}
 
 // Sets up and bins one draw into `out` (docs/raster.md, steps 1-6), extending its last pass when the draw
 // shares that pass's program, buffers, uniforms, rectangle and fragment state.
@@ -374,6 +393,7 @@ void setUpDraw(SetUpDraws& out, const DrawState& state, Topology topology, const
                 continue;
 
             ClTriangle& t = out.triangles.emplace_back();
+            ClTriangleVaryings& tv = out.varyings.emplace_back();
             for (int j = 0; j < 3; ++j) {
                 const WindowVertex& a = *v[j];
                 const WindowVertex& b = *v[(j + 1) % 3];
@@ -385,7 +405,7 @@ void setUpDraw(SetUpDraws& out, const DrawState& state, Topology topology, const
                 t.bias[j] = (dy < 0 || (dy == 0 && dx > 0)) ? 0 : -1;
                 for (int k = 0; k < kMaxAttributes; ++k) {
                     const glm::dvec4& aw = a.attrOverW[k];
-                    t.attr_over_w[j][k] = cl_float4{{f(aw.x), f(aw.y), f(aw.z), f(aw.w)}};
+                    tv.attr_over_w[k][j] = cl_float4{{f(aw.x), f(aw.y), f(aw.z), f(aw.w)}};
                 }
             }
             t.front_facing = front ? 1u : 0u;
@@ -395,8 +415,8 @@ void setUpDraw(SetUpDraws& out, const DrawState& state, Topology topology, const
             t.row_min = py0;
             t.row_max = py1;
             t.pad0 = 0;
-            t.depth = cl_float4{{f(v[0]->depth), f(v[1]->depth), f(v[2]->depth), 0.0f}};
-            t.inv_w = cl_float4{{f(v[0]->invW), f(v[1]->invW), f(v[2]->invW), 0.0f}};
+            tv.depth = cl_float4{{f(v[0]->depth), f(v[1]->depth), f(v[2]->depth), 0.0f}};
+            tv.inv_w = cl_float4{{f(v[0]->invW), f(v[1]->invW), f(v[2]->invW), 0.0f}};
         }
     }
     pass.endTriangle = out.triangles.size();
@@ -414,30 +434,34 @@ TileGrid tileGrid(const std::vector<ClTriangle>& triangles, const Pass& pass)
     return small ? TileGrid{pass.rect, CLVR_PIXELS_PER_ITEM, 1} : TileGrid{pass.rect, CLVR_TILE_SIZE, CLVR_TILE_SIZE};
 }
 
-// Tile lists of one pass in submission order (count, prefix sum, fill), appended to the staging arrays:
-// tile t's triangles are tileTris[tileStarts[base + t] .. tileStarts[base + t + 1]). Returns base.
+// Tile lists of one pass in submission order, appended to the staging arrays: tile t's triangles are
+// tileTris[tileStarts[base + t] .. tileStarts[base + t + 1]). A counting sort: one walk over the
+// triangles records each (tile, triangle) pair in `pairs` and counts per tile, a prefix sum gives the
+// starts, and the pairs, still in submission order, are scattered into place. Returns base.
 std::size_t binPass(const std::vector<ClTriangle>& triangles, const Pass& pass, const TileGrid& grid,
-                    std::vector<cl_uint>& tileStarts, std::vector<cl_uint>& tileTris)
+                    std::vector<cl_uint>& tileStarts, std::vector<cl_uint>& tileTris,
+                    std::vector<std::array<cl_uint, 2>>& pairs)
 {
     const int tilesX = grid.tilesX();
     const std::size_t tileCount = static_cast<std::size_t>(tilesX) * grid.tilesY();
     const std::size_t base = tileStarts.size();
     tileStarts.resize(base + tileCount + 1, 0);
     cl_uint* start = tileStarts.data() + base;
-    const auto each = [&](auto&& visit) {
-        for (std::size_t i = pass.firstTriangle; i < pass.endTriangle; ++i) {
-            const ClTriangle& t = triangles[i];
-            const int tx0 = (t.col_min - grid.rect.x) / grid.tileW, tx1 = (t.col_max - grid.rect.x) / grid.tileW;
-            const int ty0 = (t.row_min - grid.rect.y) / grid.tileH, ty1 = (t.row_max - grid.rect.y) / grid.tileH;
-            // One tile holds every center the triangle can cover: the corner test could only drop it.
-            const bool single = tx0 == tx1 && ty0 == ty1;
-            for (int ty = ty0; ty <= ty1; ++ty)
-                for (int tx = tx0; tx <= tx1; ++tx)
-                    if (single || touches(t, grid, tx, ty))
-                        visit(i, static_cast<std::size_t>(ty) * tilesX + tx);
-        }
-    };
-    each([&](std::size_t, std::size_t tile) { ++start[tile + 1]; });
+    pairs.clear();
+    for (std::size_t i = pass.firstTriangle; i < pass.endTriangle; ++i) {
+        const ClTriangle& t = triangles[i];
+        const int tx0 = (t.col_min - grid.rect.x) / grid.tileW, tx1 = (t.col_max - grid.rect.x) / grid.tileW;
+        const int ty0 = (t.row_min - grid.rect.y) / grid.tileH, ty1 = (t.row_max - grid.rect.y) / grid.tileH;
+        // One tile holds every center the triangle can cover: the corner test could only drop it.
+        const bool single = tx0 == tx1 && ty0 == ty1;
+        for (int ty = ty0; ty <= ty1; ++ty)
+            for (int tx = tx0; tx <= tx1; ++tx)
+                if (single || touches(t, grid, tx, ty)) {
+                    const auto tile = static_cast<cl_uint>(static_cast<std::size_t>(ty) * tilesX + tx);
+                    ++start[tile + 1];
+                    pairs.push_back({tile, static_cast<cl_uint>(i)});
+                }
+    }
     std::uint64_t entries = tileTris.size();
     start[0] = static_cast<cl_uint>(entries);
     for (std::size_t i = 0; i < tileCount; ++i) {
@@ -448,7 +472,8 @@ std::size_t binPass(const std::vector<ClTriangle>& triangles, const Pass& pass, 
     }
     std::vector<cl_uint> cursor(start, start + tileCount);
     tileTris.resize(entries);
-    each([&](std::size_t triangle, std::size_t tile) { tileTris[cursor[tile]++] = static_cast<cl_uint>(triangle); });
+    for (const auto& [tile, triangle] : pairs)
+        tileTris[cursor[tile]++] = triangle;
     return base;
 }
 
@@ -551,10 +576,12 @@ void Rasterizer::submit(Framebuffer& fb, SetUpDraws& draws)
         grids.push_back(tileGrid(draws.triangles, pass));
         bases.push_back(pass.firstTriangle == pass.endTriangle || pass.rect.width == 0 || pass.rect.height == 0
                             ? std::size_t(-1)
-                            : binPass(draws.triangles, pass, grids.back(), s.stagedTileStarts, s.stagedTileTris));
+                            : binPass(draws.triangles, pass, grids.back(), s.stagedTileStarts, s.stagedTileTris,
+                                      s.binPairs));
     }
     // This submission's triangles and uniforms become the staging; the caller refills the old staging.
     s.stagedTriangles.swap(draws.triangles);
+    s.stagedVaryings.swap(draws.varyings);
     s.stagedUniforms.swap(draws.uniforms);
 
     const auto upload = [&](std::string_view what, cl::Buffer& buffer, std::size_t& capacity, const auto& data,
@@ -568,6 +595,7 @@ void Rasterizer::submit(Framebuffer& fb, SetUpDraws& draws)
         }
     };
     upload("raster triangles", s.triangles, s.triangleBytes, s.stagedTriangles, CL_MEM_READ_ONLY);
+    upload("raster triangle varyings", s.varyings, s.varyingBytes, s.stagedVaryings, CL_MEM_READ_ONLY);
     upload("raster tile starts", s.tileStarts, s.tileStartBytes, s.stagedTileStarts, CL_MEM_READ_ONLY);
     upload("raster tile lists", s.tileTris, s.tileTrisBytes, s.stagedTileTris, CL_MEM_READ_ONLY);
     upload("fragment program uniforms", s.uniforms, s.uniformBytes, s.stagedUniforms, CL_MEM_READ_ONLY);
@@ -593,6 +621,7 @@ void Rasterizer::submit(Framebuffer& fb, SetUpDraws& draws)
         k.setArg(arg++, static_cast<cl_int>(grids[i].tilesX()));
         k.setArg(arg++, static_cast<cl_uint>(bases[i]));
         k.setArg(arg++, s.triangles);
+        k.setArg(arg++, s.varyings);
         k.setArg(arg++, s.tileStarts);
         k.setArg(arg++, s.tileTris);
         k.setArg(arg++, pass.fragment);
@@ -629,9 +658,10 @@ DrawBatch::DrawBatch(Rasterizer& rasterizer, Framebuffer& fb)
 {
     draws_->fbWidth = fb.width();
     draws_->fbHeight = fb.height();
+    lendCapacity(*rasterizer_.immediate_, *draws_);
 }
 
-DrawBatch::~DrawBatch() = default;
+DrawBatch::~DrawBatch() { lendCapacity(*draws_, *rasterizer_.immediate_); }
 
 void DrawBatch::add(const DrawState& state, Topology topology, const std::vector<Vertex>& vertices,
                     const FragmentProgram& program)
