@@ -75,7 +75,7 @@ typedef struct {
     float4 base, c_src, c_dst, c_src_a, c_dst_a, c_sat;
 } ClvrBlendFactor;
 
-__attribute__((always_inline)) void clvr_factor_channel(uint f, float4 k, int ch, ClvrBlendFactor* out)
+void clvr_factor_channel(uint f, float4 k, int ch, ClvrBlendFactor* out)
 {
     float base = 0.0f, cs = 0.0f, cd = 0.0f, csa = 0.0f, cda = 0.0f, csat = 0.0f;
     const float kc = ch == 0 ? k.x : ch == 1 ? k.y : ch == 2 ? k.z : k.w;
@@ -110,7 +110,7 @@ __attribute__((always_inline)) void clvr_factor_channel(uint f, float4 k, int ch
 }
 
 /* The source or destination factor: rgb from rgb_factor, alpha from alpha_factor. */
-__attribute__((always_inline)) ClvrBlendFactor clvr_blend_factor_setup(uint rgb_factor, uint alpha_factor, float4 k)
+ClvrBlendFactor clvr_blend_factor_setup(uint rgb_factor, uint alpha_factor, float4 k)
 {
     ClvrBlendFactor f;
     for (int ch = 0; ch < 3; ++ch)
@@ -133,7 +133,7 @@ typedef struct {
     int4 use_min, use_max;
 } ClvrBlend;
 
-__attribute__((always_inline)) void clvr_equation_channel(uint eq, float* ss, float* sd, int* mn, int* mx)
+void clvr_equation_channel(uint eq, float* ss, float* sd, int* mn, int* mx)
 {
     *ss = eq == CLVR_BLEND_REVERSE_SUBTRACT ? -1.0f : 1.0f;
     *sd = eq == CLVR_BLEND_SUBTRACT ? -1.0f : 1.0f;
@@ -141,7 +141,7 @@ __attribute__((always_inline)) void clvr_equation_channel(uint eq, float* ss, fl
     *mx = eq == CLVR_BLEND_MAX ? -1 : 0;
 }
 
-__attribute__((always_inline)) ClvrBlend clvr_blend_setup(const ClBlendState* b)
+ClvrBlend clvr_blend_setup(const ClBlendState* b)
 {
     ClvrBlend r;
     r.src = clvr_blend_factor_setup(b->src_rgb, b->src_alpha, b->color);
@@ -171,9 +171,9 @@ long clvr_edge(int xa, int ya, int xb, int yb, int px, int py)
     return (long)(xb - xa) * (long)(py - ya) - (long)(yb - ya) * (long)(px - xa);
 }
 
-/* One fragment of triangle t (its varyings v) at pixel (px, py) with exact edge values e0..e2, through GL's
+/* One fragment of triangle t at pixel (px, py) with exact edge values e0..e2, through GL's
  * per-fragment operations against the pixel's color c, depth d and stencil s (kept in registers). */
-__attribute__((always_inline)) void clvr_shade(global const ClTriangle* t, global const ClTriangleVaryings* v, long e0, long e1, long e2, int px, int py,
+__attribute__((always_inline)) void clvr_shade(global const ClTriangle* t, long e0, long e1, long e2, int px, int py,
                                                const ClFragmentState* fs, const ClBlendState* bs,
                                                const ClvrBlend* blend, int4 write_mask,
                                                const ClFragmentResources* resources, float4* c, float* d, uint* s)
@@ -185,11 +185,11 @@ __attribute__((always_inline)) void clvr_shade(global const ClTriangle* t, globa
     const float l2 = (float)e0 * t->inv_area;
     ClFragment f;
     f.window = (float2)((float)px + 0.5f, (float)py + 0.5f);
-    f.depth = l0 * v->depth.x + l1 * v->depth.y + l2 * v->depth.z;
+    f.depth = l0 * t->depth.x + l1 * t->depth.y + l2 * t->depth.z;
     f.front_facing = (int)t->front_facing;
-    const float q = 1.0f / (l0 * v->inv_w.x + l1 * v->inv_w.y + l2 * v->inv_w.z);
+    const float q = 1.0f / (l0 * t->inv_w.x + l1 * t->inv_w.y + l2 * t->inv_w.z);
     for (int k = 0; k < CLVR_MAX_ATTRIBUTES; ++k)
-        f.attr[k] = (l0 * v->attr_over_w[k][0] + l1 * v->attr_over_w[k][1] + l2 * v->attr_over_w[k][2]) * q;
+        f.attr[k] = (l0 * t->attr_over_w[0][k] + l1 * t->attr_over_w[1][k] + l2 * t->attr_over_w[2][k]) * q;
 
     float4 src;
     if (!clvr_fragment(&f, resources, &src))
@@ -231,7 +231,6 @@ __attribute__((always_inline)) void clvr_shade(global const ClTriangle* t, globa
 kernel void raster_fragments(global float4* color, global float* depth, global uchar* stencil, const int fb_width,
                              const int rect_x, const int rect_y, const int rect_w, const int rect_h,
                              const int tile_w_log2, const int tile_h_log2, const int tiles_x, const uint tile_base, global const ClTriangle* tris,
-                             global const ClTriangleVaryings* varyings,
                              global const uint* tile_start, global const uint* tile_tris, const ClFragmentState fs,
                              const ClBlendState bs, constant float4* uniforms, const uint uniform_base,
                              global const float* buffer0,
@@ -279,8 +278,7 @@ kernel void raster_fragments(global float4* color, global float* depth, global u
     }
 
     for (uint i = begin; i < end; ++i) {
-        const uint index = tile_tris[i];
-        global const ClTriangle* t = tris + index;
+        global const ClTriangle* t = tris + tile_tris[i];
         const int col_min = t->col_min, col_max = t->col_max;
         if (py < t->row_min || py > t->row_max || px1 < col_min || px0 > col_max)
             continue;
@@ -299,7 +297,7 @@ kernel void raster_fragments(global float4* color, global float* depth, global u
             if (px0 + p >= col_min && px0 + p <= col_max && e0 + t->bias[0] >= 0 && e1 + t->bias[1] >= 0 &&
                 e2 + t->bias[2] >= 0) {
                 ++covered;
-                clvr_shade(t, varyings + index, e0, e1, e2, px0 + p, py, &fs, &bs, &blend, write_mask, &resources, &c[p], &d[p], &s[p]);
+                clvr_shade(t, e0, e1, e2, px0 + p, py, &fs, &bs, &blend, write_mask, &resources, &c[p], &d[p], &s[p]);
             }
             e0 += step0;
             e1 += step1;
@@ -342,12 +340,11 @@ kernel void raster_layout_probe(global uint* out)
     CLVR_PROBE_OFFSET(11, ClTriangle, bias);
     CLVR_PROBE_OFFSET(12, ClTriangle, front_facing);
     CLVR_PROBE_OFFSET(13, ClTriangle, inv_area);
-    CLVR_PROBE_OFFSET(14, ClTriangleVaryings, depth);
-    CLVR_PROBE_OFFSET(15, ClTriangleVaryings, inv_w);
-    CLVR_PROBE_OFFSET(16, ClTriangleVaryings, attr_over_w);
+    CLVR_PROBE_OFFSET(14, ClTriangle, depth);
+    CLVR_PROBE_OFFSET(15, ClTriangle, inv_w);
+    CLVR_PROBE_OFFSET(16, ClTriangle, attr_over_w);
     CLVR_PROBE_SIZE(17, ClTexture);
     CLVR_PROBE_OFFSET(18, ClTexture, border);
     CLVR_PROBE_OFFSET(19, ClTriangle, col_min);
     CLVR_PROBE_OFFSET(20, ClTriangle, row_max);
-    CLVR_PROBE_SIZE(21, ClTriangleVaryings);
 }

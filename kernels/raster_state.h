@@ -92,9 +92,8 @@ typedef struct {
     cl_uint pad0;
 } ClBlendState; /* 48 bytes */
 
-/* One set-up triangle after clipping, projection, viewport transform and snapping: what coverage
- * needs, one 64-byte record (one cache line), read for every tile entry. Vertices are ordered so that
- * the edge functions are positive inside (clockwise on the row-down screen). */
+/* One set-up triangle after clipping, projection, viewport transform and snapping. Vertices are
+ * ordered so that the edge functions are positive inside (clockwise on the row-down screen). */
 typedef struct {
     cl_int x[3], y[3];  /* window position in 1/CLVR_SUBPIXEL_SCALE pixels, row-down */
     cl_int bias[3];     /* fill rule: 0 for a top or left edge (i -> i+1), -1 otherwise */
@@ -104,15 +103,9 @@ typedef struct {
      * inclusive): a work-item skips the triangle outside them, and no pixel outside is ever visited. */
     cl_int col_min, col_max, row_min, row_max;
     cl_uint pad0;
-} ClTriangle; /* 64 bytes */
-
-/* The same triangle's values to interpolate, in a buffer of their own at the same index: read only
- * for covered pixels. */
-typedef struct {
     cl_float4 depth;    /* window depth of vertices 0..2 in .x .y .z */
     cl_float4 inv_w;    /* 1 / clip w of vertices 0..2 in .x .y .z */
-    /* attribute k / clip w of vertices 0..2, attribute-major: what one attribute needs is adjacent */
-    cl_float4 attr_over_w[CLVR_MAX_ATTRIBUTES][3];
-} ClTriangleVaryings; /* 224 bytes */
+    cl_float4 attr_over_w[3][CLVR_MAX_ATTRIBUTES]; /* attribute / clip w, per vertex */
+} ClTriangle; /* 288 bytes */
 
 #endif

@@ -14,9 +14,9 @@
 
 namespace clvr::raster {
 
-static_assert(sizeof(ClTriangle) == 64, "one cache line; also probed on the device by tests/layout_test.cpp");
-static_assert(sizeof(ClTriangleVaryings) == 224);
-static_assert(offsetof(ClTriangleVaryings, attr_over_w) == 32);
+static_assert(sizeof(ClTriangle) == 288, "also probed on the device by tests/layout_test.cpp");
+static_assert(offsetof(ClTriangle, depth) == 64);
+static_assert(offsetof(ClTriangle, attr_over_w) == 96);
 
 namespace {
 
@@ -194,7 +194,6 @@ struct Pass {
 struct SetUpDraws {
     int fbWidth = 0, fbHeight = 0;
     std::vector<ClTriangle> triangles;  // set up, in submission order
-    std::vector<ClTriangleVaryings> varyings;  // varyings[i] belongs to triangles[i]
     std::vector<Pass> passes;
     std::vector<cl_float4> uniforms;
     std::uint64_t setUp = 0;            // DrawStats::triangles: also those whose pixel box is empty
@@ -205,7 +204,6 @@ struct SetUpDraws {
     void clear()
     {
         triangles.clear();
-        varyings.clear();
         passes.clear();
         uniforms.clear();
         setUp = 0;
@@ -216,10 +214,9 @@ struct SetUpDraws {
 // Everything a Rasterizer keeps between draws. Host staging is uploaded without blocking, so it is
 // only refilled after the uploads that read it have completed (uploadsDone).
 struct RasterScratch {
-    cl::Buffer triangles, varyings, tileStarts, tileTris, uniforms, fragmentCounts, dummy;
-    std::size_t triangleBytes = 0, varyingBytes = 0, tileStartBytes = 0, tileTrisBytes = 0, uniformBytes = 0;
+    cl::Buffer triangles, tileStarts, tileTris, uniforms, fragmentCounts, dummy;
+    std::size_t triangleBytes = 0, tileStartBytes = 0, tileTrisBytes = 0, uniformBytes = 0;
     std::vector<ClTriangle> stagedTriangles;
-    std::vector<ClTriangleVaryings> stagedVaryings;
     std::vector<cl_uint> stagedTileStarts, stagedTileTris;
     std::vector<std::array<cl_uint, 2>> binPairs;  // binPass's (tile, triangle) scratch
     std::vector<cl_float4> stagedUniforms;
@@ -238,19 +235,16 @@ struct RasterScratch {
 
 namespace {
 
-// Hands the (empty) triangle arrays of `from`, with their capacity, to `to`: a DrawBatch borrows the
-// Rasterizer's, so that a batch per frame does not grow its arrays from nothing (and fault in fresh
+// Hands the (empty) triangle array of `from`, with its capacity, to `to`: a DrawBatch borrows the
+// Rasterizer's, so that a batch per frame does not grow its array from nothing (and fault in fresh
 // pages) every frame. Only the capacity moves; pending draws are never lost.
 void lendCapacity(SetUpDraws& from, SetUpDraws& to)
 {
-    if (!from.triangles.empty() || !from.varyings.empty())
+    if (!from.triangles.empty())
         return;
     to.triangles.clear();
-    to.varyings.clear();
     if (to.triangles.capacity() < from.triangles.capacity())
         to.triangles.swap(from.triangles);
-    if (to.varyings.capacity() < from.varyings.capacity())
-        to.varyings.swap(from.varyings);
 }
 
 // Sets up and bins one draw into `out` (docs/raster.md, steps 1-6), extending its last pass when the draw
@@ -393,7 +387,6 @@ void setUpDraw(SetUpDraws& out, const DrawState& state, Topology topology, const
                 continue;
 
             ClTriangle& t = out.triangles.emplace_back();
-            ClTriangleVaryings& tv = out.varyings.emplace_back();
             for (int j = 0; j < 3; ++j) {
                 const WindowVertex& a = *v[j];
                 const WindowVertex& b = *v[(j + 1) % 3];
@@ -405,7 +398,7 @@ void setUpDraw(SetUpDraws& out, const DrawState& state, Topology topology, const
                 t.bias[j] = (dy < 0 || (dy == 0 && dx > 0)) ? 0 : -1;
                 for (int k = 0; k < kMaxAttributes; ++k) {
                     const glm::dvec4& aw = a.attrOverW[k];
-                    tv.attr_over_w[k][j] = cl_float4{{f(aw.x), f(aw.y), f(aw.z), f(aw.w)}};
+                    t.attr_over_w[j][k] = cl_float4{{f(aw.x), f(aw.y), f(aw.z), f(aw.w)}};
                 }
             }
             t.front_facing = front ? 1u : 0u;
@@ -415,8 +408,8 @@ void setUpDraw(SetUpDraws& out, const DrawState& state, Topology topology, const
             t.row_min = py0;
             t.row_max = py1;
             t.pad0 = 0;
-            tv.depth = cl_float4{{f(v[0]->depth), f(v[1]->depth), f(v[2]->depth), 0.0f}};
-            tv.inv_w = cl_float4{{f(v[0]->invW), f(v[1]->invW), f(v[2]->invW), 0.0f}};
+            t.depth = cl_float4{{f(v[0]->depth), f(v[1]->depth), f(v[2]->depth), 0.0f}};
+            t.inv_w = cl_float4{{f(v[0]->invW), f(v[1]->invW), f(v[2]->invW), 0.0f}};
         }
     }
     pass.endTriangle = out.triangles.size();
@@ -581,7 +574,6 @@ void Rasterizer::submit(Framebuffer& fb, SetUpDraws& draws)
     }
     // This submission's triangles and uniforms become the staging; the caller refills the old staging.
     s.stagedTriangles.swap(draws.triangles);
-    s.stagedVaryings.swap(draws.varyings);
     s.stagedUniforms.swap(draws.uniforms);
 
     const auto upload = [&](std::string_view what, cl::Buffer& buffer, std::size_t& capacity, const auto& data,
@@ -595,7 +587,6 @@ void Rasterizer::submit(Framebuffer& fb, SetUpDraws& draws)
         }
     };
     upload("raster triangles", s.triangles, s.triangleBytes, s.stagedTriangles, CL_MEM_READ_ONLY);
-    upload("raster triangle varyings", s.varyings, s.varyingBytes, s.stagedVaryings, CL_MEM_READ_ONLY);
     upload("raster tile starts", s.tileStarts, s.tileStartBytes, s.stagedTileStarts, CL_MEM_READ_ONLY);
     upload("raster tile lists", s.tileTris, s.tileTrisBytes, s.stagedTileTris, CL_MEM_READ_ONLY);
     upload("fragment program uniforms", s.uniforms, s.uniformBytes, s.stagedUniforms, CL_MEM_READ_ONLY);
@@ -621,7 +612,6 @@ void Rasterizer::submit(Framebuffer& fb, SetUpDraws& draws)
         k.setArg(arg++, static_cast<cl_int>(grids[i].tilesX()));
         k.setArg(arg++, static_cast<cl_uint>(bases[i]));
         k.setArg(arg++, s.triangles);
-        k.setArg(arg++, s.varyings);
         k.setArg(arg++, s.tileStarts);
         k.setArg(arg++, s.tileTris);
         k.setArg(arg++, pass.fragment);

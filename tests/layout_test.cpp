@@ -50,14 +50,13 @@ TEST(Layout, DeviceAndHostAgreeOnEveryClStruct)
         {"offsetof(ClTriangle, bias)", offsetof(ClTriangle, bias)},
         {"offsetof(ClTriangle, front_facing)", offsetof(ClTriangle, front_facing)},
         {"offsetof(ClTriangle, inv_area)", offsetof(ClTriangle, inv_area)},
-        {"offsetof(ClTriangleVaryings, depth)", offsetof(ClTriangleVaryings, depth)},
-        {"offsetof(ClTriangleVaryings, inv_w)", offsetof(ClTriangleVaryings, inv_w)},
-        {"offsetof(ClTriangleVaryings, attr_over_w)", offsetof(ClTriangleVaryings, attr_over_w)},
+        {"offsetof(ClTriangle, depth)", offsetof(ClTriangle, depth)},
+        {"offsetof(ClTriangle, inv_w)", offsetof(ClTriangle, inv_w)},
+        {"offsetof(ClTriangle, attr_over_w)", offsetof(ClTriangle, attr_over_w)},
         {"sizeof(ClTexture)", sizeof(ClTexture)},
         {"offsetof(ClTexture, border)", offsetof(ClTexture, border)},
         {"offsetof(ClTriangle, col_min)", offsetof(ClTriangle, col_min)},
         {"offsetof(ClTriangle, row_max)", offsetof(ClTriangle, row_max)},
-        {"sizeof(ClTriangleVaryings)", sizeof(ClTriangleVaryings)},
     };
     for (std::size_t i = 0; i < std::size(want); ++i)
         EXPECT_EQ(got[i], want[i].second) << want[i].first << ": device " << got[i] << ", host " << want[i].second;
