@@ -218,6 +218,7 @@ struct RasterScratch {
     std::size_t triangleBytes = 0, tileStartBytes = 0, tileTrisBytes = 0, uniformBytes = 0;
     std::vector<ClTriangle> stagedTriangles;
     std::vector<cl_uint> stagedTileStarts, stagedTileTris;
+    std::vector<std::array<cl_uint, 2>> binPairs;  // binPass's (tile, triangle) scratch
     std::vector<cl_float4> stagedUniforms;
     std::vector<cl::Event> uploads;
     std::size_t maxUniforms = 0;  // the device's constant buffer size in float4s
@@ -233,6 +234,18 @@ struct RasterScratch {
 };
 
 namespace {
+
+// Hands the (empty) triangle array of `from`, with its capacity, to `to`: a DrawBatch borrows the
+// Rasterizer's, so that a batch per frame does not grow its array from nothing (and fault in fresh
+// pages) every frame. Only the capacity moves; pending draws are never lost.
+void lendCapacity(SetUpDraws& from, SetUpDraws& to)
+{
+    if (!from.triangles.empty())
+        return;
+    to.triangles.clear();
+    if (to.triangles.capacity() < from.triangles.capacity())
+        to.triangles.swap(from.triangles);
+}
 
 // Sets up and bins one draw into `out` (docs/raster.md, steps 1-6), extending its last pass when the draw
 // shares that pass's program, buffers, uniforms, rectangle and fragment state.
@@ -414,30 +427,34 @@ TileGrid tileGrid(const std::vector<ClTriangle>& triangles, const Pass& pass)
     return small ? TileGrid{pass.rect, CLVR_PIXELS_PER_ITEM, 1} : TileGrid{pass.rect, CLVR_TILE_SIZE, CLVR_TILE_SIZE};
 }
 
-// Tile lists of one pass in submission order (count, prefix sum, fill), appended to the staging arrays:
-// tile t's triangles are tileTris[tileStarts[base + t] .. tileStarts[base + t + 1]). Returns base.
+// Tile lists of one pass in submission order, appended to the staging arrays: tile t's triangles are
+// tileTris[tileStarts[base + t] .. tileStarts[base + t + 1]). A counting sort: one walk over the
+// triangles records each (tile, triangle) pair in `pairs` and counts per tile, a prefix sum gives the
+// starts, and the pairs, still in submission order, are scattered into place. Returns base.
 std::size_t binPass(const std::vector<ClTriangle>& triangles, const Pass& pass, const TileGrid& grid,
-                    std::vector<cl_uint>& tileStarts, std::vector<cl_uint>& tileTris)
+                    std::vector<cl_uint>& tileStarts, std::vector<cl_uint>& tileTris,
+                    std::vector<std::array<cl_uint, 2>>& pairs)
 {
     const int tilesX = grid.tilesX();
     const std::size_t tileCount = static_cast<std::size_t>(tilesX) * grid.tilesY();
     const std::size_t base = tileStarts.size();
     tileStarts.resize(base + tileCount + 1, 0);
     cl_uint* start = tileStarts.data() + base;
-    const auto each = [&](auto&& visit) {
-        for (std::size_t i = pass.firstTriangle; i < pass.endTriangle; ++i) {
-            const ClTriangle& t = triangles[i];
-            const int tx0 = (t.col_min - grid.rect.x) / grid.tileW, tx1 = (t.col_max - grid.rect.x) / grid.tileW;
-            const int ty0 = (t.row_min - grid.rect.y) / grid.tileH, ty1 = (t.row_max - grid.rect.y) / grid.tileH;
-            // One tile holds every center the triangle can cover: the corner test could only drop it.
-            const bool single = tx0 == tx1 && ty0 == ty1;
-            for (int ty = ty0; ty <= ty1; ++ty)
-                for (int tx = tx0; tx <= tx1; ++tx)
-                    if (single || touches(t, grid, tx, ty))
-                        visit(i, static_cast<std::size_t>(ty) * tilesX + tx);
-        }
-    };
-    each([&](std::size_t, std::size_t tile) { ++start[tile + 1]; });
+    pairs.clear();
+    for (std::size_t i = pass.firstTriangle; i < pass.endTriangle; ++i) {
+        const ClTriangle& t = triangles[i];
+        const int tx0 = (t.col_min - grid.rect.x) / grid.tileW, tx1 = (t.col_max - grid.rect.x) / grid.tileW;
+        const int ty0 = (t.row_min - grid.rect.y) / grid.tileH, ty1 = (t.row_max - grid.rect.y) / grid.tileH;
+        // One tile holds every center the triangle can cover: the corner test could only drop it.
+        const bool single = tx0 == tx1 && ty0 == ty1;
+        for (int ty = ty0; ty <= ty1; ++ty)
+            for (int tx = tx0; tx <= tx1; ++tx)
+                if (single || touches(t, grid, tx, ty)) {
+                    const auto tile = static_cast<cl_uint>(static_cast<std::size_t>(ty) * tilesX + tx);
+                    ++start[tile + 1];
+                    pairs.push_back({tile, static_cast<cl_uint>(i)});
+                }
+    }
     std::uint64_t entries = tileTris.size();
     start[0] = static_cast<cl_uint>(entries);
     for (std::size_t i = 0; i < tileCount; ++i) {
@@ -448,7 +465,8 @@ std::size_t binPass(const std::vector<ClTriangle>& triangles, const Pass& pass, 
     }
     std::vector<cl_uint> cursor(start, start + tileCount);
     tileTris.resize(entries);
-    each([&](std::size_t triangle, std::size_t tile) { tileTris[cursor[tile]++] = static_cast<cl_uint>(triangle); });
+    for (const auto& [tile, triangle] : pairs)
+        tileTris[cursor[tile]++] = triangle;
     return base;
 }
 
@@ -551,7 +569,8 @@ void Rasterizer::submit(Framebuffer& fb, SetUpDraws& draws)
         grids.push_back(tileGrid(draws.triangles, pass));
         bases.push_back(pass.firstTriangle == pass.endTriangle || pass.rect.width == 0 || pass.rect.height == 0
                             ? std::size_t(-1)
-                            : binPass(draws.triangles, pass, grids.back(), s.stagedTileStarts, s.stagedTileTris));
+                            : binPass(draws.triangles, pass, grids.back(), s.stagedTileStarts, s.stagedTileTris,
+                                      s.binPairs));
     }
     // This submission's triangles and uniforms become the staging; the caller refills the old staging.
     s.stagedTriangles.swap(draws.triangles);
@@ -629,9 +648,10 @@ DrawBatch::DrawBatch(Rasterizer& rasterizer, Framebuffer& fb)
 {
     draws_->fbWidth = fb.width();
     draws_->fbHeight = fb.height();
+    lendCapacity(*rasterizer_.immediate_, *draws_);
 }
 
-DrawBatch::~DrawBatch() = default;
+DrawBatch::~DrawBatch() { lendCapacity(*draws_, *rasterizer_.immediate_); }
 
 void DrawBatch::add(const DrawState& state, Topology topology, const std::vector<Vertex>& vertices,
                     const FragmentProgram& program)

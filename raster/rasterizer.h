@@ -126,6 +126,7 @@ private:
 // pass, so it takes effect exactly where it was added). Every pixel sees its fragments in add() order,
 // so a batch gives the same bits as the same draws one by one. Nothing enqueued between add() and
 // flush() (a clear, say) runs after the batch's draws: flush first. Draws not flushed are dropped.
+// The batch borrows the Rasterizer's host arrays while it lives, so the Rasterizer must outlive it.
 class DrawBatch {
 public:
     DrawBatch(Rasterizer& rasterizer, Framebuffer& fb);
