@@ -25,7 +25,7 @@ Camera sceneCamera(const Scene& scene, const SceneData& data)
 {
     if (scene.camera)
         return *scene.camera;
-    if (!scene.mesh.is_null())
+    if (scene.mesh)
         return fitCamera(data.mesh.boundsMin(), data.mesh.boundsMax());
     return fitCamera(data.volume.boundsMin(), data.volume.boundsMax());
 }
@@ -43,10 +43,10 @@ SceneData loadSceneData(const Scene& scene)
 {
     const Clock::time_point t0 = Clock::now();
     SceneData data;
-    if (!scene.volume.is_null())
-        data.volume = loadVolume(scene.volume, scene.baseDir);
-    if (!scene.mesh.is_null())
-        data.mesh = loadMesh(scene.mesh, scene.baseDir);
+    if (scene.volume)
+        data.volume = loadVolume(*scene.volume);
+    if (scene.mesh)
+        data.mesh = loadMesh(*scene.mesh);
     data.loadMs = msSince(t0);
     return data;
 }

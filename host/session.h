@@ -25,7 +25,7 @@ struct SceneData {
     double loadMs = 0.0;  // wall time of the load
 };
 
-// Loads scene.volume or scene.mesh (paths relative to scene.baseDir). InputError naming the file.
+// Loads what scene.volume or scene.mesh names (paths resolved at parse time). InputError naming the file.
 SceneData loadSceneData(const Scene& scene);
 
 // One rendered frame: the image and what the frame did. stats.frameMs is the renderer's own time, or
@@ -68,7 +68,7 @@ public:
     const Scene& scene() const { return scene_; }
     const Camera& camera() const { return *scene_.camera; }
     const SceneData& data() const { return data_; }
-    bool isMesh() const { return !scene_.mesh.is_null(); }
+    bool isMesh() const { return scene_.mesh.has_value(); }
     Device& device() { return *device_; }
     const Renderer& renderer() const { return *renderer_; }
     // Wall time of the latest renderer set-up (upload, kernel builds), in ms.

@@ -85,12 +85,13 @@ TEST(BenchMesh, BluntfinScenesHaveTheStatedControlPointsAndImageSize)
         EXPECT_EQ(scene.image.width, 512) << name;
         EXPECT_EQ(scene.image.height, 512) << name;
         EXPECT_FALSE(scene.camera) << name << ": like data/scenes/bluntfin.json, the camera is fitted to the mesh";
-        ASSERT_TRUE(scene.mesh.is_object()) << name;
-        EXPECT_EQ(scene.mesh.value("scalar", std::string()), "density") << name;
+        ASSERT_TRUE(scene.mesh.has_value()) << name;
+        EXPECT_EQ(scene.mesh->kind, clvr::MeshSpec::Kind::Plot3d) << name;
+        EXPECT_EQ(scene.mesh->scalar, "density") << name;
         // The same data as data/scenes/bluntfin.json (whose paths are one folder shallower).
         const clvr::Scene reference = clvr::loadScene(std::filesystem::path(CLVR_SOURCE_DIR) / "data/scenes/bluntfin.json");
-        EXPECT_EQ(std::filesystem::weakly_canonical(scene.baseDir / scene.mesh["file"].get<std::string>()),
-                  std::filesystem::weakly_canonical(reference.baseDir / reference.mesh["file"].get<std::string>()))
+        ASSERT_TRUE(reference.mesh.has_value());
+        EXPECT_EQ(std::filesystem::weakly_canonical(scene.mesh->file), std::filesystem::weakly_canonical(reference.mesh->file))
             << name;
         // Equal steps of s over the same range, so the two differ only in how finely they split a cell.
         const auto& p = scene.transferFunction.points();
@@ -111,8 +112,8 @@ TEST(BenchMesh, TetgenSceneMeshesToAMillionTetrahedra)
     EXPECT_EQ(scene.image.width, 512);
     EXPECT_EQ(scene.image.height, 512);
     ASSERT_TRUE(scene.camera);
-    ASSERT_TRUE(scene.mesh.contains("surface"));
-    const clvr::TetMesh mesh = clvr::loadMesh(scene.mesh, scene.baseDir);
+    ASSERT_TRUE(scene.mesh && scene.mesh->kind == clvr::MeshSpec::Kind::Surface);
+    const clvr::TetMesh mesh = clvr::loadMesh(*scene.mesh);
     EXPECT_GE(mesh.tets.size(), 1000000u);
     EXPECT_EQ(mesh.tetsDegenerate, 0u);
     EXPECT_EQ(mesh.scalars.size(), mesh.points.size());
@@ -175,8 +176,8 @@ TEST(BenchMesh, MeshCacheReturnsTheMeshTetgenMade)
     EXPECT_EQ(cached.tetsRead, made.tetsRead);
 
     clvr::Scene other = scene;
-    other.mesh["max_volume"] = 0.004;
-    EXPECT_NE(clvr::tools::meshCacheKey(other.mesh, other.baseDir), clvr::tools::meshCacheKey(scene.mesh, scene.baseDir));
+    other.mesh->maxVolume = 0.004;
+    EXPECT_NE(clvr::tools::meshCacheKey(*other.mesh), clvr::tools::meshCacheKey(*scene.mesh));
     clvr::tools::loadBenchMesh(other, "small", dir / "cache", progress);
     EXPECT_EQ(meshed, 2);
 }
@@ -219,7 +220,7 @@ TEST(BenchMesh, BluntfinScenesRenderAndMoreSegmentsSplitMore)
 {
     const clvr::Scene scene10 = clvr::loadScene(benchScene("harc-bluntfin-10.json"), {"image={\"width\":24,\"height\":20}"});
     const clvr::Scene scene255 = clvr::loadScene(benchScene("harc-bluntfin-255.json"), {"image={\"width\":24,\"height\":20}"});
-    const clvr::TetMesh mesh = clvr::loadMesh(scene10.mesh, scene10.baseDir);
+    const clvr::TetMesh mesh = clvr::loadMesh(*scene10.mesh);
     clvr::FrameStats stats10, stats255;
     const clvr::Image4f image10 = clvr::makeMeshRenderer(clvr::test::device(), scene10, mesh)->render(stats10);
     const clvr::Image4f image255 = clvr::makeMeshRenderer(clvr::test::device(), scene255, mesh)->render(stats255);

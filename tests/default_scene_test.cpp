@@ -21,7 +21,7 @@ using namespace clvr;
 TEST(DefaultScene, MatchesReferenceIntegral)
 {
     const Scene scene = defaultScene({"image.width=48", "image.height=48"});
-    const Volume volume = loadVolume(scene.volume, scene.baseDir);
+    const Volume volume = loadVolume(*scene.volume);
     ASSERT_TRUE(scene.camera.has_value());
 
     auto renderer = makeRenderer(test::device(), scene, volume);

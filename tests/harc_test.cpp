@@ -800,7 +800,7 @@ void checkShippedScene(const char* name, const Camera& through)
 {
     Scene scene = loadScene(test::repoData(std::string("scenes/") + name));
     scene.image.width = scene.image.height = 64;
-    const TetMesh mesh = loadMesh(scene.mesh, scene.baseDir);
+    const TetMesh mesh = loadMesh(*scene.mesh);
     const TetTopology topology = buildTopology(mesh);
     Camera parallel = through;
     parallel.parallel = true;

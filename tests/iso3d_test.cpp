@@ -689,7 +689,7 @@ TEST(Iso3dHeadlight, HeadsqSkinIsLitWithoutALight)
     const Scene scene = loadScene(test::repoData("scenes/headsq.json"),
                                   {"technique=iso3d", "iso.value=1150", "image.width=96", "image.height=96",
                                    "options.slices=128"});
-    const Volume volume = loadVolume(scene.volume, scene.baseDir);
+    const Volume volume = loadVolume(*scene.volume);
     FrameStats stats;
     const Image4f image = makeRenderer(test::device(), scene, volume)->render(stats);
     std::size_t covered = 0;

@@ -459,7 +459,7 @@ TEST(SphericalRender, AtmosphereSceneFileRenders)
                                   {"image={\"width\":32,\"height\":32,\"background\":[0,0,0.02]}",
                                    "volume.dims=[33,17,12]", "options.shells=48", "options.segments=96"});
     ASSERT_EQ(scene.technique, "spherical");
-    const Volume volume = loadVolume(scene.volume, scene.baseDir);
+    const Volume volume = loadVolume(*scene.volume);
     const Image4f image = test::renderScene(scene, volume);
     const SphericalOptions options = parseSphericalOptions(scene.options);
     const Image4d reference = sphericalReferenceIntegral(volume, scene.transferFunction, *scene.camera, scene.image,

@@ -483,7 +483,7 @@ int bench(const BenchOptions& options)
         const std::string name = scenePath.stem().string();
         const fs::path prefix = outDir / ("bench." + name);
         const Scene scene = loadScene(scenePath, options.overrides, options.unsets);
-        if (!scene.mesh.is_null()) {
+        if (scene.mesh) {
             report["scenes"].push_back(benchMeshScene(device, scenePath, scene, options, frames, prefix));
             continue;
         }

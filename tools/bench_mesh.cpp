@@ -34,12 +34,6 @@ std::string readBytes(const fs::path& path)
     return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
-fs::path resolve(const fs::path& baseDir, const std::string& file)
-{
-    const fs::path p(file);
-    return p.is_absolute() ? p : baseDir / p;
-}
-
 std::uint64_t count(const nlohmann::json& extra, const char* key)
 {
     if (!extra.contains(key) || !extra[key].is_number())
@@ -66,18 +60,16 @@ MeshFigures meshFigures(const nlohmann::json& extra, double frameMs)
     return f;
 }
 
-std::uint64_t meshCacheKey(const nlohmann::json& meshSpec, const fs::path& baseDir)
+std::uint64_t meshCacheKey(const MeshSpec& spec)
 {
+    char options[96];
+    std::snprintf(options, sizeof options, "quality %.17g max_volume %.17g ", spec.quality, spec.maxVolume);
     std::uint64_t h = 0xcbf29ce484222325ull;
-    fnv1a(h, meshSpec.dump());
-    if (meshSpec.contains("surface") && meshSpec["surface"].is_string())
-        fnv1a(h, readBytes(resolve(baseDir, meshSpec["surface"].get<std::string>())));
-    if (meshSpec.contains("scalar") && meshSpec["scalar"].is_string()) {
-        const fs::path scalarFile = resolve(baseDir, meshSpec["scalar"].get<std::string>());
-        std::error_code ec;
-        if (fs::is_regular_file(scalarFile, ec))  // a volume the scalar is sampled from
-            fnv1a(h, readBytes(scalarFile));
-    }
+    fnv1a(h, spec.surface.string() + "\n" + options + spec.scalar);
+    fnv1a(h, readBytes(spec.surface));
+    std::error_code ec;
+    if (fs::is_regular_file(spec.scalar, ec))  // a volume the scalar is sampled from (resolved by parseMeshSpec)
+        fnv1a(h, readBytes(spec.scalar));
     return h;
 }
 
@@ -91,11 +83,14 @@ fs::path defaultMeshCacheDir()
 TetMesh loadBenchMesh(const Scene& scene, const std::string& name, const fs::path& cacheDir,
                       const std::function<void(const std::string&)>& progress)
 {
-    if (!scene.mesh.is_object() || !scene.mesh.contains("surface"))
-        return loadMesh(scene.mesh, scene.baseDir);
+    if (!scene.mesh)
+        throw InternalError("loadBenchMesh: the scene has no mesh");
+    const MeshSpec& spec = *scene.mesh;
+    if (spec.kind != MeshSpec::Kind::Surface)
+        return loadMesh(spec);
 
     char hex[17];
-    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(meshCacheKey(scene.mesh, scene.baseDir)));
+    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(meshCacheKey(spec)));
     const fs::path base = cacheDir / (name + "-" + hex);
     const fs::path node = base.string() + ".node";
     std::error_code ec;
@@ -105,9 +100,10 @@ TetMesh loadBenchMesh(const Scene& scene, const std::string& name, const fs::pat
         return mesh;
     }
 
-    progress("meshing " + scene.mesh["surface"].get<std::string>() + " with TetGen (" + scene.mesh.dump() +
+    progress("meshing " + spec.surface.string() + " with TetGen (quality " + std::to_string(spec.quality) +
+             ", max_volume " + std::to_string(spec.maxVolume) + ", scalar " + spec.scalar +
              "); kept as " + base.string() + ".{node,ele,neigh} for the next run");
-    TetMesh mesh = loadMesh(scene.mesh, scene.baseDir);
+    TetMesh mesh = loadMesh(spec);
     fs::create_directories(cacheDir);
     // Written under a temporary name and renamed, the .node last: a cache entry whose .node exists is whole.
     const fs::path temp = base.string() + ".tmp" + std::to_string(::getpid());

@@ -41,9 +41,10 @@ MeshFigures meshFigures(const nlohmann::json& extra, double frameMs);
 TetMesh loadBenchMesh(const Scene& scene, const std::string& name, const std::filesystem::path& cacheDir,
                       const std::function<void(const std::string&)>& progress);
 
-// FNV-1a 64 of the mesh object's JSON text and the surface file's bytes: a changed option or surface
-// meshes again. InputError when the surface cannot be read.
-std::uint64_t meshCacheKey(const nlohmann::json& meshSpec, const std::filesystem::path& baseDir);
+// FNV-1a 64 of the surface spec's fields (path, quality, max_volume, scalar), the surface file's bytes
+// and the scalar volume's bytes: a changed option or file meshes again. InputError when the surface
+// cannot be read.
+std::uint64_t meshCacheKey(const MeshSpec& spec);
 
 // The cache folder: `bench-data` beside the clvr executable (build/bench-data for build/clvr).
 std::filesystem::path defaultMeshCacheDir();

@@ -1061,93 +1061,46 @@ void writeVtkUnstructured(const TetMesh& mesh, const fs::path& path, bool binary
 
 namespace {
 
-// {"surface": ..., "quality": Q, "max_volume": V, "scalar": generator or volume file}: TetGen at load time.
-TetMesh meshSurfaceSpec(const nlohmann::json& spec, const fs::path& baseDir)
+}  // namespace
+
+namespace {
+
+// The mesh as read, before checkMesh: by the file's extension, which parseMeshSpec has checked.
+TetMesh readMeshFile(const MeshSpec& spec)
 {
-    const auto resolve = [&](const std::string& f) {
-        const fs::path p(f);
-        return p.is_absolute() ? p : baseDir / p;
-    };
-    if (!spec["surface"].is_string())
-        throw InputError("scene: mesh.surface must be a file name (string)");
-    MesherOptions options;
-    const auto positive = [&](const char* key, double& out) {
-        if (!spec.contains(key))
-            return;
-        const auto& v = spec[key];
-        if (!v.is_number() || !(v.get<double>() > 0.0) || !std::isfinite(v.get<double>()))
-            throw InputError(std::string("scene: mesh.") + key + " must be a positive number, got " + v.dump());
-        out = v.get<double>();
-    };
-    positive("quality", options.quality);
-    positive("max_volume", options.maxVolume);
-    if (spec.contains("scalar")) {
-        if (!spec["scalar"].is_string())
-            throw InputError("scene: mesh.scalar must be a generator name or a volume file (string) for a surface");
-        options.scalar = spec["scalar"].get<std::string>();
-        const std::string ext = lower(fs::path(options.scalar).extension().string());
-        if (ext == ".nrrd" || ext == ".nhdr")
-            options.scalar = resolve(options.scalar).string();
-    }
-    return meshSurface(resolve(spec["surface"].get<std::string>()), options);
+    const std::string ext = lower(spec.file.extension().string());
+    if (ext == ".node" || ext == ".ele")
+        return readTetgen(spec.file, spec.scalar);
+    if (ext == ".vtk")
+        return readVtkUnstructured(spec.file, spec.scalar);
+    if (ext == ".off")
+        return readOffTet(spec.file, spec.scalar);
+    throw InternalError("loadMesh: mesh file " + spec.file.string() + " has an extension parseMeshSpec rejects");
 }
 
 }  // namespace
 
-TetMesh loadMesh(const nlohmann::json& spec, const fs::path& baseDir)
+TetMesh loadMesh(const MeshSpec& spec)
 {
-    if (!spec.is_object())
-        throw InputError("scene: \"mesh\" must be an object such as {\"file\": \"x.vtk\"}");
-    if (spec.contains("surface")) {
-        for (auto it = spec.begin(); it != spec.end(); ++it)
-            if (it.key() != "surface" && it.key() != "quality" && it.key() != "max_volume" && it.key() != "scalar")
-                throw InputError("scene: mesh." + it.key() +
-                                 " is not a key of a surface mesh (surface, quality, max_volume, scalar)");
-        return meshSurfaceSpec(spec, baseDir);  // checked by meshSurface
+    if (spec.kind == MeshSpec::Kind::Surface) {
+        MesherOptions options;
+        options.quality = spec.quality;
+        options.maxVolume = spec.maxVolume;
+        options.scalar = spec.scalar;
+        return meshSurface(spec.surface, options);  // checked by meshSurface
     }
-    for (auto it = spec.begin(); it != spec.end(); ++it)
-        if (it.key() != "file" && it.key() != "q_file" && it.key() != "scalar")
-            throw InputError("scene: mesh." + it.key() + " is not a mesh key (file, q_file, scalar, or surface)");
-    if (!spec.contains("file") || !spec["file"].is_string())
-        throw InputError("scene: mesh.file must be a file name (string)");
-    std::string scalar;
-    if (spec.contains("scalar")) {
-        const auto& s = spec["scalar"];
-        if (s.is_string())
-            scalar = s.get<std::string>();
-        else if (s.is_number_integer() && s.get<std::int64_t>() >= 0)
-            scalar = std::to_string(s.get<std::int64_t>());
-        else
-            throw InputError("scene: mesh.scalar must be a name (string) or an attribute index (non-negative integer)");
-    }
-    const auto resolve = [&](const std::string& f) {
-        const fs::path p(f);
-        return p.is_absolute() ? p : baseDir / p;
-    };
-    const fs::path file = resolve(spec["file"].get<std::string>());
-    TetMesh mesh;
-    if (spec.contains("q_file")) {
-        if (!spec["q_file"].is_string())
-            throw InputError("scene: mesh.q_file must be a file name (string)");
-        mesh = readPlot3d(file, resolve(spec["q_file"].get<std::string>()), scalar.empty() ? "density" : scalar);
-    } else {
-        const std::string ext = lower(file.extension().string());
-        if (ext == ".node" || ext == ".ele")
-            mesh = readTetgen(file, scalar);
-        else if (ext == ".vtk")
-            mesh = readVtkUnstructured(file, scalar);
-        else if (ext == ".off")
-            mesh = readOffTet(file, scalar);
-        else if (ext == ".bin" || ext == ".xyz" || ext == ".x")
-            throw InputError("scene: mesh.file " + file.string() + " looks like a PLOT3D grid: mesh.q_file is missing");
-        else
-            throw InputError(file.string() + ": unknown mesh format " + shown(ext) + " (.node, .ele, .vtk, .off, or PLOT3D with q_file)");
-    }
+    TetMesh mesh = spec.kind == MeshSpec::Kind::Plot3d ? readPlot3d(spec.file, spec.qFile, spec.scalar)
+                                                       : readMeshFile(spec);
     checkMesh(mesh);
     if (mesh.tets.empty())
         throw InputError(mesh.source + ": no tetrahedra left (" + std::to_string(mesh.tetsRead) + " read, " +
                          std::to_string(mesh.tetsDegenerate) + " of zero volume)");
     return mesh;
+}
+
+TetMesh loadMesh(const nlohmann::json& spec, const fs::path& baseDir)
+{
+    return loadMesh(parseMeshSpec(spec, baseDir));
 }
 
 }  // namespace clvr

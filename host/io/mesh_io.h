@@ -1,10 +1,11 @@
 // host/io/mesh_io.h — tetrahedral mesh input and output: TetGen .node/.ele, VTK legacy UNSTRUCTURED_GRID
 // (ASCII and big-endian BINARY; tetrahedra, hexahedra and wedges), .off tetrahedral meshes, PLOT3D
-// curvilinear grids (split into tetrahedra), and the scene's "mesh" object. Every reader throws a
+// curvilinear grids (split into tetrahedra), and the scene's "mesh" (a MeshSpec). Every reader throws a
 // one-line InputError that names the file (and line or cell) and what is wrong; counts are checked
 // against the file's size before anything is allocated. docs/meshes.md lists what is accepted.
 #pragma once
 
+#include "host/model/data_spec.h"
 #include "host/model/mesh.h"
 
 #include <nlohmann/json_fwd.hpp>
@@ -14,12 +15,13 @@
 
 namespace clvr {
 
-// Loads the scene's "mesh" object and returns a checked mesh (checkMesh applied):
-//   {"file": "x.node"|"x.ele"|"x.vtk"|"x.off", "scalar": name or index (optional)}
-//   {"file": "xyz.bin", "q_file": "q.bin", "scalar": "density"|"momentum"|"energy"|"pressure"} (PLOT3D)
-//   {"surface": "x.off"|.stl|.poly|.smesh, "quality": Q, "max_volume": V, "scalar": generator or .nrrd}
-//     (meshed with TetGen at load time, host/io/tetgen_mesher.h; scalar default "sphere")
-// Relative paths are relative to baseDir. Unknown keys and wrongly typed values: InputError naming the key.
+// Loads what the scene's "mesh" names (host/model/data_spec.h) and returns a checked mesh (checkMesh
+// applied): a .node/.ele/.vtk/.off file, a PLOT3D grid with its q file, or a surface meshed with TetGen
+// at load time (host/io/tetgen_mesher.h).
+TetMesh loadMesh(const MeshSpec& spec);
+
+// parseMeshSpec(spec, baseDir) then loadMesh (tests): {"file": ..., "scalar": ...}, {"file": ...,
+// "q_file": ...}, {"surface": ..., "quality": Q, "max_volume": V, "scalar": ...}; docs/scene-format.md.
 TetMesh loadMesh(const nlohmann::json& spec, const std::filesystem::path& baseDir);
 
 // The readers return the mesh as read (tetsRead set), not yet checked: call checkMesh().

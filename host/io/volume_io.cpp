@@ -737,60 +737,6 @@ std::optional<ScalarType> vtkType(const std::string& t)
     return std::nullopt;
 }
 
-// ---------------------------------------------------------------------------------------------------
-// The scene's "volume" object.
-
-[[noreturn]] void badKey(const std::string& key, const std::string& what)
-{
-    throw InputError("volume: \"" + key + "\" " + what);
-}
-
-glm::dvec3 jsonVec3(const nlohmann::json& spec, const std::string& key)
-{
-    const nlohmann::json& v = spec.at(key);
-    if (!v.is_array() || v.size() != 3 || !std::all_of(v.begin(), v.end(), [](const auto& x) { return x.is_number(); }))
-        badKey(key, "must be an array of 3 numbers");
-    return {v[0].get<double>(), v[1].get<double>(), v[2].get<double>()};
-}
-
-glm::ivec3 jsonDims(const nlohmann::json& spec)
-{
-    if (!spec.contains("dims"))
-        badKey("dims", "is missing");
-    const nlohmann::json& v = spec.at("dims");
-    if (!v.is_array() || v.size() != 3 ||
-        !std::all_of(v.begin(), v.end(), [](const auto& x) { return x.is_number_integer(); }))
-        badKey("dims", "must be an array of 3 integers");
-    glm::ivec3 d;
-    for (int a = 0; a < 3; ++a) {
-        const long long n = v[static_cast<std::size_t>(a)].get<long long>();
-        if (n < 1 || n > INT_MAX)
-            badKey("dims", "[" + std::to_string(a) + "] is " + std::to_string(n) + ", must be a positive int");
-        d[a] = static_cast<int>(n);
-    }
-    return d;
-}
-
-std::string jsonString(const nlohmann::json& spec, const std::string& key)
-{
-    const nlohmann::json& v = spec.at(key);
-    if (!v.is_string())
-        badKey(key, "must be a string");
-    return v.get<std::string>();
-}
-
-void checkKeys(const nlohmann::json& spec, std::initializer_list<const char*> allowed, const std::string& form)
-{
-    for (auto it = spec.begin(); it != spec.end(); ++it) {
-        if (std::none_of(allowed.begin(), allowed.end(), [&](const char* k) { return it.key() == k; })) {
-            std::string list;
-            for (const char* k : allowed)
-                list += (list.empty() ? "" : ", ") + std::string(k);
-            throw InputError("volume: unknown key \"" + it.key() + "\" for " + form + " (allowed: " + list + ")");
-        }
-    }
-}
-
 }  // namespace
 
 std::size_t scalarSize(ScalarType type)
@@ -1125,67 +1071,20 @@ Volume readVtkStructuredPoints(const fs::path& path)
     return v;
 }
 
+Volume loadVolume(const VolumeSpec& spec)
+{
+    switch (spec.kind) {
+    case VolumeSpec::Kind::Generator: return generateVolume(spec.generator, spec.dims);
+    case VolumeSpec::Kind::Nrrd: return readNrrd(spec.file);
+    case VolumeSpec::Kind::Vtk: return readVtkStructuredPoints(spec.file);
+    case VolumeSpec::Kind::Raw: return readRaw(spec.file, spec.raw);
+    }
+    throw InternalError("loadVolume: unknown VolumeSpec::Kind " + std::to_string(static_cast<int>(spec.kind)));
+}
+
 Volume loadVolume(const nlohmann::json& spec, const fs::path& baseDir)
 {
-    if (!spec.is_object())
-        throw InputError("volume: must be an object with \"file\" or \"generator\"");
-    const bool hasFile = spec.contains("file"), hasGenerator = spec.contains("generator");
-    if (hasFile == hasGenerator)
-        throw InputError(std::string("volume: needs exactly one of \"file\" and \"generator\"") +
-                         (hasFile ? ", has both" : ", has neither"));
-
-    if (hasGenerator) {
-        checkKeys(spec, {"generator", "dims"}, "a generator");
-        return generateVolume(jsonString(spec, "generator"), jsonDims(spec));
-    }
-
-    const fs::path file = jsonString(spec, "file");
-    const fs::path path = file.is_absolute() ? file : baseDir / file;
-    const std::string ext = lower(file.extension().string());
-    const bool selfDescribing = ext == ".nrrd" || ext == ".nhdr" || ext == ".vtk";
-    if (!selfDescribing && (spec.contains("dims") || ext == ".raw")) {
-        checkKeys(spec, {"file", "dims", "type", "endian", "spacing", "origin", "header_bytes"}, "a raw file");
-        RawLayout layout;
-        layout.dims = jsonDims(spec);
-        if (!spec.contains("type"))
-            badKey("type", "is missing (uint8, int8, int16, uint16, int32, uint32, float32 or float64)");
-        const std::string type = jsonString(spec, "type");
-        static const std::array<std::pair<const char*, ScalarType>, 8> kTypes{{
-            {"uint8", ScalarType::UInt8},   {"int8", ScalarType::Int8},     {"int16", ScalarType::Int16},
-            {"uint16", ScalarType::UInt16}, {"int32", ScalarType::Int32},   {"uint32", ScalarType::UInt32},
-            {"float32", ScalarType::Float32}, {"float64", ScalarType::Float64},
-        }};
-        const auto it = std::find_if(kTypes.begin(), kTypes.end(), [&](const auto& p) { return type == p.first; });
-        if (it == kTypes.end())
-            badKey("type", "is " + shown(type) + " (uint8, int8, int16, uint16, int32, uint32, float32 or float64)");
-        layout.type = it->second;
-        if (spec.contains("endian")) {
-            const std::string e = jsonString(spec, "endian");
-            if (e != "little" && e != "big")
-                badKey("endian", "is " + shown(e) + ", must be little or big");
-            layout.endian = e == "big" ? Endian::Big : Endian::Little;
-        } else if (scalarSize(layout.type) > 1) {
-            badKey("endian", "is missing (little or big)");
-        }
-        if (spec.contains("spacing"))
-            layout.spacing = jsonVec3(spec, "spacing");
-        if (spec.contains("origin"))
-            layout.origin = jsonVec3(spec, "origin");
-        if (spec.contains("header_bytes")) {
-            const nlohmann::json& hb = spec.at("header_bytes");
-            if (!hb.is_number_integer() || hb.get<long long>() < 0)
-                badKey("header_bytes", "must be a non-negative integer");
-            layout.headerBytes = hb.get<std::uint64_t>();
-        }
-        return readRaw(path, layout);
-    }
-    checkKeys(spec, {"file"}, ext.empty() ? "a file" : "a " + ext + " file");
-    if (ext == ".nrrd" || ext == ".nhdr")
-        return readNrrd(path);
-    if (ext == ".vtk")
-        return readVtkStructuredPoints(path);
-    throw InputError(path.string() + ": unknown volume format " + shown(ext) +
-                     " (.nrrd, .nhdr, .vtk, or .raw / any file with \"dims\")");
+    return loadVolume(parseVolumeSpec(spec, baseDir));
 }
 
 }  // namespace clvr

@@ -1,6 +1,7 @@
 // host/model/scene.cpp — scene JSON (DESIGN.md, "Scene files and the command line"): parsing with line and
 // column on malformed text, `--set` overrides, key-by-key validation, the embedded default scene, and
-// the camera that fits a bounding box. Every error is an InputError that starts with the file's name.
+// the camera that fits a bounding box. Every error is an InputError that starts with the file's name, but
+// those of "volume" and "mesh" (host/model/data_spec.cpp), which keep the readers' messages.
 #include "host/model/scene.h"
 
 #include "host/runtime/errors.h"
@@ -454,10 +455,10 @@ Scene parseSceneJson(json root, const std::string& label, const std::filesystem:
             check.object(root[key], key);
     }
     if (root.contains("volume"))
-        scene.volume = root["volume"];
+        scene.volume = parseVolumeSpec(root["volume"], baseDir);
     if (root.contains("mesh"))
-        scene.mesh = root["mesh"];
-    if (scene.volume.is_null() && scene.mesh.is_null())
+        scene.mesh = parseMeshSpec(root["mesh"], baseDir);
+    if (!scene.volume && !scene.mesh)
         check.fail("the scene has neither \"volume\" nor \"mesh\"");
     if (root.contains("camera"))
         scene.camera = parseCamera(check, root["camera"]);

@@ -1,10 +1,12 @@
 // host/model/scene.h — a scene as DESIGN.md defines it (JSON, paths relative to the file), parsed and
 // validated once: camera, image, transfer function, "iso", "lights" and "material" as typed values that
-// renderers take as they are. Data is not loaded here: `volume` keeps its JSON for host/io/volume_io.h's
-// loadVolume(); `options` stays JSON, checked by the technique (host/render/renderer.h's registry).
+// renderers take as they are, and "volume" / "mesh" as VolumeSpec / MeshSpec (host/model/data_spec.h,
+// paths resolved). Data is not loaded here: host/io's loadVolume() / loadMesh() read it. `options` stays
+// JSON, checked by the technique (host/render/renderer.h's registry).
 #pragma once
 
 #include "host/model/camera.h"
+#include "host/model/data_spec.h"
 #include "host/model/transfer_function.h"
 
 #include <nlohmann/json.hpp>
@@ -62,8 +64,8 @@ struct Lighting {
 struct Scene {
     std::string technique = "slice3d";
     std::filesystem::path baseDir;  // folder of the scene file: relative data paths start here
-    nlohmann::json volume;          // {"file": ...} or {"generator": ...}; null when absent
-    nlohmann::json mesh;            // {"file": ...}; null when absent (tetrahedral techniques)
+    std::optional<VolumeSpec> volume;  // "volume": a file or a generator; absent for a mesh scene
+    std::optional<MeshSpec> mesh;      // "mesh" (tetrahedral techniques); absent for a volume scene
     std::optional<Camera> camera;   // absent: fit the data bounds (see fitCamera)
     ImageSpec image;
     TransferFunction transferFunction;
