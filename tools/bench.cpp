@@ -14,6 +14,7 @@
 #include "host/model/scene.h"
 #include "host/session.h"
 #include "host/io/volume_io.h"
+#include "tools/bench_machine.h"
 #include "tools/bench_mesh.h"
 #include "tools/bench_raster.h"
 #include "tools/ceiling.h"
@@ -79,36 +80,6 @@ fs::path repoFile(const fs::path& relative)
             return dir / relative;
     throw InputError(relative.string() + ": not found in the current folder or above the clvr executable "
                      "(run clvr bench from the repository root, or name the scene files)");
-}
-
-std::string cpuModel()
-{
-    std::ifstream in("/proc/cpuinfo");
-    for (std::string line; std::getline(in, line);)
-        if (line.rfind("model name", 0) == 0) {
-            const auto colon = line.find(':');
-            return colon == std::string::npos ? line : line.substr(colon + 2);
-        }
-    return "unknown";
-}
-
-// /proc/loadavg's first three fields: the machine is shared, so every report says how busy it was.
-std::string loadAverage()
-{
-    std::ifstream in("/proc/loadavg");
-    std::string a, b, c;
-    in >> a >> b >> c;
-    return in ? a + " " + b + " " + c : "unknown";
-}
-
-std::string utcNow()
-{
-    const std::time_t t = std::time(nullptr);
-    std::tm tm{};
-    gmtime_r(&t, &tm);
-    char buf[32];
-    std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-    return buf;
 }
 
 // Per-channel absolute difference over R, G, B (VTK's PNG has no alpha).

@@ -7,6 +7,8 @@
 // script can run the same suite on main's code and on this one (BENCHMARKS.md says how).
 #include "tools/bench_raster.h"
 
+#include "tools/bench_machine.h"
+
 #include "host/runtime/device.h"
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
@@ -38,24 +40,6 @@ using Clock = std::chrono::steady_clock;
 constexpr int kSize = 512, kTriangles = 100000, kDraws = 1000, kFrames = 7;
 
 double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
-
-std::string loadAverage()
-{
-    std::ifstream in("/proc/loadavg");
-    std::string a, b, c;
-    in >> a >> b >> c;
-    return in ? a + " " + b + " " + c : "unknown";
-}
-
-std::string utcNow()
-{
-    const std::time_t t = std::time(nullptr);
-    std::tm tm{};
-    gmtime_r(&t, &tm);
-    char buf[32];
-    std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-    return buf;
-}
 
 // Triangles of area 1..20 pixels: an equilateral triangle of that area, rotated and stretched by k and
 // 1/k (k in 0.5..2, area kept), centered anywhere on the frame buffer; depth and color random.

@@ -12,7 +12,7 @@ repo=$(cd "$(dirname "$0")/.." && pwd)
 mkdir -p "$work/src"
 work=$(cd "$work" && pwd)
 git -C "$repo" archive "$before" | tar -x -C "$work/src"
-cp "$repo/tools/bench_raster.h" "$repo/tools/bench_raster.cpp" "$work/src/tools/"
+cp "$repo/tools/bench_raster.h" "$repo/tools/bench_raster.cpp" "$repo/tools/bench_machine.h" "$work/src/tools/"
 # The hooks: `--suite raster` in tools/commands.cpp and its dispatch in tools/bench.cpp.
 grep -q bench_raster.h "$work/src/tools/bench.cpp" || sed -i \
   -e 's|#include "tools/bench_mesh.h"|#include "tools/bench_mesh.h"\n#include "tools/bench_raster.h"|' \
