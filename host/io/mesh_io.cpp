@@ -52,13 +52,6 @@ std::string shown(std::string_view s)
     return out + "\"";
 }
 
-std::string lower(std::string s)
-{
-    for (char& c : s)
-        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return s;
-}
-
 std::optional<long long> parseInteger(std::string_view s)
 {
     if (!s.empty() && s[0] == '+')
@@ -232,7 +225,7 @@ struct VtkType {
 
 std::optional<VtkType> vtkType(const std::string& name)
 {
-    const std::string n = lower(name);
+    const std::string n = asciiLower(name);
     if (n == "unsigned_char")
         return VtkType{1, VtkType::Unsigned};
     if (n == "char")
@@ -368,7 +361,7 @@ public:
 
     VtkType type(const std::string& name) const
     {
-        if (lower(name) == "bit")
+        if (asciiLower(name) == "bit")
             throw InputError(where() + ": data type bit is not supported");
         const auto t = vtkType(name);
         if (!t)
@@ -447,14 +440,14 @@ TetMesh readVtkUnstructured(const fs::path& path, const std::string& scalar)
     std::string mode = in.rawLine();
     while (!mode.empty() && std::isspace(static_cast<unsigned char>(mode.back())))
         mode.pop_back();
-    if (lower(mode) == "binary")
+    if (asciiLower(mode) == "binary")
         in.binary = true;
-    else if (lower(mode) != "ascii")
+    else if (asciiLower(mode) != "ascii")
         throw InputError(in.file() + ": the third line must be ASCII or BINARY, not " + shown(mode));
     auto line = in.headerLine();
-    if (line.size() < 2 || lower(line[0]) != "dataset")
+    if (line.size() < 2 || asciiLower(line[0]) != "dataset")
         throw InputError(in.where() + ": expected DATASET UNSTRUCTURED_GRID");
-    if (lower(line[1]) != "unstructured_grid")
+    if (asciiLower(line[1]) != "unstructured_grid")
         throw InputError(in.where() + ": DATASET " + line[1] + " is not an unstructured grid (UNSTRUCTURED_GRID)");
 
     TetMesh mesh;
@@ -483,7 +476,7 @@ TetMesh readVtkUnstructured(const fs::path& path, const std::string& scalar)
     };
 
     while (!(line = in.headerLine()).empty()) {
-        const std::string key = lower(line[0]);
+        const std::string key = asciiLower(line[0]);
         if (key == "points") {
             argCount(line, 3);
             const VtkType t = in.type(line[2]);
@@ -495,13 +488,13 @@ TetMesh readVtkUnstructured(const fs::path& path, const std::string& scalar)
             const long long a = in.integer(line[1], "CELLS count"), b = in.integer(line[2], "CELLS size");
             if (major >= 5) {  // 5.x: OFFSETS and CONNECTIVITY arrays
                 auto sub = in.headerLine();
-                if (sub.size() < 2 || lower(sub[0]) != "offsets")
+                if (sub.size() < 2 || asciiLower(sub[0]) != "offsets")
                     throw InputError(in.where() + ": expected OFFSETS after CELLS (file version 5)");
                 VtkType t = in.type(sub[1]);
                 const std::uint64_t no = checkedCount(in.where(), "OFFSETS", a, kMaxTets + 1, in.valuesLeft(t));
                 in.values(t, no, "OFFSETS", &offsets);
                 sub = in.headerLine();
-                if (sub.size() < 2 || lower(sub[0]) != "connectivity")
+                if (sub.size() < 2 || asciiLower(sub[0]) != "connectivity")
                     throw InputError(in.where() + ": expected CONNECTIVITY after OFFSETS");
                 t = in.type(sub[1]);
                 const std::uint64_t nc = checkedCount(in.where(), "CONNECTIVITY", b, 16 * kMaxTets, in.valuesLeft(t));
@@ -558,7 +551,7 @@ TetMesh readVtkUnstructured(const fs::path& path, const std::string& scalar)
                 if (arr.empty())
                     throw InputError(in.file() + ": FIELD " + line[1] + " ends after " + std::to_string(a) + " of " +
                                      std::to_string(arrays) + " arrays (truncated)");
-                if (lower(arr[0]) == "null_array")
+                if (asciiLower(arr[0]) == "null_array")
                     continue;
                 if (arr.size() < 4)
                     throw InputError(in.where() + ": FIELD array line needs: name components tuples type");
@@ -575,7 +568,7 @@ TetMesh readVtkUnstructured(const fs::path& path, const std::string& scalar)
             if (comps < 1 || comps > 4)
                 throw InputError(in.where() + ": SCALARS components " + std::to_string(comps) + " must be 1 to 4");
             auto lut = in.headerLine();
-            if (lut.empty() || lower(lut[0]) != "lookup_table")
+            if (lut.empty() || asciiLower(lut[0]) != "lookup_table")
                 throw InputError(in.where() + ": expected LOOKUP_TABLE after SCALARS " + line[1]);
             dataArray(line[1], static_cast<std::uint64_t>(comps), sectionCount, t, "SCALARS " + line[1]);
         } else if (key == "lookup_table") {
@@ -697,7 +690,7 @@ TetMesh readVtkUnstructured(const fs::path& path, const std::string& scalar)
 TetMesh readTetgen(const fs::path& path, const std::string& scalar)
 {
     fs::path base = path;
-    const std::string ext = lower(path.extension().string());
+    const std::string ext = asciiLower(path.extension().string());
     if (ext == ".node" || ext == ".ele")
         base.replace_extension();
     const fs::path nodePath = base.string() + ".node", elePath = base.string() + ".ele";
@@ -822,7 +815,7 @@ TetMesh readOffTet(const fs::path& path, const std::string& scalar)
     std::vector<std::string_view> tok;
     if (!in.next(tok))
         throw InputError(in.file() + ": empty file");
-    if (lower(std::string(tok[0])) == "off" || lower(std::string(tok[0])) == "toff") {
+    if (asciiLower(std::string(tok[0])) == "off" || asciiLower(std::string(tok[0])) == "toff") {
         tok.erase(tok.begin());
         if (tok.empty() && !in.next(tok))
             throw InputError(in.file() + ": no counts after OFF");
@@ -902,7 +895,7 @@ glm::u64vec3 plot3dDims(const std::string& d, const fs::path& path)
 
 TetMesh readPlot3d(const fs::path& xyzPath, const fs::path& qPath, const std::string& scalarName)
 {
-    const std::string which = scalarName.empty() ? "density" : lower(scalarName);
+    const std::string which = scalarName.empty() ? "density" : asciiLower(scalarName);
     if (which != "density" && which != "momentum" && which != "energy" && which != "pressure")
         throw InputError(qPath.string() + ": PLOT3D scalar " + shown(scalarName) +
                          " is not one of density, momentum, energy, pressure");
@@ -1068,7 +1061,7 @@ namespace {
 // The mesh as read, before checkMesh: by the file's extension, which parseMeshSpec has checked.
 TetMesh readMeshFile(const MeshSpec& spec)
 {
-    const std::string ext = lower(spec.file.extension().string());
+    const std::string ext = asciiLower(spec.file.extension().string());
     if (ext == ".node" || ext == ".ele")
         return readTetgen(spec.file, spec.scalar);
     if (ext == ".vtk")

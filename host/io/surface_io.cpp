@@ -3,6 +3,7 @@
 #include "host/io/surface_io.h"
 
 #include "host/runtime/errors.h"
+#include "host/runtime/file_io.h"
 
 #include <algorithm>
 #include <cctype>
@@ -18,13 +19,6 @@ namespace clvr {
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string lower(std::string s)
-{
-    for (char& c : s)
-        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return s;
-}
 
 // The file's lines, as TetGen's readline gives them: text after '#' dropped, blank lines skipped, then
 // split into numbers at spaces, tabs and commas. take() gives the next line's words; more() the next
@@ -327,7 +321,7 @@ Plc readPlc(const fs::path& path)
 {
     if (!fs::is_regular_file(path))
         throw InputError(path.string() + ": no such file");
-    const std::string ext = lower(path.extension().string());
+    const std::string ext = asciiLower(path.extension().string());
     if (ext == ".off")
         return readOff(path);
     if (ext == ".stl")

@@ -4,6 +4,7 @@
 #include "host/io/tetgen_mesher.h"
 
 #include "host/runtime/errors.h"
+#include "host/runtime/file_io.h"
 #include "host/io/generators.h"
 #include "host/io/surface_io.h"
 #include "host/io/volume_io.h"
@@ -21,13 +22,6 @@ namespace clvr {
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string lower(std::string s)
-{
-    for (char& c : s)
-        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return s;
-}
 
 // Copies `plc` into `io` as tetgenio::load_off / load_stl / load_poly would have filled it; the arrays are
 // allocated with new[], which tetgenio's destructor frees.
@@ -128,14 +122,14 @@ std::string tetgenSwitches(const MesherOptions& options)
 void assignScalar(TetMesh& mesh, const std::string& scalar)
 {
     mesh.scalars.resize(mesh.points.size());
-    const std::string name = lower(scalar);
+    const std::string name = asciiLower(scalar);
     if (name == "marschner-lobb" || name == "sphere" || name == "blobs") {
         double (*f)(const glm::dvec3&) = name == "sphere" ? sphereField : name == "blobs" ? blobsField : marschnerLobb;
         for (std::size_t i = 0; i < mesh.points.size(); ++i)
             mesh.scalars[i] = f(mesh.points[i]);
         return;
     }
-    const std::string ext = lower(fs::path(scalar).extension().string());
+    const std::string ext = asciiLower(fs::path(scalar).extension().string());
     if (ext != ".nrrd" && ext != ".nhdr")
         throw InputError("mesh scalar " + scalar +
                          ": neither a generator (marschner-lobb, sphere, blobs) nor a .nrrd/.nhdr volume");
@@ -152,12 +146,12 @@ TetMesh meshSurface(const fs::path& surface, const MesherOptions& options)
     if (!(options.quality >= 0.0) || !(options.maxVolume >= 0.0))
         throw InputError(surface.string() + ": --quality and --max-volume must be positive");
     {
-        const std::string s = lower(options.scalar), e = lower(fs::path(options.scalar).extension().string());
+        const std::string s = asciiLower(options.scalar), e = asciiLower(fs::path(options.scalar).extension().string());
         if (s != "marschner-lobb" && s != "sphere" && s != "blobs" && e != ".nrrd" && e != ".nhdr")
             throw InputError("mesh scalar " + options.scalar +
                              ": neither a generator (marschner-lobb, sphere, blobs) nor a .nrrd/.nhdr volume");
     }
-    const std::string ext = lower(surface.extension().string());
+    const std::string ext = asciiLower(surface.extension().string());
     if (ext != ".poly" && ext != ".smesh" && ext != ".off" && ext != ".stl")
         throw InputError(surface.string() + ": unknown surface format \"" + ext + "\" (.poly, .smesh, .off, .stl)");
     const Plc plc = readPlc(surface);

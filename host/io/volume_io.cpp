@@ -43,13 +43,6 @@ std::string trim(std::string_view s)
     return std::string(s.substr(b, e - b));
 }
 
-std::string lower(std::string s)
-{
-    for (char& c : s)
-        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return s;
-}
-
 std::vector<std::string> splitWhitespace(std::string_view s)
 {
     std::vector<std::string> out;
@@ -340,7 +333,7 @@ std::optional<ScalarType> nrrdType(const std::string& t)
     }};
     // Internal runs of spaces count as one ("unsigned  char").
     std::string norm;
-    for (const std::string& w : splitWhitespace(lower(t)))
+    for (const std::string& w : splitWhitespace(asciiLower(t)))
         norm += (norm.empty() ? "" : " ") + w;
     for (const auto& [name, type] : kNames)
         if (norm == name)
@@ -352,7 +345,7 @@ std::optional<ScalarType> nrrdType(const std::string& t)
 std::string fieldKey(const std::string& name)
 {
     std::string k;
-    for (char c : lower(name))
+    for (char c : asciiLower(name))
         if (c != ' ')
             k += c;
     return k;
@@ -485,7 +478,7 @@ NrrdHeader readNrrdHeader(const fs::path& path)
                 throw InputError(source + ": type " + shown(value) +
                                  " is not supported (8, 16 and 32-bit integers, float and double are)");
         } else if (key == "encoding") {
-            const std::string e = lower(value);
+            const std::string e = asciiLower(value);
             if (e == "raw")
                 h.encoding = NrrdEncoding::Raw;
             else if (e == "gzip" || e == "gz")
@@ -496,7 +489,7 @@ NrrdHeader readNrrdHeader(const fs::path& path)
                 throw InputError(source + ": encoding " + shown(value) +
                                  " is not supported (raw, gzip and ascii are)");
         } else if (key == "endian") {
-            const std::string e = lower(value);
+            const std::string e = asciiLower(value);
             if (e == "little")
                 h.endian = Endian::Little;
             else if (e == "big")
@@ -540,7 +533,7 @@ NrrdHeader readNrrdHeader(const fs::path& path)
             h.origin = value;
         } else if (key == "space") {
             // Any named 3D space ("left-posterior-superior", "3D-left-handed", ...); only the dimension matters.
-            const std::string s = lower(value);
+            const std::string s = asciiLower(value);
             static const std::array<const char*, 4> kTwoOrFour{"right-anterior-superior-time", "ras-time",
                                                                "left-anterior-superior-time", "scanner-xyz-time"};
             for (const char* t : kTwoOrFour)
@@ -725,7 +718,7 @@ void readNrrdData(const NrrdHeader& h, const fs::path& file, std::uint64_t start
 
 std::optional<ScalarType> vtkType(const std::string& t)
 {
-    const std::string s = lower(t);
+    const std::string s = asciiLower(t);
     if (s == "unsigned_char") return ScalarType::UInt8;
     if (s == "char" || s == "signed_char") return ScalarType::Int8;
     if (s == "short") return ScalarType::Int16;
@@ -930,21 +923,21 @@ Volume readVtkStructuredPoints(const fs::path& path)
     };
 
     const std::optional<std::string> magic = nextLine();
-    if (!magic || lower(*magic).rfind("# vtk datafile version", 0) != 0)
+    if (!magic || asciiLower(*magic).rfind("# vtk datafile version", 0) != 0)
         throw InputError(source + ": not a VTK legacy file (the first line is " + shown(magic.value_or("")) +
                          ", expected \"# vtk DataFile Version x.y\")");
     nextLine();  // title
     const std::vector<std::string> format = nextTokens();
-    const std::string fmt = format.empty() ? "" : lower(format[0]);
+    const std::string fmt = format.empty() ? "" : asciiLower(format[0]);
     if (fmt != "ascii" && fmt != "binary")
         throw InputError(source + ": the third line must say ASCII or BINARY, not " +
                          shown(format.empty() ? "" : format[0]));
     const bool binary = fmt == "binary";
 
     std::vector<std::string> t = nextTokens();
-    if (t.empty() || lower(t[0]) != "dataset")
+    if (t.empty() || asciiLower(t[0]) != "dataset")
         throw InputError(source + ": expected DATASET STRUCTURED_POINTS after the " + fmt + " line");
-    if (t.size() < 2 || lower(t[1]) != "structured_points")
+    if (t.size() < 2 || asciiLower(t[1]) != "structured_points")
         throw InputError(source + ": DATASET is " + shown(t.size() > 1 ? t[1] : "") +
                          ", only STRUCTURED_POINTS is read as a regular volume");
 
@@ -965,7 +958,7 @@ Volume readVtkStructuredPoints(const fs::path& path)
     };
     std::optional<long long> pointData;
     while (!(t = nextTokens()).empty()) {
-        const std::string key = lower(t[0]);
+        const std::string key = asciiLower(t[0]);
         if (key == "dimensions") {
             if (t.size() != 4)
                 throw InputError(source + ": DIMENSIONS needs 3 integers");
@@ -1007,7 +1000,7 @@ Volume readVtkStructuredPoints(const fs::path& path)
                              ", must be positive");
 
     t = nextTokens();
-    if (t.empty() || lower(t[0]) != "scalars")
+    if (t.empty() || asciiLower(t[0]) != "scalars")
         throw InputError(source + ": expected SCALARS after POINT_DATA, found " +
                          shown(t.empty() ? "end of file" : t[0]));
     if (t.size() < 3 || t.size() > 4)
@@ -1022,7 +1015,7 @@ Volume readVtkStructuredPoints(const fs::path& path)
     {
         const std::size_t save = pos;
         const std::vector<std::string> lut = nextTokens();
-        if (lut.empty() || lower(lut[0]) != "lookup_table")
+        if (lut.empty() || asciiLower(lut[0]) != "lookup_table")
             pos = save;
     }
 

@@ -3,6 +3,7 @@
 #include "host/model/data_spec.h"
 
 #include "host/runtime/errors.h"
+#include "host/runtime/file_io.h"
 
 #include <nlohmann/json.hpp>
 
@@ -21,13 +22,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-std::string lower(std::string s)
-{
-    for (char& c : s)
-        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return s;
-}
 
 // `s` quoted, unprintable characters as '?', cut after `limit` characters.
 std::string shown(std::string_view s, std::size_t limit)
@@ -185,7 +179,7 @@ MeshSpec parseSurfaceSpec(const json& spec, const fs::path& baseDir)
         if (!spec["scalar"].is_string())
             throw InputError("scene: mesh.scalar must be a generator name or a volume file (string) for a surface");
         m.scalar = spec["scalar"].get<std::string>();
-        const std::string ext = lower(fs::path(m.scalar).extension().string());
+        const std::string ext = asciiLower(fs::path(m.scalar).extension().string());
         if (ext == ".nrrd" || ext == ".nhdr")
             m.scalar = resolve(baseDir, m.scalar).string();
     }
@@ -213,7 +207,7 @@ VolumeSpec parseVolumeSpec(const json& spec, const fs::path& baseDir)
     }
     const fs::path file = jsonString(spec, "file");
     v.file = file.is_absolute() ? file : baseDir / file;
-    const std::string ext = lower(file.extension().string());
+    const std::string ext = asciiLower(file.extension().string());
     const bool selfDescribing = ext == ".nrrd" || ext == ".nhdr" || ext == ".vtk";
     if (!selfDescribing && (spec.contains("dims") || ext == ".raw")) {
         v.kind = VolumeSpec::Kind::Raw;
@@ -255,7 +249,7 @@ MeshSpec parseMeshSpec(const json& spec, const fs::path& baseDir)
         return m;
     }
     m.kind = MeshSpec::Kind::File;
-    const std::string ext = lower(m.file.extension().string());
+    const std::string ext = asciiLower(m.file.extension().string());
     if (ext == ".bin" || ext == ".xyz" || ext == ".x")
         throw InputError("scene: mesh.file " + m.file.string() + " looks like a PLOT3D grid: mesh.q_file is missing");
     if (ext != ".node" && ext != ".ele" && ext != ".vtk" && ext != ".off")

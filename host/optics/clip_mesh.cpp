@@ -3,6 +3,7 @@
 #include "host/optics/clip_mesh.h"
 
 #include "host/runtime/errors.h"
+#include "host/runtime/file_io.h"
 #include "host/model/json_values.h"
 #include "host/io/surface_io.h"
 
@@ -24,13 +25,6 @@ namespace fs = std::filesystem;
 namespace {
 
 using nlohmann::json;
-
-std::string lower(std::string s)
-{
-    for (char& c : s)
-        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return s;
-}
 
 // Adds the fan of a polygon (indices into mesh.points).
 void addPolygon(ClipMesh& mesh, const std::vector<std::uint32_t>& polygon)
@@ -252,7 +246,7 @@ ClipMesh readSurface(const fs::path& path)
 {
     if (!fs::is_regular_file(path))
         throw InputError(path.string() + ": no such file (clip mesh)");
-    const std::string ext = lower(path.extension().string());
+    const std::string ext = asciiLower(path.extension().string());
     if (ext == ".obj")
         return readObj(path);
     std::uint32_t count = 0;

@@ -3,6 +3,7 @@
 
 #include "host/runtime/embedded_kernels.h"
 #include "host/runtime/errors.h"
+#include "host/runtime/file_io.h"
 
 #include <algorithm>
 #include <array>
@@ -13,12 +14,6 @@
 
 namespace clvr {
 namespace {
-
-std::string lower(std::string s)
-{
-    std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
-    return s;
-}
 
 std::string typeName(cl_device_type type)
 {
@@ -97,8 +92,8 @@ const Found& pick(const std::vector<Found>& found, const std::string& spec)
         return found[index];
     }
     for (const Found& f : found)
-        if (lower(f.listing.name).find(lower(rule)) != std::string::npos ||
-            lower(f.listing.platform).find(lower(rule)) != std::string::npos)
+        if (asciiLower(f.listing.name).find(asciiLower(rule)) != std::string::npos ||
+            asciiLower(f.listing.platform).find(asciiLower(rule)) != std::string::npos)
             return f;
     throw DeviceError(source + " \"" + rule + "\" matches no OpenCL device (see clvr info)");
 }

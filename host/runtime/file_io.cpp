@@ -3,6 +3,8 @@
 
 #include "host/runtime/errors.h"
 
+#include <cctype>
+
 namespace clvr {
 
 std::uint64_t fileSize(const std::filesystem::path& path)
@@ -18,6 +20,13 @@ std::uint64_t fileSize(const std::filesystem::path& path)
     if (ec)
         throw InputError(path.string() + ": cannot read (" + ec.message() + ")");
     return size;
+}
+
+std::string asciiLower(std::string s)
+{
+    for (char& c : s)
+        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return s;
 }
 
 }  // namespace clvr

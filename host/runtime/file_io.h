@@ -3,11 +3,15 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <string>
 
 namespace clvr {
 
 // The size of the regular file at `path`; InputError "<path>: no such file", "... is a directory, not a
 // file" or "... cannot read (...)".
 std::uint64_t fileSize(const std::filesystem::path& path);
+
+// `s` with ASCII letters in lower case (file extensions, names and keywords compare case-blind).
+std::string asciiLower(std::string s);
 
 }  // namespace clvr
