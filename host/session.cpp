@@ -1,6 +1,7 @@
 // host/session.cpp — clvr::Session: one scene's data, device and renderer kept across frames.
 #include "host/session.h"
 
+#include "host/render/scaffold.h"
 #include "host/runtime/errors.h"
 #include "host/io/mesh_io.h"
 #include "host/io/volume_io.h"
@@ -14,11 +15,6 @@ namespace clvr {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double msSince(Clock::time_point t0)
-{
-    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 // The scene's camera, or one that fits its data's bounds (as clvr render always did).
 Camera sceneCamera(const Scene& scene, const SceneData& data)

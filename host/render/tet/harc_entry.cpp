@@ -3,6 +3,7 @@
 #include "host/render/tet/harc_entry.h"
 
 #include "host/runtime/embedded_kernels.h"
+#include "host/render/scaffold.h"
 #include "host/runtime/errors.h"
 #include "host/render/camera_args.h"
 #include "host/render/fragment_uniforms.h"
@@ -25,11 +26,6 @@ std::string fragmentSource()
         if (k.name == "harc_entry.cl")
             return "#define CLVR_HARC_ENTRY_FRAGMENT 1\n" + std::string(k.source);
     throw InternalError("kernels/harc_entry.cl is not embedded in this build");
-}
-
-double msSince(std::chrono::steady_clock::time_point t0)
-{
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
 }  // namespace
