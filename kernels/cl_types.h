@@ -9,6 +9,7 @@
 #ifdef __OPENCL_C_VERSION__
 typedef uint cl_uint;
 typedef int cl_int;
+typedef ulong cl_ulong;
 typedef float cl_float;
 typedef float4 cl_float4;
 typedef int4 cl_int4;

@@ -1,9 +1,18 @@
 // kernels/raster.cl — the ordered fragment stage (DESIGN.md, raster stage; rules in docs/raster.md).
-// The host has clipped, set up and binned the triangles; here one work-item owns one pixel, walks
-// its tile's triangle list in submission order and applies GL's per-fragment operations.
+// The host has clipped, set up and binned the triangles; here one work-item owns a rectangle of pixels,
+// walks its tile's triangle list in submission order and applies GL's per-fragment operations.
 #include "clvr_common.h"
 #include "raster_state.h"
 #include "texture.h"
+
+/* Attributes the fragment program reads (FragmentProgram::attributes; the rest are zero) and the most
+ * pixels of an item (RasterShape): build options of each compiled fragment program. */
+#ifndef CLVR_ATTRIBUTES
+#define CLVR_ATTRIBUTES CLVR_MAX_ATTRIBUTES
+#endif
+#ifndef CLVR_ITEM_PIXELS
+#define CLVR_ITEM_PIXELS (CLVR_TILE_SIZE * CLVR_TILE_SIZE)
+#endif
 
 typedef struct {
     float2 window;     /* pixel center (x + 0.5, row + 0.5), row 0 at the top */
@@ -173,7 +182,8 @@ long clvr_edge(int xa, int ya, int xb, int yb, int px, int py)
 
 /* One fragment of triangle t at pixel (px, py) with exact edge values e0..e2, through GL's
  * per-fragment operations against the pixel's color c, depth d and stencil s (kept in registers). */
-__attribute__((always_inline)) void clvr_shade(global const ClTriangle* t, long e0, long e1, long e2, int px, int py,
+__attribute__((always_inline)) void clvr_shade(global const ClTriangle* t, global const float4* attr_over_w,
+                                               long e0, long e1, long e2, int px, int py,
                                                const ClFragmentState* fs, const ClBlendState* bs,
                                                const ClvrBlend* blend, int4 write_mask,
                                                const ClFragmentResources* resources, float4* c, float* d, uint* s)
@@ -188,8 +198,10 @@ __attribute__((always_inline)) void clvr_shade(global const ClTriangle* t, long 
     f.depth = l0 * t->depth.x + l1 * t->depth.y + l2 * t->depth.z;
     f.front_facing = (int)t->front_facing;
     const float q = 1.0f / (l0 * t->inv_w.x + l1 * t->inv_w.y + l2 * t->inv_w.z);
+#pragma unroll
     for (int k = 0; k < CLVR_MAX_ATTRIBUTES; ++k)
-        f.attr[k] = (l0 * t->attr_over_w[0][k] + l1 * t->attr_over_w[1][k] + l2 * t->attr_over_w[2][k]) * q;
+        f.attr[k] = k < CLVR_ATTRIBUTES ? (l0 * attr_over_w[3 * k] + l1 * attr_over_w[3 * k + 1] + l2 * attr_over_w[3 * k + 2]) * q
+                                        : (float4)(0.0f);
 
     float4 src;
     if (!clvr_fragment(&f, resources, &src))
@@ -218,103 +230,123 @@ __attribute__((always_inline)) void clvr_shade(global const ClTriangle* t, long 
     *c = select(*c, blended, write_mask);
 }
 
-/* One work-item per CLVR_PIXELS_PER_ITEM horizontally adjacent pixels of the viewport rectangle
- * (rect_*, clipped to the frame buffer): independent pixels give the CPU instruction-level
- * parallelism and share each triangle's loads. Tiles of 2^tile_w_log2 x 2^tile_h_log2 pixels (the
- * width a multiple of CLVR_PIXELS_PER_ITEM; the host picks the shape) start at the rectangle's corner,
- * so a work-item's pixels share a tile; tile t lists triangle indices
- * tile_tris[tile_start[tile_base + t] .. tile_start[tile_base + t + 1]) in submission order (one
- * buffer holds the tile lists of every pass of a batch, and one uniforms buffer their uniforms,
- * this pass's from uniform_base). fragment_counts[row] accumulates the
- * covered-pixel count of that rectangle row over launches until the host reads and clears it. Pixels
- * outside a triangle's col/row bounds (which include GL's scissor rectangle) are never its fragments. */
-kernel void raster_fragments(global float4* color, global float* depth, global uchar* stencil, const int fb_width,
-                             const int rect_x, const int rect_y, const int rect_w, const int rect_h,
-                             const int tile_w_log2, const int tile_h_log2, const int tiles_x, const uint tile_base, global const ClTriangle* tris,
-                             global const uint* tile_start, global const uint* tile_tris, const ClFragmentState fs,
-                             const ClBlendState bs, constant float4* uniforms, const uint uniform_base,
-                             global const float* buffer0,
+/* Triangle records are fetched this many tile-list entries ahead: tile lists jump through the
+ * triangle buffer, so without it every entry waits for memory. */
+#define CLVR_PREFETCH_AHEAD 8
+#if defined(__clang__) && defined(__x86_64__)
+/* PoCL's prefetch() does nothing; on x86 fetch the record's first two cache lines (header, attribute 0). */
+#define CLVR_PREFETCH(p, n) __asm__ volatile("prefetcht0 (%0)\n\tprefetcht0 64(%0)" : : "r"(p))
+#else
+#define CLVR_PREFETCH(p, n) prefetch((p), (n))
+#endif
+
+/* One work-item per item of the pass (ClRasterPass). The item walks its tile's list once, in
+ * submission order, and for each triangle the pixels of the triangle's col/row bounds (which include
+ * GL's scissor rectangle) inside the item, row by row; so every pixel sees its fragments in submission
+ * order and no other work-item touches it. The item's pixels stay in private memory meanwhile (on a
+ * CPU an item is a whole tile: a tile list is walked once and its pixels read and written once; on a
+ * GPU an item is a pixel). fragment_counts[item row] accumulates the covered-pixel count of that row
+ * of items over launches until the host reads and clears it. */
+kernel void raster_fragments(global float4* color, global float* depth, global uchar* stencil, const ClRasterPass pass,
+                             global const float4* triangles, global const uint* tile_start,
+                             global const uint* tile_tris, constant float4* uniforms, global const float* buffer0,
                              global const float* buffer1, global const float* buffer2, global const float* buffer3,
                              global uint* fragment_counts)
 {
-    CLVR_GUARD_2D((rect_w + CLVR_PIXELS_PER_ITEM - 1) / CLVR_PIXELS_PER_ITEM, rect_h);
-    const int gx0 = (int)get_global_id(0) * CLVR_PIXELS_PER_ITEM;
-    const int gy = (int)get_global_id(1);
-    /* Shifts, not divisions: an integer division per work-item was the launch's largest cost. */
-    const uint tile = tile_base + (uint)((gy >> tile_h_log2) * tiles_x + (gx0 >> tile_w_log2));
+    const int item_w = 1 << pass.item_w_log2, item_h = 1 << pass.item_h_log2;
+    CLVR_GUARD_2D((pass.rect_w + item_w - 1) >> pass.item_w_log2, (pass.rect_h + item_h - 1) >> pass.item_h_log2);
+    const int gx0 = (int)get_global_id(0) << pass.item_w_log2;  /* the item's corner in the rectangle */
+    const int gy0 = (int)get_global_id(1) << pass.item_h_log2;
+    /* Shifts, not divisions: an integer division per work-item was once the launch's largest cost. */
+    const uint tile = pass.tile_base + (uint)((gy0 >> pass.tile_h_log2) * pass.tiles_x + (gx0 >> pass.tile_w_log2));
     const uint begin = tile_start[tile];
     const uint end = tile_start[tile + 1];
     if (begin == end)
         return;
 
-    const int px0 = rect_x + gx0;
-    const int py = rect_y + gy;
-    const int count = min(CLVR_PIXELS_PER_ITEM, rect_w - gx0);
-    const int px1 = px0 + count - 1;  /* last pixel of this work-item */
-    const size_t pixel0 = (size_t)py * (size_t)fb_width + (size_t)px0;
-    const int sx0 = px0 * CLVR_SUBPIXEL_SCALE + CLVR_SUBPIXEL_SCALE / 2;  /* first pixel center */
-    const int sy = py * CLVR_SUBPIXEL_SCALE + CLVR_SUBPIXEL_SCALE / 2;
+    /* The item's pixels, ends inclusive, and its private copy of them (row-major, w per row). */
+    const int x0 = pass.rect_x + gx0, x1 = min(x0 + item_w, pass.rect_x + pass.rect_w) - 1;
+    const int y0 = pass.rect_y + gy0, y1 = min(y0 + item_h, pass.rect_y + pass.rect_h) - 1;
+    const int w = x1 - x0 + 1;
+    float4 c[CLVR_ITEM_PIXELS];
+    float d[CLVR_ITEM_PIXELS];
+    uint s[CLVR_ITEM_PIXELS];
+    for (int py = y0, l = 0; py <= y1; ++py)
+        for (int px = x0; px <= x1; ++px, ++l) {
+            const size_t i = (size_t)py * (size_t)pass.fb_width + (size_t)px;
+            c[l] = color[i];
+            d[l] = depth[i];
+            s[l] = stencil[i];
+        }
 
     ClFragmentResources resources;
     resources.buffer[0] = buffer0;
     resources.buffer[1] = buffer1;
     resources.buffer[2] = buffer2;
     resources.buffer[3] = buffer3;
-    resources.uniforms = uniforms + uniform_base;
+    resources.uniforms = uniforms + pass.uniform_base;
+    const ClFragmentState fs = pass.fragment;
+    const ClBlendState bs = pass.blend;
     const ClvrBlend blend = clvr_blend_setup(&bs);
     const int4 write_mask = (int4)((fs.color_mask & CLVR_MASK_R) ? -1 : 0, (fs.color_mask & CLVR_MASK_G) ? -1 : 0,
                                    (fs.color_mask & CLVR_MASK_B) ? -1 : 0, (fs.color_mask & CLVR_MASK_A) ? -1 : 0);
+    global const float4* pass_triangles = triangles + pass.triangle_base;
+    const size_t stride = CLVR_TRIANGLE_FLOAT4S(CLVR_ATTRIBUTES);
 
-    float4 c[CLVR_PIXELS_PER_ITEM];
-    float d[CLVR_PIXELS_PER_ITEM];
-    uint s[CLVR_PIXELS_PER_ITEM];
     uint covered = 0;
-#pragma unroll
-    for (int p = 0; p < CLVR_PIXELS_PER_ITEM; ++p) {
-        const size_t i = pixel0 + (size_t)min(p, count - 1);  /* past the rectangle: a harmless duplicate */
-        c[p] = color[i];
-        d[p] = depth[i];
-        s[p] = stencil[i];
-    }
-
     for (uint i = begin; i < end; ++i) {
-        global const ClTriangle* t = tris + tile_tris[i];
-        const int col_min = t->col_min, col_max = t->col_max;
-        if (py < t->row_min || py > t->row_max || px1 < col_min || px0 > col_max)
+        if (i + CLVR_PREFETCH_AHEAD < end)
+            CLVR_PREFETCH(pass_triangles + tile_tris[i + CLVR_PREFETCH_AHEAD] * stride, stride);
+        global const float4* record = pass_triangles + tile_tris[i] * stride;
+        global const ClTriangle* t = (global const ClTriangle*)record;
+        const int cx0 = max(t->col_min, x0), cx1 = min(t->col_max, x1);
+        const int cy0 = max(t->row_min, y0), cy1 = min(t->row_max, y1);
+        if (cx0 > cx1 || cy0 > cy1)
             continue;
-        /* e0: edge 0->1 (opposite vertex 2), e1: edge 1->2 (opposite 0), e2: edge 2->0 (opposite 1);
-         * one pixel to the right adds -(y_b - y_a) * CLVR_SUBPIXEL_SCALE. */
-        long e0 = clvr_edge(t->x[0], t->y[0], t->x[1], t->y[1], sx0, sy);
-        long e1 = clvr_edge(t->x[1], t->y[1], t->x[2], t->y[2], sx0, sy);
-        long e2 = clvr_edge(t->x[2], t->y[2], t->x[0], t->y[0], sx0, sy);
-        const long step0 = -(long)(t->y[1] - t->y[0]) * CLVR_SUBPIXEL_SCALE;
-        const long step1 = -(long)(t->y[2] - t->y[1]) * CLVR_SUBPIXEL_SCALE;
-        const long step2 = -(long)(t->y[0] - t->y[2]) * CLVR_SUBPIXEL_SCALE;
-#pragma unroll
-        for (int p = 0; p < CLVR_PIXELS_PER_ITEM; ++p) {
-            /* Top-left rule: a pixel center on an edge belongs to the triangle only for a top or left
-             * edge. col_max is inside the rectangle, so p < count holds for every pixel that passes. */
-            if (px0 + p >= col_min && px0 + p <= col_max && e0 + t->bias[0] >= 0 && e1 + t->bias[1] >= 0 &&
-                e2 + t->bias[2] >= 0) {
-                ++covered;
-                clvr_shade(t, e0, e1, e2, px0 + p, py, &fs, &bs, &blend, write_mask, &resources, &c[p], &d[p], &s[p]);
+        /* Edge values with the fill-rule bias at the first pixel center (e0: edge 0->1, opposite vertex 2;
+         * e1: edge 1->2, opposite 0; e2: edge 2->0, opposite 1); one pixel right adds -(y_b - y_a) *
+         * CLVR_SUBPIXEL_SCALE, one row down (x_b - x_a) * CLVR_SUBPIXEL_SCALE. Exact, so every pixel gets
+         * the values it would get on its own. Top-left rule: a center on an edge is inside (>= 0 with
+         * the bias) only for a top or left edge. */
+        const int sx = cx0 * CLVR_SUBPIXEL_SCALE + CLVR_SUBPIXEL_SCALE / 2;
+        const int sy = cy0 * CLVR_SUBPIXEL_SCALE + CLVR_SUBPIXEL_SCALE / 2;
+        const long b0 = t->bias[0], b1 = t->bias[1], b2 = t->bias[2];
+        long r0 = clvr_edge(t->x[0], t->y[0], t->x[1], t->y[1], sx, sy) + b0;
+        long r1 = clvr_edge(t->x[1], t->y[1], t->x[2], t->y[2], sx, sy) + b1;
+        long r2 = clvr_edge(t->x[2], t->y[2], t->x[0], t->y[0], sx, sy) + b2;
+        const long dx0 = -(long)(t->y[1] - t->y[0]) * CLVR_SUBPIXEL_SCALE;
+        const long dx1 = -(long)(t->y[2] - t->y[1]) * CLVR_SUBPIXEL_SCALE;
+        const long dx2 = -(long)(t->y[0] - t->y[2]) * CLVR_SUBPIXEL_SCALE;
+        const long dy0 = (long)(t->x[1] - t->x[0]) * CLVR_SUBPIXEL_SCALE;
+        const long dy1 = (long)(t->x[2] - t->x[1]) * CLVR_SUBPIXEL_SCALE;
+        const long dy2 = (long)(t->x[0] - t->x[2]) * CLVR_SUBPIXEL_SCALE;
+        for (int py = cy0; py <= cy1; ++py) {
+            long e0 = r0, e1 = r1, e2 = r2;
+            for (int px = cx0, l = (py - y0) * w + (cx0 - x0); px <= cx1; ++px, ++l) {
+                if (e0 >= 0 && e1 >= 0 && e2 >= 0) {
+                    ++covered;
+                    clvr_shade(t, record + 6, e0 - b0, e1 - b1, e2 - b2, px, py, &fs, &bs, &blend, write_mask,
+                               &resources, &c[l], &d[l], &s[l]);
+                }
+                e0 += dx0;
+                e1 += dx1;
+                e2 += dx2;
             }
-            e0 += step0;
-            e1 += step1;
-            e2 += step2;
+            r0 += dy0;
+            r1 += dy1;
+            r2 += dy2;
         }
     }
 
     if (covered) {
-#pragma unroll
-        for (int p = 0; p < CLVR_PIXELS_PER_ITEM; ++p) {
-            if (p < count) {
-                color[pixel0 + p] = c[p];
-                depth[pixel0 + p] = d[p];
-                stencil[pixel0 + p] = (uchar)s[p];
+        for (int py = y0, l = 0; py <= y1; ++py)
+            for (int px = x0; px <= x1; ++px, ++l) {
+                const size_t i = (size_t)py * (size_t)pass.fb_width + (size_t)px;
+                color[i] = c[l];
+                depth[i] = d[l];
+                stencil[i] = (uchar)s[l];
             }
-        }
-        atomic_add(fragment_counts + gy, covered);
+        atomic_add(fragment_counts + get_global_id(1), covered);
     }
 }
 
@@ -342,9 +374,13 @@ kernel void raster_layout_probe(global uint* out)
     CLVR_PROBE_OFFSET(13, ClTriangle, inv_area);
     CLVR_PROBE_OFFSET(14, ClTriangle, depth);
     CLVR_PROBE_OFFSET(15, ClTriangle, inv_w);
-    CLVR_PROBE_OFFSET(16, ClTriangle, attr_over_w);
+    CLVR_PROBE_SIZE(16, ClRasterPass);
     CLVR_PROBE_SIZE(17, ClTexture);
     CLVR_PROBE_OFFSET(18, ClTexture, border);
     CLVR_PROBE_OFFSET(19, ClTriangle, col_min);
     CLVR_PROBE_OFFSET(20, ClTriangle, row_max);
+    CLVR_PROBE_OFFSET(21, ClRasterPass, triangle_base);
+    CLVR_PROBE_OFFSET(22, ClRasterPass, fragment);
+    CLVR_PROBE_OFFSET(23, ClRasterPass, blend);
+    CLVR_PROBE_OFFSET(24, ClRasterPass, item_h_log2);
 }

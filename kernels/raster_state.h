@@ -13,10 +13,10 @@
  * coverage is decided by exact integer edge functions on the host, the device and the reference. */
 #define CLVR_SUBPIXEL_BITS 8
 #define CLVR_SUBPIXEL_SCALE 256
-/* Triangles are binned to square screen tiles of this many pixels; one work-item shades this many
- * horizontally adjacent pixels of a tile (CLVR_TILE_SIZE is a multiple of it). */
+/* Triangles are binned to screen tiles of at most CLVR_TILE_SIZE x CLVR_TILE_SIZE pixels, and a
+ * work-item (an "item") shades at most a tile's pixels; the host picks both shapes per device
+ * (raster/rasterizer.h, RasterShape). */
 #define CLVR_TILE_SIZE 16
-#define CLVR_PIXELS_PER_ITEM 8
 
 /* CompareFunc, StencilOp, BlendEquation and BlendFactor values: the host's enum classes. */
 #define CLVR_FUNC_NEVER 0u
@@ -83,7 +83,10 @@ typedef struct {
 } ClBlendState; /* 48 bytes */
 
 /* One set-up triangle after clipping, projection, viewport transform and snapping. Vertices are
- * ordered so that the edge functions are positive inside (clockwise on the row-down screen). */
+ * ordered so that the edge functions are positive inside (clockwise on the row-down screen). In the
+ * triangle buffer each one is followed by its pass's attributes: for attribute k = 0 .. n-1 (n: the
+ * fragment program's attribute count), attribute / clip w at vertices 0, 1, 2 as three float4, so a
+ * record is CLVR_TRIANGLE_FLOAT4S(n) float4s long. */
 typedef struct {
     cl_int x[3], y[3];  /* window position in 1/CLVR_SUBPIXEL_SCALE pixels, row-down */
     cl_int bias[3];     /* fill rule: 0 for a top or left edge (i -> i+1), -1 otherwise */
@@ -95,7 +98,26 @@ typedef struct {
     cl_uint pad0;
     cl_float4 depth;    /* window depth of vertices 0..2 in .x .y .z */
     cl_float4 inv_w;    /* 1 / clip w of vertices 0..2 in .x .y .z */
-    cl_float4 attr_over_w[3][CLVR_MAX_ATTRIBUTES]; /* attribute / clip w, per vertex */
-} ClTriangle; /* 288 bytes */
+} ClTriangle; /* 96 bytes = 6 float4 */
+
+#define CLVR_TRIANGLE_FLOAT4S(n) (6 + 3 * (n))
+
+/* One fragment launch (a pass: consecutive draws sharing program and state) over the viewport
+ * rectangle rect_* (clipped to the frame buffer). Tiles of 2^tile_w_log2 x 2^tile_h_log2 pixels and
+ * items of 2^item_w_log2 x 2^item_h_log2 pixels (one work-item each, inside one tile) start at the
+ * rectangle's corner; tile t of the pass lists its triangles in tile_start[tile_base + t] ..
+ * tile_start[tile_base + t + 1] of the submission's tile lists. */
+typedef struct {
+    cl_int fb_width;
+    cl_int rect_x, rect_y, rect_w, rect_h;
+    cl_int tile_w_log2, tile_h_log2, tiles_x;
+    cl_int item_w_log2, item_h_log2;
+    cl_uint tile_base;      /* the pass's first tile in tile_start */
+    cl_uint uniform_base;   /* the pass's first uniform in the submission's uniforms */
+    cl_ulong triangle_base; /* float4 offset of the pass's triangle 0 in the triangle buffer */
+    cl_uint pad0, pad1;
+    ClFragmentState fragment;
+    ClBlendState blend;
+} ClRasterPass; /* 176 bytes */
 
 #endif

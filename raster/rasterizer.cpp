@@ -1,6 +1,8 @@
 // raster/rasterizer.cpp — primitive assembly, clipping, set-up and tile binning on the host (in
 // double precision, then snapped to the subpixel grid), and the ordered fragment launches: one per pass
 // (a run of draws with the same program and state), from buffers that persist in the Rasterizer.
+// A triangle is binned as soon as it is set up, while its record is in cache; a submission then only
+// sorts the (tile, triangle) pairs into tile lists.
 #include "raster/rasterizer.h"
 
 #include "host/runtime/errors.h"
@@ -14,9 +16,10 @@
 
 namespace clvr::raster {
 
-static_assert(sizeof(ClTriangle) == 288, "also probed on the device by tests/layout_test.cpp");
+static_assert(sizeof(ClTriangle) == 96, "also probed on the device by tests/layout_test.cpp");
+static_assert(sizeof(ClTriangle) == CLVR_TRIANGLE_FLOAT4S(0) * sizeof(cl_float4));
 static_assert(offsetof(ClTriangle, depth) == 64);
-static_assert(offsetof(ClTriangle, attr_over_w) == 96);
+static_assert(sizeof(ClRasterPass) == 176 && offsetof(ClRasterPass, fragment) == 64);
 
 namespace {
 
@@ -93,7 +96,7 @@ std::vector<glm::dvec4> clipPlanes(const DrawState& state, const ResolvedViewpor
 struct WindowVertex {
     std::int64_t x, y;  // subpixel units, row-down
     double depth, invW;
-    std::array<glm::dvec4, kMaxAttributes> attrOverW;
+    std::array<glm::dvec4, kMaxAttributes> attrOverW;  // the first `attributes` are set
 };
 
 std::int64_t cross(const WindowVertex& a, const WindowVertex& b, const WindowVertex& c)
@@ -103,26 +106,37 @@ std::int64_t cross(const WindowVertex& a, const WindowVertex& b, const WindowVer
 
 float f(double v) { return static_cast<float>(v); }
 
+// floor(v) as an integer, for |v| < 2^62: the same value as static_cast<int64_t>(std::floor(v)) without
+// the libm call (x86-64's baseline has no rounding instruction).
+std::int64_t floorToInt(double v)
+{
+    const auto i = static_cast<std::int64_t>(v);  // truncates towards zero
+    return static_cast<double>(i) > v ? i - 1 : i;
+}
+
 // Perspective divide, viewport transform (clip +y to the top row), snap to the subpixel grid.
 // False for a vertex at w <= 0.
-bool toWindow(const glm::dvec4& position, const std::array<glm::dvec4, kMaxAttributes>& attributes,
+bool toWindow(const glm::dvec4& position, const std::array<glm::dvec4, kMaxAttributes>& attributes, int count,
               const ResolvedViewport& vp, WindowVertex& wv)
 {
     const double w = position.w;
     if (!(w > 0.0))
         return false;
     const glm::dvec3 ndc = glm::dvec3(position) / w;
-    wv.x = static_cast<std::int64_t>(std::floor((vp.x + (ndc.x + 1.0) * 0.5 * vp.width) * CLVR_SUBPIXEL_SCALE + 0.5));
-    wv.y = static_cast<std::int64_t>(std::floor((vp.y + (1.0 - ndc.y) * 0.5 * vp.height) * CLVR_SUBPIXEL_SCALE + 0.5));
+    wv.x = floorToInt((vp.x + (ndc.x + 1.0) * 0.5 * vp.width) * CLVR_SUBPIXEL_SCALE + 0.5);
+    wv.y = floorToInt((vp.y + (1.0 - ndc.y) * 0.5 * vp.height) * CLVR_SUBPIXEL_SCALE + 0.5);
     wv.depth = vp.nearZ + (ndc.z + 1.0) * 0.5 * (vp.farZ - vp.nearZ);
     wv.invW = 1.0 / w;
-    for (int k = 0; k < kMaxAttributes; ++k)
+    for (int k = 0; k < count; ++k)
         wv.attrOverW[k] = attributes[k] * wv.invW;
     return true;
 }
 
-// Tiles of a pass: tileW x tileH pixels from the rectangle's corner, powers of two (the kernel shifts).
-// tileW is a multiple of CLVR_PIXELS_PER_ITEM, so a work-item's pixels share a tile.
+bool powerOfTwoUpTo(int v, int max) { return v >= 1 && v <= max && (v & (v - 1)) == 0; }
+
+int log2Of(int powerOfTwo) { return std::countr_zero(static_cast<unsigned>(powerOfTwo)); }
+
+// The tiles of a pass: shape.tileW x shape.tileH pixels from the rectangle's corner.
 struct TileGrid {
     Rect rect;
     int tileW = CLVR_TILE_SIZE, tileH = CLVR_TILE_SIZE;
@@ -156,6 +170,7 @@ bool touches(const ClTriangle& t, const TileGrid& grid, int tx, int ty)
 bool sameBytes(const auto& a, const auto& b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 cl_float4 toCl4(const glm::vec4& v) { return cl_float4{{v.x, v.y, v.z, v.w}}; }
+cl_float4 toCl4(const glm::dvec4& v) { return cl_float4{{f(v.x), f(v.y), f(v.z), f(v.w)}}; }
 
 // Grows `buffer` to hold `bytes` (capacity at least doubles, so n draws cost O(log n) allocations).
 void reserve(Device& device, std::string_view what, cl::Buffer& buffer, std::size_t& capacity, std::size_t bytes,
@@ -167,7 +182,30 @@ void reserve(Device& device, std::string_view what, cl::Buffer& buffer, std::siz
     buffer = device.buffer(what, capacity, flags);
 }
 
-constexpr std::size_t kMaxRows = 16384;  // Framebuffer's largest height: one fragment counter per row
+// Triangles of a list, strip or fan of vertexCount vertices; InternalError for an unknown topology.
+std::uint32_t triangleCount(Topology topology, std::size_t vertexCount)
+{
+    const auto n = static_cast<std::uint32_t>(vertexCount);
+    switch (topology) {
+    case Topology::Triangles: return n / 3;
+    case Topology::TriangleStrip:
+    case Topology::TriangleFan: return n >= 3 ? n - 2 : 0;
+    }
+    throw InternalError("assembleTriangles: topology " + std::to_string(static_cast<int>(topology)) + " is unknown");
+}
+
+// Vertex indices of triangle i of a list, strip or fan (assembleTriangles, without the array); the
+// topology is one that triangleCount accepted.
+inline std::array<std::uint32_t, 3> triangleIndices(Topology topology, std::uint32_t i)
+{
+    if (topology == Topology::Triangles)
+        return {3 * i, 3 * i + 1, 3 * i + 2};
+    if (topology == Topology::TriangleFan)
+        return {0, i + 1, i + 2};
+    return i % 2 == 0 ? std::array<std::uint32_t, 3>{i, i + 1, i + 2} : std::array<std::uint32_t, 3>{i + 1, i, i + 2};
+}
+
+constexpr std::size_t kMaxRows = 16384;  // Framebuffer's largest height: one fragment counter per item row
 
 }  // namespace
 
@@ -175,6 +213,8 @@ constexpr std::size_t kMaxRows = 16384;  // Framebuffer's largest height: one fr
 struct CompiledFragmentProgram {
     cl_context context = nullptr;
     std::size_t sourceSize = 0;
+    int attributes = 0;
+    int itemPixels = 0;
     cl::Kernel kernel;  // set per launch; only one thread uses a Rasterizer (rasterizer.h)
 };
 
@@ -184,26 +224,32 @@ struct Pass {
     std::array<cl::Buffer, 4> buffers;
     ClFragmentState fragment;
     ClBlendState blend;
-    Rect rect;                      // the viewport rectangle: the launch's extent and its tiles' origin
+    int attributes = 0;             // the program's: its triangle records are CLVR_TRIANGLE_FLOAT4S(attributes) long
+    TileGrid grid;                  // its rect is the viewport rectangle: the launch's extent and its tiles' origin
     std::size_t uniformBase = 0;    // first uniform in SetUpDraws::uniforms
     std::size_t uniformCount = 0;
-    std::size_t firstTriangle = 0;  // triangles [firstTriangle, endTriangle) of SetUpDraws::triangles
-    std::size_t endTriangle = 0;
+    std::size_t triangleBase = 0;   // float4 offset of its first triangle in SetUpDraws::triangles
+    std::size_t triangles = 0;
+    std::size_t tileBase = 0;       // its first tile in SetUpDraws::tileCounts
 };
 
 struct SetUpDraws {
     int fbWidth = 0, fbHeight = 0;
-    std::vector<ClTriangle> triangles;  // set up, in submission order
+    RasterShape shape;
+    std::vector<cl_float4> triangles;                 // set-up records, in submission order
+    std::vector<cl_uint> tileCounts;                  // entries per tile, the tiles of every pass in turn
+    std::vector<std::array<cl_uint, 2>> pairs;        // (tile, triangle of its pass), in submission order
     std::vector<Pass> passes;
     std::vector<cl_float4> uniforms;
     std::uint64_t setUp = 0;            // DrawStats::triangles: also those whose pixel box is empty
     std::size_t draws = 0;
     std::vector<ClipVertex> polygon, scratch;
-    std::vector<WindowVertex> window;
 
     void clear()
     {
         triangles.clear();
+        tileCounts.clear();
+        pairs.clear();
         passes.clear();
         uniforms.clear();
         setUp = 0;
@@ -216,9 +262,8 @@ struct SetUpDraws {
 struct RasterScratch {
     cl::Buffer triangles, tileStarts, tileTris, uniforms, fragmentCounts, dummy;
     std::size_t triangleBytes = 0, tileStartBytes = 0, tileTrisBytes = 0, uniformBytes = 0;
-    std::vector<ClTriangle> stagedTriangles;
+    std::vector<cl_float4> stagedTriangles;
     std::vector<cl_uint> stagedTileStarts, stagedTileTris;
-    std::vector<std::array<cl_uint, 2>> binPairs;  // binPass's (tile, triangle) scratch
     std::vector<cl_float4> stagedUniforms;
     std::vector<cl::Event> uploads;
     std::size_t maxUniforms = 0;  // the device's constant buffer size in float4s
@@ -235,22 +280,26 @@ struct RasterScratch {
 
 namespace {
 
-// Hands the (empty) triangle array of `from`, with its capacity, to `to`: a DrawBatch borrows the
-// Rasterizer's, so that a batch per frame does not grow its array from nothing (and fault in fresh
-// pages) every frame. Only the capacity moves; pending draws are never lost.
+// Hands the (empty) host arrays of `from`, with their capacity, to `to`: a DrawBatch borrows the
+// Rasterizer's, so that a batch per frame does not grow its arrays from nothing (and fault in fresh
+// pages) every frame. Only capacity moves; pending draws are never lost.
 void lendCapacity(SetUpDraws& from, SetUpDraws& to)
 {
-    if (!from.triangles.empty())
-        return;
-    to.triangles.clear();
-    if (to.triangles.capacity() < from.triangles.capacity())
-        to.triangles.swap(from.triangles);
+    const auto lend = [](auto& a, auto& b) {
+        if (!a.empty())
+            return;
+        b.clear();
+        if (b.capacity() < a.capacity())
+            b.swap(a);
+    };
+    lend(from.triangles, to.triangles);
+    lend(from.pairs, to.pairs);
 }
 
 // Sets up and bins one draw into `out` (docs/raster.md, steps 1-6), extending its last pass when the draw
 // shares that pass's program, buffers, uniforms, rectangle and fragment state.
 void setUpDraw(SetUpDraws& out, const DrawState& state, Topology topology, const std::vector<Vertex>& vertices,
-               const cl::Kernel& kernel, const FragmentProgram& program)
+               const cl::Kernel& kernel, const FragmentProgram& program, int attributes)
 {
     if (state.clipPlanes.size() > static_cast<std::size_t>(kMaxClipPlanes))
         throw InternalError("draw: " + std::to_string(state.clipPlanes.size()) + " clip planes, at most " +
@@ -280,7 +329,8 @@ void setUpDraw(SetUpDraws& out, const DrawState& state, Topology topology, const
     // The pass this draw joins.
     const ClFragmentState clFragment = toCl(fs);
     const ClBlendState clBlend = toCl(fs.blend);
-    std::vector<cl_float4> uniforms(std::max<std::size_t>(program.uniforms.size(), 1), cl_float4{{0, 0, 0, 0}});
+    std::array<cl_float4, kMaxUniforms> uniforms{};
+    const std::size_t uniformCount = std::max<std::size_t>(program.uniforms.size(), 1);
     for (std::size_t i = 0; i < program.uniforms.size(); ++i)
         uniforms[i] = toCl4(program.uniforms[i]);
     const auto sameBuffers = [&](const Pass& p) {
@@ -290,23 +340,33 @@ void setUpDraw(SetUpDraws& out, const DrawState& state, Topology topology, const
         return true;
     };
     const auto sameUniforms = [&](const Pass& p) {
-        return p.uniformCount == uniforms.size() &&
-               std::memcmp(out.uniforms.data() + p.uniformBase, uniforms.data(), uniforms.size() * sizeof(cl_float4)) == 0;
+        return p.uniformCount == uniformCount &&
+               std::memcmp(out.uniforms.data() + p.uniformBase, uniforms.data(), uniformCount * sizeof(cl_float4)) == 0;
     };
     if (out.passes.empty() || out.passes.back().kernel() != kernel() || !sameBuffers(out.passes.back()) ||
         !sameBytes(out.passes.back().fragment, clFragment) || !sameBytes(out.passes.back().blend, clBlend) ||
-        !sameBytes(out.passes.back().rect, rect) || !sameUniforms(out.passes.back())) {
-        Pass p{kernel, program.buffers, clFragment, clBlend, rect, out.uniforms.size(), uniforms.size(),
-               out.triangles.size(), out.triangles.size()};
-        out.uniforms.insert(out.uniforms.end(), uniforms.begin(), uniforms.end());
+        !sameBytes(out.passes.back().grid.rect, rect) || !sameUniforms(out.passes.back())) {
+        Pass p{kernel, program.buffers, clFragment, clBlend, attributes, TileGrid{rect, out.shape.tileW, out.shape.tileH},
+               out.uniforms.size(), uniformCount, out.triangles.size(), 0, out.tileCounts.size()};
+        out.uniforms.insert(out.uniforms.end(), uniforms.begin(), uniforms.begin() + static_cast<std::ptrdiff_t>(uniformCount));
+        out.tileCounts.resize(out.tileCounts.size() + static_cast<std::size_t>(p.grid.tilesX()) * p.grid.tilesY(), 0);
         out.passes.push_back(std::move(p));
     }
     Pass& pass = out.passes.back();
+    const TileGrid& grid = pass.grid;
+    const int tilesX = grid.tilesX();
+    const int tileWLog2 = log2Of(grid.tileW), tileHLog2 = log2Of(grid.tileH);
+    const std::size_t stride = CLVR_TRIANGLE_FLOAT4S(attributes);
 
     std::vector<ClipVertex>& polygon = out.polygon;
     std::vector<ClipVertex>& scratch = out.scratch;
-    std::vector<WindowVertex>& window = out.window;
-    for (const auto& indices : assembleTriangles(topology, vertices.size())) {
+    // The clipped polygon in window coordinates: each of the planes (near, far, the user's, four guard
+    // band planes) adds at most one vertex to a convex polygon.
+    std::array<WindowVertex, 3 + 2 + kMaxClipPlanes + 4> window;
+    std::size_t windowSize = 0;
+    const std::uint32_t count = triangleCount(topology, vertices.size());
+    for (std::uint32_t triangle = 0; triangle < count; ++triangle) {
+        const std::array<std::uint32_t, 3> indices = triangleIndices(topology, triangle);
         bool inside = true;
         glm::dvec4 position[3];
         for (int j = 0; j < 3; ++j) {
@@ -314,19 +374,17 @@ void setUpDraw(SetUpDraws& out, const DrawState& state, Topology topology, const
             for (const glm::dvec4& p : planes)
                 inside = inside && glm::dot(p, position[j]) >= 0.0;
         }
-        window.clear();
+        windowSize = 0;
         bool finite = true;
-        const auto project = [&](const glm::dvec4& pos, const std::array<glm::dvec4, kMaxAttributes>& attributes) {
-            WindowVertex wv;
-            finite = finite && toWindow(pos, attributes, vp, wv);
-            window.push_back(wv);
+        const auto project = [&](const glm::dvec4& pos, const std::array<glm::dvec4, kMaxAttributes>& attrs) {
+            finite = finite && toWindow(pos, attrs, attributes, vp, window[windowSize++]);
         };
-        std::array<glm::dvec4, kMaxAttributes> attributes;
+        std::array<glm::dvec4, kMaxAttributes> attrs;
         if (inside) {  // the common case: no clipping, straight from the vertices
             for (int j = 0; j < 3 && finite; ++j) {
-                for (int k = 0; k < kMaxAttributes; ++k)
-                    attributes[k] = glm::dvec4(vertices[indices[j]].attributes[k]);
-                project(position[j], attributes);
+                for (int k = 0; k < attributes; ++k)
+                    attrs[k] = glm::dvec4(vertices[indices[j]].attributes[k]);
+                project(position[j], attrs);
             }
         } else {
             polygon.clear();
@@ -355,7 +413,7 @@ void setUpDraw(SetUpDraws& out, const DrawState& state, Topology topology, const
         // Facing from the polygon's signed area. cross() > 0 is clockwise on the row-down screen,
         // so counter-clockwise as GL sees it (y up) is cross() < 0.
         std::int64_t area2 = 0;
-        for (std::size_t i = 1; i + 1 < window.size(); ++i)
+        for (std::size_t i = 1; i + 1 < windowSize; ++i)
             area2 += cross(window[0], window[i], window[i + 1]);
         if (area2 == 0)
             continue;
@@ -364,7 +422,7 @@ void setUpDraw(SetUpDraws& out, const DrawState& state, Topology topology, const
             (fs.cull == CullFace::Back && !front))
             continue;
 
-        for (std::size_t i = 1; i + 1 < window.size(); ++i) {
+        for (std::size_t i = 1; i + 1 < windowSize; ++i) {
             const WindowVertex* v[3] = {&window[0], &window[i], &window[i + 1]};
             const std::int64_t a2 = cross(*v[0], *v[1], *v[2]);
             // A fan triangle whose snapped orientation disagrees with the polygon's is a snapping
@@ -386,7 +444,7 @@ void setUpDraw(SetUpDraws& out, const DrawState& state, Topology topology, const
             if (px0 > px1 || py0 > py1)
                 continue;
 
-            ClTriangle& t = out.triangles.emplace_back();
+            ClTriangle t{};
             for (int j = 0; j < 3; ++j) {
                 const WindowVertex& a = *v[j];
                 const WindowVertex& b = *v[(j + 1) % 3];
@@ -396,10 +454,6 @@ void setUpDraw(SetUpDraws& out, const DrawState& state, Topology topology, const
                 // Top-left rule (row-down, edge functions positive inside): a left edge runs up, a
                 // top edge runs exactly horizontal to the right.
                 t.bias[j] = (dy < 0 || (dy == 0 && dx > 0)) ? 0 : -1;
-                for (int k = 0; k < kMaxAttributes; ++k) {
-                    const glm::dvec4& aw = a.attrOverW[k];
-                    t.attr_over_w[j][k] = cl_float4{{f(aw.x), f(aw.y), f(aw.z), f(aw.w)}};
-                }
             }
             t.front_facing = front ? 1u : 0u;
             t.inv_area = f(1.0 / static_cast<double>(std::llabs(a2)));
@@ -407,67 +461,30 @@ void setUpDraw(SetUpDraws& out, const DrawState& state, Topology topology, const
             t.col_max = px1;
             t.row_min = py0;
             t.row_max = py1;
-            t.pad0 = 0;
             t.depth = cl_float4{{f(v[0]->depth), f(v[1]->depth), f(v[2]->depth), 0.0f}};
             t.inv_w = cl_float4{{f(v[0]->invW), f(v[1]->invW), f(v[2]->invW), 0.0f}};
+            std::array<cl_float4, CLVR_TRIANGLE_FLOAT4S(kMaxAttributes)> record;
+            std::memcpy(record.data(), &t, sizeof t);
+            for (int k = 0; k < attributes; ++k)
+                for (int j = 0; j < 3; ++j)
+                    record[CLVR_TRIANGLE_FLOAT4S(k) + j] = toCl4(v[j]->attrOverW[k]);
+            out.triangles.insert(out.triangles.end(), record.begin(), record.begin() + static_cast<std::ptrdiff_t>(stride));
+
+            // Binned now, while the record is in cache: every tile of its pixel box that it can cover.
+            const auto index = static_cast<cl_uint>(pass.triangles++);
+            const int tx0 = (px0 - rect.x) >> tileWLog2, tx1 = (px1 - rect.x) >> tileWLog2;
+            const int ty0 = (py0 - rect.y) >> tileHLog2, ty1 = (py1 - rect.y) >> tileHLog2;
+            // One tile holds every center the triangle can cover: the corner test could only drop it.
+            const bool single = tx0 == tx1 && ty0 == ty1;
+            for (int ty = ty0; ty <= ty1; ++ty)
+                for (int tx = tx0; tx <= tx1; ++tx)
+                    if (single || touches(t, grid, tx, ty)) {
+                        const auto tile = static_cast<cl_uint>(pass.tileBase + static_cast<std::size_t>(ty) * tilesX + tx);
+                        ++out.tileCounts[tile];
+                        out.pairs.push_back({tile, index});
+                    }
         }
     }
-    pass.endTriangle = out.triangles.size();
-}
-
-// The tiles of a pass. Every work-item walks its tile's whole list, so small triangles get one-row
-// tiles of one work-item (each entry then is a triangle crossing that work-item's pixels) and large ones
-// 16x16 tiles (a triangle over the whole screen makes 1/32 of the entries). Only speed depends on it.
-TileGrid tileGrid(const std::vector<ClTriangle>& triangles, const Pass& pass)
-{
-    std::uint64_t rows = 0;
-    for (std::size_t i = pass.firstTriangle; i < pass.endTriangle; ++i)
-        rows += static_cast<std::uint64_t>(triangles[i].row_max - triangles[i].row_min + 1);
-    const bool small = rows <= 8 * (pass.endTriangle - pass.firstTriangle);  // mean height <= 8 rows
-    return small ? TileGrid{pass.rect, CLVR_PIXELS_PER_ITEM, 1} : TileGrid{pass.rect, CLVR_TILE_SIZE, CLVR_TILE_SIZE};
-}
-
-// Tile lists of one pass in submission order, appended to the staging arrays: tile t's triangles are
-// tileTris[tileStarts[base + t] .. tileStarts[base + t + 1]). A counting sort: one walk over the
-// triangles records each (tile, triangle) pair in `pairs` and counts per tile, a prefix sum gives the
-// starts, and the pairs, still in submission order, are scattered into place. Returns base.
-std::size_t binPass(const std::vector<ClTriangle>& triangles, const Pass& pass, const TileGrid& grid,
-                    std::vector<cl_uint>& tileStarts, std::vector<cl_uint>& tileTris,
-                    std::vector<std::array<cl_uint, 2>>& pairs)
-{
-    const int tilesX = grid.tilesX();
-    const std::size_t tileCount = static_cast<std::size_t>(tilesX) * grid.tilesY();
-    const std::size_t base = tileStarts.size();
-    tileStarts.resize(base + tileCount + 1, 0);
-    cl_uint* start = tileStarts.data() + base;
-    pairs.clear();
-    for (std::size_t i = pass.firstTriangle; i < pass.endTriangle; ++i) {
-        const ClTriangle& t = triangles[i];
-        const int tx0 = (t.col_min - grid.rect.x) / grid.tileW, tx1 = (t.col_max - grid.rect.x) / grid.tileW;
-        const int ty0 = (t.row_min - grid.rect.y) / grid.tileH, ty1 = (t.row_max - grid.rect.y) / grid.tileH;
-        // One tile holds every center the triangle can cover: the corner test could only drop it.
-        const bool single = tx0 == tx1 && ty0 == ty1;
-        for (int ty = ty0; ty <= ty1; ++ty)
-            for (int tx = tx0; tx <= tx1; ++tx)
-                if (single || touches(t, grid, tx, ty)) {
-                    const auto tile = static_cast<cl_uint>(static_cast<std::size_t>(ty) * tilesX + tx);
-                    ++start[tile + 1];
-                    pairs.push_back({tile, static_cast<cl_uint>(i)});
-                }
-    }
-    std::uint64_t entries = tileTris.size();
-    start[0] = static_cast<cl_uint>(entries);
-    for (std::size_t i = 0; i < tileCount; ++i) {
-        entries += start[i + 1];
-        if (entries > std::numeric_limits<cl_uint>::max())
-            throw InputError("draw: more than 2^32 triangle-tile pairs in one submission; split the draw");
-        start[i + 1] = static_cast<cl_uint>(entries);
-    }
-    std::vector<cl_uint> cursor(start, start + tileCount);
-    tileTris.resize(entries);
-    for (const auto& [tile, triangle] : pairs)
-        tileTris[cursor[tile]++] = triangle;
-    return base;
 }
 
 }  // namespace
@@ -475,25 +492,10 @@ std::size_t binPass(const std::vector<ClTriangle>& triangles, const Pass& pass, 
 std::vector<std::array<std::uint32_t, 3>> assembleTriangles(Topology topology, std::size_t vertexCount)
 {
     std::vector<std::array<std::uint32_t, 3>> out;
-    const auto n = static_cast<std::uint32_t>(vertexCount);
-    switch (topology) {
-    case Topology::Triangles:
-        for (std::uint32_t i = 0; i + 2 < n; i += 3)
-            out.push_back({i, i + 1, i + 2});
-        break;
-    case Topology::TriangleStrip:
-        for (std::uint32_t i = 0; i + 2 < n; ++i)
-            out.push_back(i % 2 == 0 ? std::array<std::uint32_t, 3>{i, i + 1, i + 2}
-                                     : std::array<std::uint32_t, 3>{i + 1, i, i + 2});
-        break;
-    case Topology::TriangleFan:
-        for (std::uint32_t i = 1; i + 1 < n; ++i)
-            out.push_back({0, i, i + 1});
-        break;
-    default:
-        throw InternalError("assembleTriangles: topology " + std::to_string(static_cast<int>(topology)) +
-                            " is unknown");
-    }
+    const std::uint32_t count = triangleCount(topology, vertexCount);
+    out.reserve(count);
+    for (std::uint32_t i = 0; i < count; ++i)
+        out.push_back(triangleIndices(topology, i));
     return out;
 }
 
@@ -503,10 +505,26 @@ glm::vec4 clipPlaneFromWorld(const glm::vec4& worldPlane, const glm::mat4& viewP
     return glm::vec4(m * glm::dvec4(worldPlane));
 }
 
-Rasterizer::Rasterizer(Device& device)
-    : device_(device), scratch_(std::make_unique<RasterScratch>()), immediate_(std::make_unique<SetUpDraws>())
+RasterShape RasterShape::forDevice(Device& device)
 {
+    RasterShape shape;
+    if (device.device().getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_GPU)
+        shape.itemW = shape.itemH = 1;
+    return shape;
+}
+
+Rasterizer::Rasterizer(Device& device, RasterShape shape)
+    : device_(device), shape_(shape), scratch_(std::make_unique<RasterScratch>()),
+      immediate_(std::make_unique<SetUpDraws>())
+{
+    if (!powerOfTwoUpTo(shape.tileW, CLVR_TILE_SIZE) || !powerOfTwoUpTo(shape.tileH, CLVR_TILE_SIZE) ||
+        !powerOfTwoUpTo(shape.itemW, shape.tileW) || !powerOfTwoUpTo(shape.itemH, shape.tileH))
+        throw InternalError("raster shape: tiles " + std::to_string(shape.tileW) + "x" + std::to_string(shape.tileH) +
+                            ", items " + std::to_string(shape.itemW) + "x" + std::to_string(shape.itemH) +
+                            " (powers of two, items inside tiles, at most " + std::to_string(CLVR_TILE_SIZE) + ")");
     defaultProgram_.source = kDefaultFragmentProgram;
+    defaultProgram_.attributes = 1;
+    immediate_->shape = shape_;
     RasterScratch& s = *scratch_;
     s.maxUniforms = device.device().getInfo<CL_DEVICE_MAX_CONSTANT_BUFFER_SIZE>() / sizeof(cl_float4);
     s.fragmentCounts = device.buffer("raster fragment counts", kMaxRows * sizeof(cl_uint));
@@ -526,13 +544,22 @@ const CompiledFragmentProgram& Rasterizer::compiled(const FragmentProgram& progr
 {
     // The empty source is the default program; its memo lives in the Rasterizer (callers pass a temporary).
     const FragmentProgram& p = program.source.empty() ? defaultProgram_ : program;
+    if (p.attributes < 0 || p.attributes > kMaxAttributes)
+        throw InternalError("draw: a fragment program of " + std::to_string(p.attributes) + " attributes, at most " +
+                            std::to_string(kMaxAttributes));
     const cl_context context = device_.context()();
-    if (p.compiled && p.compiled->context == context && p.compiled->sourceSize == p.source.size())
+    const int itemPixels = shape_.itemW * shape_.itemH;
+    if (p.compiled && p.compiled->context == context && p.compiled->sourceSize == p.source.size() &&
+        p.compiled->attributes == p.attributes && p.compiled->itemPixels == itemPixels)
         return *p.compiled;
     auto c = std::make_shared<CompiledFragmentProgram>();
     c->context = context;
     c->sourceSize = p.source.size();
-    c->kernel = device_.kernel("raster.cl", "raster_fragments", p.source);
+    c->attributes = p.attributes;
+    c->itemPixels = itemPixels;
+    c->kernel = device_.kernel("raster.cl", "raster_fragments", p.source,
+                               "-DCLVR_ATTRIBUTES=" + std::to_string(p.attributes) +
+                                   " -DCLVR_ITEM_PIXELS=" + std::to_string(itemPixels));
     p.compiled = c;
     return *c;
 }
@@ -544,7 +571,8 @@ void Rasterizer::draw(Framebuffer& fb, const DrawState& state, Topology topology
     d.clear();
     d.fbWidth = fb.width();
     d.fbHeight = fb.height();
-    setUpDraw(d, state, topology, vertices, compiled(program).kernel, program);
+    const CompiledFragmentProgram& c = compiled(program);
+    setUpDraw(d, state, topology, vertices, c.kernel, program, c.attributes);
     submit(fb, d);
 }
 
@@ -556,22 +584,31 @@ void Rasterizer::submit(Framebuffer& fb, SetUpDraws& draws)
                             std::to_string(fb.height()));
     RasterScratch& s = *scratch_;
     s.setUp += draws.setUp;
-    if (draws.triangles.empty()) {
+    if (draws.pairs.empty()) {
         draws.clear();
         return;
     }
     s.uploadsDone();
-    s.stagedTileStarts.clear();
-    s.stagedTileTris.clear();
-    std::vector<std::size_t> bases;
-    std::vector<TileGrid> grids;
-    for (const Pass& pass : draws.passes) {
-        grids.push_back(tileGrid(draws.triangles, pass));
-        bases.push_back(pass.firstTriangle == pass.endTriangle || pass.rect.width == 0 || pass.rect.height == 0
-                            ? std::size_t(-1)
-                            : binPass(draws.triangles, pass, grids.back(), s.stagedTileStarts, s.stagedTileTris,
-                                      s.binPairs));
+
+    // Tile lists in submission order, a counting sort: the per-tile counts become starts (tile t's
+    // entries are stagedTileTris[start[t] .. start[t + 1])), and the pairs, still in submission order,
+    // are scattered into place.
+    const std::size_t tiles = draws.tileCounts.size();
+    s.stagedTileStarts.resize(tiles + 1);
+    std::uint64_t entries = 0;
+    for (std::size_t t = 0; t < tiles; ++t) {
+        s.stagedTileStarts[t] = static_cast<cl_uint>(entries);
+        entries += draws.tileCounts[t];
     }
+    if (entries > std::numeric_limits<cl_uint>::max())
+        throw InputError("draw: more than 2^32 triangle-tile pairs in one submission; split the draw");
+    s.stagedTileStarts[tiles] = static_cast<cl_uint>(entries);
+    s.stagedTileTris.resize(entries);
+    std::vector<cl_uint>& cursor = draws.tileCounts;  // reused: the counts are not needed any more
+    std::copy(s.stagedTileStarts.begin(), s.stagedTileStarts.end() - 1, cursor.begin());
+    for (const auto& [tile, triangle] : draws.pairs)
+        s.stagedTileTris[cursor[tile]++] = triangle;
+
     // This submission's triangles and uniforms become the staging; the caller refills the old staging.
     s.stagedTriangles.swap(draws.triangles);
     s.stagedUniforms.swap(draws.uniforms);
@@ -591,39 +628,47 @@ void Rasterizer::submit(Framebuffer& fb, SetUpDraws& draws)
     upload("raster tile lists", s.tileTris, s.tileTrisBytes, s.stagedTileTris, CL_MEM_READ_ONLY);
     upload("fragment program uniforms", s.uniforms, s.uniformBytes, s.stagedUniforms, CL_MEM_READ_ONLY);
 
-    static_assert(CLVR_TILE_SIZE % CLVR_PIXELS_PER_ITEM == 0);  // both tile widths hold whole work-items
-    for (std::size_t i = 0; i < draws.passes.size(); ++i) {
-        const Pass& pass = draws.passes[i];
-        if (bases[i] == std::size_t(-1))
+    const std::size_t groupW = shape_.tileW / shape_.itemW, groupH = shape_.tileH / shape_.itemH;
+    for (const Pass& pass : draws.passes) {
+        const TileGrid& grid = pass.grid;
+        const Rect& rect = grid.rect;
+        if (pass.triangles == 0 || rect.width == 0 || rect.height == 0)
             continue;
-        const Rect& rect = pass.rect;
+        ClRasterPass p{};
+        p.fb_width = fb.width();
+        p.rect_x = rect.x;
+        p.rect_y = rect.y;
+        p.rect_w = rect.width;
+        p.rect_h = rect.height;
+        p.tile_w_log2 = log2Of(grid.tileW);
+        p.tile_h_log2 = log2Of(grid.tileH);
+        p.tiles_x = grid.tilesX();
+        p.item_w_log2 = log2Of(shape_.itemW);
+        p.item_h_log2 = log2Of(shape_.itemH);
+        p.tile_base = static_cast<cl_uint>(pass.tileBase);
+        p.uniform_base = static_cast<cl_uint>(pass.uniformBase);
+        p.triangle_base = pass.triangleBase;
+        p.fragment = pass.fragment;
+        p.blend = pass.blend;
         cl::Kernel k = pass.kernel;
         int arg = 0;
         k.setArg(arg++, fb.color());
         k.setArg(arg++, fb.depth());
         k.setArg(arg++, fb.stencil());
-        k.setArg(arg++, static_cast<cl_int>(fb.width()));
-        k.setArg(arg++, static_cast<cl_int>(rect.x));
-        k.setArg(arg++, static_cast<cl_int>(rect.y));
-        k.setArg(arg++, static_cast<cl_int>(rect.width));
-        k.setArg(arg++, static_cast<cl_int>(rect.height));
-        k.setArg(arg++, static_cast<cl_int>(std::countr_zero(static_cast<unsigned>(grids[i].tileW))));
-        k.setArg(arg++, static_cast<cl_int>(std::countr_zero(static_cast<unsigned>(grids[i].tileH))));
-        k.setArg(arg++, static_cast<cl_int>(grids[i].tilesX()));
-        k.setArg(arg++, static_cast<cl_uint>(bases[i]));
+        k.setArg(arg++, p);
         k.setArg(arg++, s.triangles);
         k.setArg(arg++, s.tileStarts);
         k.setArg(arg++, s.tileTris);
-        k.setArg(arg++, pass.fragment);
-        k.setArg(arg++, pass.blend);
         k.setArg(arg++, s.uniforms);
-        k.setArg(arg++, static_cast<cl_uint>(pass.uniformBase));
         for (const cl::Buffer& b : pass.buffers)
             k.setArg(arg++, b() ? b : s.dummy);
         k.setArg(arg++, s.fragmentCounts);
-        const std::size_t items = (static_cast<std::size_t>(rect.width) + CLVR_PIXELS_PER_ITEM - 1) / CLVR_PIXELS_PER_ITEM;
-        device_.launch("raster: fragments", k, items, static_cast<std::size_t>(rect.height));
-        s.rowsCounted = std::max<std::size_t>(s.rowsCounted, static_cast<std::size_t>(rect.height));
+        // A CPU runs one item per work-group: PoCL would otherwise keep the private pixels of every
+        // work-item of a group in one stack array (its context arrays), far apart in memory.
+        const std::size_t itemsX = (static_cast<std::size_t>(rect.width) + shape_.itemW - 1) / shape_.itemW;
+        const std::size_t itemsY = (static_cast<std::size_t>(rect.height) + shape_.itemH - 1) / shape_.itemH;
+        device_.launch("raster: fragments", k, itemsX, itemsY, groupW, groupH);
+        s.rowsCounted = std::max(s.rowsCounted, itemsY);
     }
     draws.clear();
 }
@@ -648,6 +693,7 @@ DrawBatch::DrawBatch(Rasterizer& rasterizer, Framebuffer& fb)
 {
     draws_->fbWidth = fb.width();
     draws_->fbHeight = fb.height();
+    draws_->shape = rasterizer.shape_;
     lendCapacity(*rasterizer_.immediate_, *draws_);
 }
 
@@ -659,7 +705,8 @@ void DrawBatch::add(const DrawState& state, Topology topology, const std::vector
     // The uniforms of one submission are one constant buffer: flush before it would overflow.
     if (draws_->uniforms.size() + kMaxUniforms > rasterizer_.scratch_->maxUniforms)
         flush();
-    setUpDraw(*draws_, state, topology, vertices, rasterizer_.compiled(program).kernel, program);
+    const CompiledFragmentProgram& c = rasterizer_.compiled(program);
+    setUpDraw(*draws_, state, topology, vertices, c.kernel, program, c.attributes);
 }
 
 void DrawBatch::flush()

@@ -1,8 +1,9 @@
 // raster/rasterizer.h — the ordered triangle rasterizer and GL's per-fragment operations
 // (DESIGN.md, raster stage; the exact rules are in docs/raster.md). Triangles are clipped, set up
-// and binned to screen tiles on the host in submission order; one work-item per 8 pixels of a row
-// then walks its tile's list in that order, so blending is exactly ordered and two runs give identical
-// bits. Rasterizer and DrawBatch (below) make many draws cheap; raster::draw is the one-shot form.
+// and binned to screen tiles on the host in submission order; one work-item per rectangle of pixels
+// (a whole tile on a CPU) then walks its tile's list in that order, so blending is exactly ordered and
+// two runs give identical bits. Rasterizer and DrawBatch (below) make many draws cheap; raster::draw
+// is the one-shot form.
 #pragma once
 
 #include "host/runtime/device.h"
@@ -46,11 +47,15 @@ struct CompiledFragmentProgram;  // raster/rasterizer.cpp: the raster kernel bui
 // (texture.h). Empty: color = attribute 0.
 struct FragmentProgram {
     std::string source;
+    // f->attr[0 .. attributes-1] are interpolated; the others read as zero. Each attribute adds 48 bytes
+    // to every triangle record, so a program that reads one attribute says so (the default program does).
+    int attributes = kMaxAttributes;
     std::array<cl::Buffer, 4> buffers;  // r->buffer[i]; null ones are bound to a dummy
     std::vector<glm::vec4> uniforms;    // r->uniforms[i], up to kMaxUniforms
     // Filled by the first draw with this program and shared by its copies: the built raster kernel, so
     // that later draws never look the (often 20 KB) source up again. Set `source` before the first draw;
-    // to draw another source, use another FragmentProgram (a source of another length is rebuilt).
+    // to draw another source, use another FragmentProgram (a source of another length, or another
+    // attribute count, is rebuilt).
     mutable std::shared_ptr<const CompiledFragmentProgram> compiled;
 };
 
@@ -80,6 +85,17 @@ struct DrawStats {
 DrawStats draw(Device& device, Framebuffer& fb, const DrawState& state, Topology topology,
                const std::vector<Vertex>& vertices, const FragmentProgram& program = {});
 
+// How a fragment launch divides the viewport rectangle: tiles of tileW x tileH pixels (one triangle list
+// each) and items of itemW x itemH pixels (one work-item each, inside one tile), powers of two up to
+// CLVR_TILE_SIZE. Only speed depends on it: every shape gives the same bits.
+struct RasterShape {
+    int tileW = CLVR_TILE_SIZE, tileH = CLVR_TILE_SIZE;
+    int itemW = CLVR_TILE_SIZE, itemH = CLVR_TILE_SIZE;
+    // A CPU walks each tile list once (item = tile); a GPU gives each pixel a work-item (1x1 items) and
+    // each tile a work-group's worth of them.
+    static RasterShape forDevice(Device& device);
+};
+
 #define CLVR_RASTER_BATCHES 1  // Rasterizer and DrawBatch exist (tools/bench_raster.cpp compiles without)
 
 struct SetUpDraws;    // raster/rasterizer.cpp: draws set up and binned on the host, not yet launched
@@ -93,7 +109,9 @@ struct RasterScratch;  // raster/rasterizer.cpp: device buffers, host staging an
 // take the stats at least once a frame.
 class Rasterizer {
 public:
-    explicit Rasterizer(Device& device);
+    explicit Rasterizer(Device& device) : Rasterizer(device, RasterShape::forDevice(device)) {}
+    // InternalError for a shape that is not powers of two up to CLVR_TILE_SIZE with items inside tiles.
+    Rasterizer(Device& device, RasterShape shape);
     ~Rasterizer();
     Rasterizer(const Rasterizer&) = delete;
     Rasterizer& operator=(const Rasterizer&) = delete;
@@ -108,6 +126,7 @@ public:
     DrawStats takeStats();
 
     Device& device() { return device_; }
+    const RasterShape& shape() const { return shape_; }
 
 private:
     friend class DrawBatch;
@@ -115,6 +134,7 @@ private:
     void submit(Framebuffer& fb, SetUpDraws& draws);
 
     Device& device_;
+    RasterShape shape_;
     FragmentProgram defaultProgram_;  // kDefaultFragmentProgram, for draws with an empty source
     std::unique_ptr<RasterScratch> scratch_;
     std::unique_ptr<SetUpDraws> immediate_;  // draw()'s one-draw batch, reused

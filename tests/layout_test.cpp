@@ -52,11 +52,15 @@ TEST(Layout, DeviceAndHostAgreeOnEveryClStruct)
         {"offsetof(ClTriangle, inv_area)", offsetof(ClTriangle, inv_area)},
         {"offsetof(ClTriangle, depth)", offsetof(ClTriangle, depth)},
         {"offsetof(ClTriangle, inv_w)", offsetof(ClTriangle, inv_w)},
-        {"offsetof(ClTriangle, attr_over_w)", offsetof(ClTriangle, attr_over_w)},
+        {"sizeof(ClRasterPass)", sizeof(ClRasterPass)},
         {"sizeof(ClTexture)", sizeof(ClTexture)},
         {"offsetof(ClTexture, border)", offsetof(ClTexture, border)},
         {"offsetof(ClTriangle, col_min)", offsetof(ClTriangle, col_min)},
         {"offsetof(ClTriangle, row_max)", offsetof(ClTriangle, row_max)},
+        {"offsetof(ClRasterPass, triangle_base)", offsetof(ClRasterPass, triangle_base)},
+        {"offsetof(ClRasterPass, fragment)", offsetof(ClRasterPass, fragment)},
+        {"offsetof(ClRasterPass, blend)", offsetof(ClRasterPass, blend)},
+        {"offsetof(ClRasterPass, item_h_log2)", offsetof(ClRasterPass, item_h_log2)},
     };
     for (std::size_t i = 0; i < std::size(want); ++i)
         EXPECT_EQ(got[i], want[i].second) << want[i].first << ": device " << got[i] << ", host " << want[i].second;

@@ -922,6 +922,104 @@ TEST(RasterBatch, SameBitsAsTheDrawsOneByOneAndMatchesReference)
 
 // A full-screen quad drawn four times in one batch, each with other state: the result is only right if
 // every state applies to its own draw, in order.
+// The work-item shape (tiles and items, raster/rasterizer.h) decides only speed: a CPU's whole-tile items,
+// a GPU's one-pixel items, and odd shapes on frame buffers that are no multiple of them give the same
+// bits and counts, as one draw at a time and as one batch.
+TEST(RasterShape, EveryShapeGivesTheSameBits)
+{
+    clvr::Device& device = clvr::test::device();
+    const raster::RasterShape shapes[] = {
+        {16, 16, 16, 16}, {16, 16, 1, 1}, {8, 8, 8, 8}, {16, 8, 4, 2}, {1, 1, 1, 1}, {4, 16, 4, 4}, {16, 2, 16, 1}};
+    Rng rng(313);
+    for (const auto& [width, height] : {std::pair{37, 23}, std::pair{61, 45}}) {
+        const Scene scene = randomScene(rng, width, height);
+        const std::vector<RandomDraw> draws = randomDraws(rng, 20, width, height);
+        raster::Framebuffer first(device, width, height);  // the CPU shape, the one to agree with
+        load(device, first, scene);
+        raster::Rasterizer cpu(device, shapes[0]);
+        for (const RandomDraw& d : draws)
+            cpu.draw(first, d.state, d.topology, d.vertices, d.program);
+        const raster::DrawStats firstStats = cpu.takeStats();
+        EXPECT_GT(firstStats.fragments, 0u);
+        for (const raster::RasterShape& shape : shapes) {
+            SCOPED_TRACE(std::to_string(width) + "x" + std::to_string(height) + ", tiles " + std::to_string(shape.tileW) +
+                         "x" + std::to_string(shape.tileH) + ", items " + std::to_string(shape.itemW) + "x" +
+                         std::to_string(shape.itemH));
+            raster::Rasterizer rasterizer(device, shape);
+            EXPECT_EQ(rasterizer.shape().itemW, shape.itemW);
+            raster::Framebuffer one(device, width, height), batched(device, width, height);
+            load(device, one, scene);
+            load(device, batched, scene);
+            for (const RandomDraw& d : draws)
+                rasterizer.draw(one, d.state, d.topology, d.vertices, d.program);
+            const raster::DrawStats oneStats = rasterizer.takeStats();
+            {
+                raster::DrawBatch batch(rasterizer, batched);
+                for (const RandomDraw& d : draws)
+                    batch.add(d.state, d.topology, d.vertices, d.program);
+                batch.flush();
+            }
+            const raster::DrawStats batchStats = rasterizer.takeStats();
+            expectIdentical(device, one, batched);
+            EXPECT_EQ(batchStats.fragments, oneStats.fragments);
+            expectIdentical(device, first, one);
+            EXPECT_EQ(oneStats.triangles, firstStats.triangles);
+            EXPECT_EQ(oneStats.fragments, firstStats.fragments);
+        }
+    }
+    EXPECT_THROW(raster::Rasterizer(device, raster::RasterShape{32, 32, 32, 32}), clvr::InternalError);
+    EXPECT_THROW(raster::Rasterizer(device, raster::RasterShape{16, 16, 3, 3}), clvr::InternalError);
+    EXPECT_THROW(raster::Rasterizer(device, raster::RasterShape{8, 8, 16, 16}), clvr::InternalError);
+    device.takePassTimes();
+}
+
+// FragmentProgram::attributes: the attributes a program reads are interpolated exactly as with all four,
+// the ones past the count read as zero, and a count out of range is an internal error.
+TEST(RasterFragmentProgram, AttributeCountKeepsTheReadOnesAndZeroesTheRest)
+{
+    clvr::Device& device = clvr::test::device();
+    const int width = 41, height = 29;
+    Rng rng(29);
+    const Scene scene = randomScene(rng, width, height);
+    const std::vector<raster::Vertex> v = randomVertices(rng, 60);
+    raster::DrawState state = blendedDepthStencil();
+    const auto program = [](int attributes) {
+        raster::FragmentProgram p;
+        p.source = R"(
+int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* color)
+{
+    (void)r;
+    *color = f->attr[0] + 2.0f * f->attr[1] + (f->attr[2] != 0.0f ? 4.0f : 0.0f) + (f->attr[3] != 0.0f ? 8.0f : 0.0f);
+    return 1;
+}
+)";
+        p.attributes = attributes;
+        return p;
+    };
+    const raster::FragmentProgram two = program(2), four = program(4);
+    raster::Framebuffer withTwo(device, width, height), withFour(device, width, height);
+    load(device, withTwo, scene);
+    load(device, withFour, scene);
+    raster::draw(device, withTwo, state, raster::Topology::Triangles, v, two);
+    // With all four attributes but attributes 2 and 3 zero at every vertex, the program reads what it
+    // reads with two.
+    std::vector<raster::Vertex> zeroed = v;
+    for (raster::Vertex& x : zeroed)
+        x.attributes[2] = x.attributes[3] = glm::vec4(0.0f);
+    raster::draw(device, withFour, state, raster::Topology::Triangles, zeroed, four);
+    expectIdentical(device, withTwo, withFour);
+    // And differently from four live attributes, so the comparison above could fail.
+    raster::Framebuffer live(device, width, height);
+    load(device, live, scene);
+    raster::draw(device, live, state, raster::Topology::Triangles, v, four);
+    EXPECT_FALSE(bytes(live.readColor(device)) == bytes(withTwo.readColor(device)));
+
+    raster::Framebuffer fb(device, 8, 8);
+    EXPECT_THROW(raster::draw(device, fb, state, raster::Topology::Triangles, v, program(5)), clvr::InternalError);
+    EXPECT_THROW(raster::draw(device, fb, state, raster::Topology::Triangles, v, program(-1)), clvr::InternalError);
+    device.takePassTimes();
+}
+
 TEST(RasterBatch, StateChangesTakeEffectInOrder)
 {
     clvr::Device& device = clvr::test::device();

@@ -228,11 +228,11 @@ cl::Kernel Device::kernel(std::string_view file, std::string_view kernelName, st
     }
 }
 
-void Device::enqueue(std::string name, const cl::Kernel& kernel, const cl::NDRange& global)
+void Device::enqueue(std::string name, const cl::Kernel& kernel, const cl::NDRange& global, const cl::NDRange& local)
 {
     cl::Event event;
     try {
-        queue_.enqueueNDRangeKernel(kernel, cl::NullRange, global, cl::NullRange, nullptr, &event);
+        queue_.enqueueNDRangeKernel(kernel, cl::NullRange, global, local, nullptr, &event);
     } catch (const cl::Error& e) {
         if (e.err() == CL_MEM_OBJECT_ALLOCATION_FAILURE || e.err() == CL_OUT_OF_RESOURCES ||
             e.err() == CL_OUT_OF_HOST_MEMORY)
@@ -254,6 +254,14 @@ void Device::launch(std::string name, const cl::Kernel& kernel, std::size_t widt
     const std::size_t w = std::max<std::size_t>(8, (width + 7) / 8 * 8);
     const std::size_t h = std::max<std::size_t>(8, (height + 7) / 8 * 8);
     enqueue(std::move(name), kernel, cl::NDRange(w, h));
+}
+
+void Device::launch(std::string name, const cl::Kernel& kernel, std::size_t width, std::size_t height,
+                    std::size_t groupWidth, std::size_t groupHeight)
+{
+    const std::size_t w = std::max<std::size_t>(1, (width + groupWidth - 1) / groupWidth) * groupWidth;
+    const std::size_t h = std::max<std::size_t>(1, (height + groupHeight - 1) / groupHeight) * groupHeight;
+    enqueue(std::move(name), kernel, cl::NDRange(w, h), cl::NDRange(groupWidth, groupHeight));
 }
 
 std::vector<PassTime> Device::takePassTimes()

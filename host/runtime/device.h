@@ -74,6 +74,9 @@ public:
     // take their real extent as an argument and return early past it.
     void launch(std::string name, const cl::Kernel& kernel, std::size_t count);
     void launch(std::string name, const cl::Kernel& kernel, std::size_t width, std::size_t height);
+    // A 2D launch in work-groups of groupWidth x groupHeight (the range padded to multiples of them).
+    void launch(std::string name, const cl::Kernel& kernel, std::size_t width, std::size_t height,
+                std::size_t groupWidth, std::size_t groupHeight);
 
     // Waits for the queue, then returns and forgets the device times of launches since the last call.
     std::vector<PassTime> takePassTimes();
@@ -99,7 +102,8 @@ public:
     }
 
 private:
-    void enqueue(std::string name, const cl::Kernel& kernel, const cl::NDRange& global);
+    void enqueue(std::string name, const cl::Kernel& kernel, const cl::NDRange& global,
+                 const cl::NDRange& local = cl::NullRange);
 
     DeviceListing listing_;
     cl::Device device_;

@@ -147,6 +147,7 @@ Iso3dRendererImpl::Iso3dRendererImpl(Device& device, const Scene& scene, const V
         if (k.name == "iso3d.cl")
             source = k.source;
     fragmentProgram_.source = "#define CLVR_ISO3D_FRAGMENT 1\n" + std::string(source);
+    fragmentProgram_.attributes = 1;  // the world position
     fragmentProgram_.buffers[0] = volume_;
     if (options_.interior && gradientless)
         badOption("interior", "works with \"gradient\" or \"none\" shading (the gradientless difference would need its "

@@ -157,6 +157,7 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
                 source = k.source;
         fragmentProgram_.source = std::string("#define CLVR_SLICE3D_FRAGMENT 1\n") +
                                   (clipTexture_ ? "#define CLVR_SLICE3D_CLIP_TEXTURE 1\n" : "") + std::string(source);
+        fragmentProgram_.attributes = clipTexture_ ? 2 : 1;  // world position, clip-texture coordinates
         fragmentProgram_.buffers[0] = volume_;
         fragmentProgram_.buffers[1] = tf_.buffer();
         const glm::dvec3 invSpacing = 1.0 / spacing_;

@@ -180,6 +180,7 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
             source = k.source;
     fragmentProgram_.source = "#define CLVR_STACK2D_FRAGMENT 1\n" +
                               std::string(clipTexture_ ? "#define CLVR_STACK2D_CLIP_TEXTURE 1\n" : "") + std::string(source);
+    fragmentProgram_.attributes = clipTexture_ ? 3 : 2;  // texture coordinates, slab, clip-texture coordinates
     fragmentProgram_.buffers[0] = stacks_[axis_].buffer();
     const StackShape s = stackShape(axis_);
     ClStack2dUniforms& u = uniforms_;  // fields of a mode that is off stay 0

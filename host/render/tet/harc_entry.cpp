@@ -58,6 +58,7 @@ HarcRasterEntries::HarcRasterEntries(Device& device, const TetMesh& mesh, const 
     framebuffer_ = std::make_unique<raster::Framebuffer>(device_, width_, height_);
     previous_ = device_.buffer("harc entry peel threshold", static_cast<std::size_t>(width_) * height_ * sizeof(float));
     program_.source = fragmentSource();
+    program_.attributes = 2;  // position, face code
     program_.buffers[0] = previous_;
     program_.buffers[1] = tets;
 }
