@@ -132,6 +132,11 @@ bool toWindow(const glm::dvec4& position, const std::array<glm::dvec4, kMaxAttri
     return true;
 }
 
+// ceil(a / 256) and floor(a / 256) at the subpixel scale, exact for every int64 (arithmetic shifts).
+static_assert(CLVR_SUBPIXEL_SCALE == 1 << CLVR_SUBPIXEL_BITS);
+std::int64_t floorSubpixel(std::int64_t a) { return a >> CLVR_SUBPIXEL_BITS; }
+std::int64_t ceilSubpixel(std::int64_t a) { return -((-a) >> CLVR_SUBPIXEL_BITS); }
+
 bool powerOfTwoUpTo(int v, int max) { return v >= 1 && v <= max && (v & (v - 1)) == 0; }
 
 int log2Of(int powerOfTwo) { return std::countr_zero(static_cast<unsigned>(powerOfTwo)); }
@@ -436,11 +441,11 @@ void setUpDraw(SetUpDraws& out, const DrawState& state, Topology topology, const
             // Pixels whose centers (x + 0.5) can be inside, clipped to the scissored viewport rectangle.
             const std::int64_t minX = std::min({v[0]->x, v[1]->x, v[2]->x}), maxX = std::max({v[0]->x, v[1]->x, v[2]->x});
             const std::int64_t minY = std::min({v[0]->y, v[1]->y, v[2]->y}), maxY = std::max({v[0]->y, v[1]->y, v[2]->y});
-            const double half = CLVR_SUBPIXEL_SCALE / 2;
-            const int px0 = std::max<int>(clip.x, int(std::ceil((double(minX) - half) / CLVR_SUBPIXEL_SCALE)));
-            const int px1 = std::min<int>(clip.x + clip.width - 1, int(std::floor((double(maxX) - half) / CLVR_SUBPIXEL_SCALE)));
-            const int py0 = std::max<int>(clip.y, int(std::ceil((double(minY) - half) / CLVR_SUBPIXEL_SCALE)));
-            const int py1 = std::min<int>(clip.y + clip.height - 1, int(std::floor((double(maxY) - half) / CLVR_SUBPIXEL_SCALE)));
+            const std::int64_t half = CLVR_SUBPIXEL_SCALE / 2;
+            const int px0 = static_cast<int>(std::max<std::int64_t>(clip.x, ceilSubpixel(minX - half)));
+            const int px1 = static_cast<int>(std::min<std::int64_t>(clip.x + clip.width - 1, floorSubpixel(maxX - half)));
+            const int py0 = static_cast<int>(std::max<std::int64_t>(clip.y, ceilSubpixel(minY - half)));
+            const int py1 = static_cast<int>(std::min<std::int64_t>(clip.y + clip.height - 1, floorSubpixel(maxY - half)));
             if (px0 > px1 || py0 > py1)
                 continue;
 
