@@ -264,20 +264,16 @@ kernel void raster_fragments(global float4* color, global float* depth, global u
     if (begin == end)
         return;
 
-    /* The item's pixels, ends inclusive, and its private copy of them (row-major, w per row). */
+    /* The item's pixels, ends inclusive, and its private copy of them (row-major, w per row): a row is
+     * read when a triangle first reaches it (bit py - y0 of `loaded`) and written back at the end, so
+     * a sparse draw moves only the rows it touches. */
     const int x0 = pass.rect_x + gx0, x1 = min(x0 + item_w, pass.rect_x + pass.rect_w) - 1;
     const int y0 = pass.rect_y + gy0, y1 = min(y0 + item_h, pass.rect_y + pass.rect_h) - 1;
     const int w = x1 - x0 + 1;
     float4 c[CLVR_ITEM_PIXELS];
     float d[CLVR_ITEM_PIXELS];
     uint s[CLVR_ITEM_PIXELS];
-    for (int py = y0, l = 0; py <= y1; ++py)
-        for (int px = x0; px <= x1; ++px, ++l) {
-            const size_t i = (size_t)py * (size_t)pass.fb_width + (size_t)px;
-            c[l] = color[i];
-            d[l] = depth[i];
-            s[l] = stencil[i];
-        }
+    uint loaded = 0u;
 
     ClFragmentResources resources;
     resources.buffer[0] = buffer0;
@@ -321,6 +317,16 @@ kernel void raster_fragments(global float4* color, global float* depth, global u
         const long dy1 = (long)(t->x[2] - t->x[1]) * CLVR_SUBPIXEL_SCALE;
         const long dy2 = (long)(t->x[0] - t->x[2]) * CLVR_SUBPIXEL_SCALE;
         for (int py = cy0; py <= cy1; ++py) {
+            const uint row = 1u << (py - y0);
+            if (!(loaded & row)) {
+                loaded |= row;
+                const size_t i0 = (size_t)py * (size_t)pass.fb_width + (size_t)x0;
+                for (int k = 0, l = (py - y0) * w; k < w; ++k, ++l) {
+                    c[l] = color[i0 + k];
+                    d[l] = depth[i0 + k];
+                    s[l] = stencil[i0 + k];
+                }
+            }
             long e0 = r0, e1 = r1, e2 = r2;
             for (int px = cx0, l = (py - y0) * w + (cx0 - x0); px <= cx1; ++px, ++l) {
                 if (e0 >= 0 && e1 >= 0 && e2 >= 0) {
@@ -338,16 +344,17 @@ kernel void raster_fragments(global float4* color, global float* depth, global u
         }
     }
 
-    if (covered) {
-        for (int py = y0, l = 0; py <= y1; ++py)
-            for (int px = x0; px <= x1; ++px, ++l) {
-                const size_t i = (size_t)py * (size_t)pass.fb_width + (size_t)px;
-                color[i] = c[l];
-                depth[i] = d[l];
-                stencil[i] = (uchar)s[l];
+    for (int py = y0; py <= y1; ++py)
+        if (loaded & (1u << (py - y0))) {
+            const size_t i0 = (size_t)py * (size_t)pass.fb_width + (size_t)x0;
+            for (int k = 0, l = (py - y0) * w; k < w; ++k, ++l) {
+                color[i0 + k] = c[l];
+                depth[i0 + k] = d[l];
+                stencil[i0 + k] = (uchar)s[l];
             }
+        }
+    if (covered)
         atomic_add(fragment_counts + get_global_id(1), covered);
-    }
 }
 
 #define CLVR_PROBE_SIZE(i, T) out[i] = (uint)sizeof(T)
