@@ -111,6 +111,9 @@ TEST(Layout, EveryParamsStructFitsTheKernelArgumentSpace)
         {"blend_render", sizeof(ClBlendParams) + 6 * sizeof(void*)},
         {"harc_render", sizeof(ClHarcParams) + 8 * sizeof(void*)},
         {"spherical_shell", sizeof(ClSphericalParams) + 5 * sizeof(void*)},
+        {"slice3d_over_background", sizeof(ClSlice3dOverBackgroundParams) + 1 * sizeof(void*)},
+        {"iso3d_finish", sizeof(ClIso3dFinishParams) + 2 * sizeof(void*)},
+        {"stack2d_iso_finish", sizeof(ClStack2dIsoFinishParams) + 2 * sizeof(void*)},
         {"pixel_transfer", sizeof(ClPixelTransferParams) + 2 * sizeof(void*)},
         {"draw_pixels", sizeof(ClDrawPixelsParams) + 4 * sizeof(void*)},
         {"pixel_texture", sizeof(ClPixelTextureParams) + 2 * sizeof(void*)},
@@ -127,6 +130,9 @@ TEST(Layout, EveryParamsStructFitsTheKernelArgumentSpace)
     EXPECT_EQ(sizeof(ClBlendParams), 208u);
     EXPECT_EQ(sizeof(ClHarcParams), 160u);
     EXPECT_EQ(sizeof(ClSphericalParams), 192u);
+    EXPECT_EQ(sizeof(ClSlice3dOverBackgroundParams), 32u);
+    EXPECT_EQ(sizeof(ClIso3dFinishParams), 48u);
+    EXPECT_EQ(sizeof(ClStack2dIsoFinishParams), 32u);
     EXPECT_EQ(sizeof(ClPixelTransfer), 128u);
     EXPECT_EQ(sizeof(ClPixelTransferParams), 144u);
     EXPECT_EQ(sizeof(ClDrawPixelsParams), 208u);

@@ -21,8 +21,10 @@
 #include <limits>
 
 namespace clvr {
-namespace {
 
+static_assert(sizeof(ClSlice3dOverBackgroundParams) == 32, "also probed on the device by tests/layout_test.cpp");
+
+namespace {
 
 class Slice3dRenderer final : public Renderer {
 public:
@@ -338,9 +340,11 @@ Image4f Slice3dRenderer::renderRaster(FrameStats& stats)
         drawStats = rasterizer_.takeStats();
     }
     const std::size_t pixels = framebuffer_->pixelCount();
+    ClSlice3dOverBackgroundParams over{};
+    over.background = toCl4(image_.background, 0.0);
+    over.count = static_cast<cl_int>(pixels);
     overBackground_.setArg(0, framebuffer_->color());
-    overBackground_.setArg(1, static_cast<cl_int>(pixels));
-    overBackground_.setArg(2, toCl4(image_.background, 0.0));
+    overBackground_.setArg(1, over);
     device_.launch("slice3d: over background", overBackground_, pixels);
     Image4f image = framebuffer_->readColor(device_);
     stats.passes = device_.takePassTimes();
