@@ -12,6 +12,7 @@ typedef int cl_int;
 typedef float cl_float;
 typedef float4 cl_float4;
 typedef int4 cl_int4;
+typedef uint4 cl_uint4;
 #else
 #include <CL/cl_platform.h>
 #endif
