@@ -13,6 +13,7 @@ typedef ulong cl_ulong;
 typedef float cl_float;
 typedef float4 cl_float4;
 typedef int4 cl_int4;
+typedef uint4 cl_uint4;
 #else
 #include <CL/cl_platform.h>
 #endif

@@ -7,6 +7,7 @@
 //  - without it: iso3d_finish, the last pass, which puts the background where no slice passed.
 // The host has validated everything; this file only does arithmetic.
 #include "clvr_common.h"
+#include "iso3d_params.h"
 #include "volume_sampling.h"
 
 #ifndef CLVR_ISO3D_FRAGMENT
@@ -15,20 +16,17 @@
  * its depth is below the cleared 1.0. On the surface: (color, 1), the color clamped to [0,1] as a
  * fixed-point frame buffer would after the color-matrix copy (shaded != 0), or the flat surface
  * color (shaded == 0). Elsewhere: (background, 0), so the image is I + (1 - A) background. */
-kernel void iso3d_finish(global float4* color, global const float* depth, const uint n, const int shaded,
-                         const float4 surface, const float4 background)
+kernel void iso3d_finish(global float4* color, global const float* depth, const ClIso3dFinishParams p)
 {
-    CLVR_GUARD_1D(n);
+    CLVR_GUARD_1D(p.n);
     const size_t i = get_global_id(0);
     if (depth[i] < 1.0f)
-        color[i] = (float4)(shaded ? clamp(color[i].xyz, 0.0f, 1.0f) : surface.xyz, 1.0f);
+        color[i] = (float4)(p.shaded ? clamp(color[i].xyz, 0.0f, 1.0f) : p.surface.xyz, 1.0f);
     else
-        color[i] = (float4)(background.xyz, 0.0f);
+        color[i] = (float4)(p.background.xyz, 0.0f);
 }
 
 #else
-
-#include "iso3d_params.h"
 
 /* Trilinear RGBA at grid coordinates g (checked inside by the caller), the four channels of each
  * grid point interleaved: the 3D texture of the paper's gradient shading, filtered as one texture. */

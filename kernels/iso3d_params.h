@@ -1,6 +1,8 @@
-/* kernels/iso3d_params.h — the uniforms of kernels/iso3d.cl's fragment program as one struct, shared
- * by host (host/render/grid/iso3d.cpp, through host/render/fragment_uniforms.h) and device (read through
- * r->uniforms). float4 fields only. Sizes and offsets are probed on the device by tests/layout_test.cpp. */
+/* kernels/iso3d_params.h — the uniforms of kernels/iso3d.cl's fragment program as one struct (float4
+ * fields only, read through r->uniforms; the host copies it through host/render/fragment_uniforms.h),
+ * and the scalar arguments of its last pass iso3d_finish as another (passed by value; buffers stay
+ * separate arguments), shared by host (host/render/grid/iso3d.cpp) and device. Sizes and offsets are
+ * probed on the device by tests/layout_test.cpp. */
 #ifndef CLVR_ISO3D_PARAMS_H
 #define CLVR_ISO3D_PARAMS_H
 
@@ -15,5 +17,13 @@ typedef struct {
     cl_float4 brick_end;    /* its box's exclusive upper end in grid units (dims unbricked), w = 0 */
     cl_float4 brick_dims;   /* its grid points per axis (dims unbricked), w = 0 */
 } ClIso3dUniforms;          /* 112 bytes */
+
+typedef struct {
+    cl_float4 surface;      /* flat surface color (shaded 0), w = 1 */
+    cl_float4 background;   /* image background, w = 0 */
+    cl_uint n;              /* pixels */
+    cl_int shaded;          /* 1: the frame buffer holds the shaded color, 0: flat `surface` */
+    cl_int pad0, pad1;
+} ClIso3dFinishParams;      /* 48 bytes */
 
 #endif

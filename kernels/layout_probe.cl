@@ -5,6 +5,7 @@
 #include "harc_entry_params.h"
 #include "harc_params.h"
 #include "iso3d_params.h"
+#include "pixel_transfer_params.h"
 #include "planes_params.h"
 #include "ray.h"
 #include "slice3d_params.h"

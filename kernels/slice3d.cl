@@ -230,12 +230,12 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
 }
 
 /* The pass-by-pass path's last pass: premultiplied (I, A) in place -> I + (1 - A) background, A. */
-kernel void slice3d_over_background(global float4* color, const int count, const float4 background)
+kernel void slice3d_over_background(global float4* color, const ClSlice3dOverBackgroundParams p)
 {
-    CLVR_GUARD_1D(count);
+    CLVR_GUARD_1D(p.count);
     const size_t i = get_global_id(0);
     const float4 c = color[i];
-    color[i] = (float4)(c.xyz + (1.0f - c.w) * background.xyz, c.w);
+    color[i] = (float4)(c.xyz + (1.0f - c.w) * p.background.xyz, c.w);
 }
 
 #else

@@ -1,7 +1,9 @@
-/* kernels/slice3d_params.h — the scalar arguments of kernels/slice3d.cl's fused kernel as one struct
- * (passed by value; buffers stay separate arguments), and the uniforms of its fragment program as
- * another (float4 fields only, read through r->uniforms), shared by host (host/render/grid/slice3d.cpp)
- * and device. Sizes and offsets are probed on the device by tests/layout_test.cpp. */
+/* kernels/slice3d_params.h — the scalar arguments of kernels/slice3d.cl's fused kernel and of its
+ * last pass slice3d_over_background as one struct each (passed by value; buffers stay separate
+ * arguments), and the uniforms of its fragment program as another (float4 fields only, read through
+ * r->uniforms), shared by host (host/render/grid/slice3d.cpp; stack2d.cpp and spherical.cpp also run
+ * slice3d_over_background) and device. Sizes and offsets are probed on the device by
+ * tests/layout_test.cpp. */
 #ifndef CLVR_SLICE3D_PARAMS_H
 #define CLVR_SLICE3D_PARAMS_H
 
@@ -29,6 +31,12 @@ typedef struct {
     ClTexture clip_tex;      /* clip texture (SLICE3D_CLIP_TEXTURE builds only) */
     cl_float4 clip_row[3];   /* rows of the affine world -> clip-texture coordinates map */
 } ClSlice3dParams;           /* 304 bytes */
+
+typedef struct {
+    cl_float4 background;    /* image background, w = 0 */
+    cl_int count;            /* pixels */
+    cl_int pad0, pad1, pad2;
+} ClSlice3dOverBackgroundParams; /* 32 bytes */
 
 typedef struct {
     ClCamera camera;

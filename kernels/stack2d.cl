@@ -194,10 +194,9 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
 
 /* Iso-surface mode's last pass: where a fragment passed the alpha test (stencil 1) the pixel is the
  * surface, opaque; elsewhere the background, A = 0. */
-kernel void stack2d_iso_finish(global float4* color, global const uchar* stencil, const int count,
-                               const float4 background)
+kernel void stack2d_iso_finish(global float4* color, global const uchar* stencil, const ClStack2dIsoFinishParams p)
 {
-    CLVR_GUARD_1D(count);
+    CLVR_GUARD_1D(p.count);
     const size_t i = get_global_id(0);
-    color[i] = stencil[i] != 0 ? (float4)(color[i].xyz, 1.0f) : (float4)(background.xyz, 0.0f);
+    color[i] = stencil[i] != 0 ? (float4)(color[i].xyz, 1.0f) : (float4)(p.background.xyz, 0.0f);
 }

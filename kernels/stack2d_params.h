@@ -1,10 +1,13 @@
-/* kernels/stack2d_params.h — the uniforms of kernels/stack2d.cl's fragment program as one struct,
- * shared by host (host/render/grid/stack2d.cpp, through host/render/fragment_uniforms.h) and device (read
- * through r->uniforms). float4 fields only. Sizes and offsets are probed on the device by
- * tests/layout_test.cpp. Fields of a mode that is off stay 0. */
+/* kernels/stack2d_params.h — the uniforms of kernels/stack2d.cl's fragment program as one struct (float4
+ * fields only, read through r->uniforms; the host copies it through host/render/fragment_uniforms.h;
+ * fields of a mode that is off stay 0), and the scalar arguments of the iso-surface mode's last pass
+ * stack2d_iso_finish as another (passed by value; buffers stay separate arguments), shared by host
+ * (host/render/grid/stack2d.cpp) and device. Sizes and offsets are probed on the device by
+ * tests/layout_test.cpp. */
 #ifndef CLVR_STACK2D_PARAMS_H
 #define CLVR_STACK2D_PARAMS_H
 
+#include "cl_types.h"
 #include "ray.h"
 
 typedef struct {
@@ -28,5 +31,11 @@ typedef struct {
     cl_float4 clip_row[3]; /* rows of world -> clip-texture coordinates */
     cl_float4 clip_offset; /* (offset of the texels in buffer[3], in floats, 0, 0, 0) */
 } ClStack2dUniforms;       /* 368 bytes */
+
+typedef struct {
+    cl_float4 background;  /* image background, w = 0 */
+    cl_int count;          /* pixels */
+    cl_int pad0, pad1, pad2;
+} ClStack2dIsoFinishParams; /* 32 bytes */
 
 #endif

@@ -9,6 +9,7 @@
 #include "kernels/harc_entry_params.h"
 #include "kernels/harc_params.h"
 #include "kernels/iso3d_params.h"
+#include "kernels/pixel_transfer_params.h"
 #include "kernels/planes_params.h"
 #include "kernels/ray.h"
 #include "kernels/slice3d_params.h"
@@ -114,6 +115,13 @@ TEST(Layout, EveryParamsStructFitsTheKernelArgumentSpace)
         {"blend_render", sizeof(ClBlendParams) + 6 * sizeof(void*)},
         {"harc_render", sizeof(ClHarcParams) + 8 * sizeof(void*)},
         {"spherical_shell", sizeof(ClSphericalParams) + 5 * sizeof(void*)},
+        {"slice3d_over_background", sizeof(ClSlice3dOverBackgroundParams) + 1 * sizeof(void*)},
+        {"iso3d_finish", sizeof(ClIso3dFinishParams) + 2 * sizeof(void*)},
+        {"stack2d_iso_finish", sizeof(ClStack2dIsoFinishParams) + 2 * sizeof(void*)},
+        {"pixel_transfer", sizeof(ClPixelTransferParams) + 2 * sizeof(void*)},
+        {"draw_pixels", sizeof(ClDrawPixelsParams) + 4 * sizeof(void*)},
+        {"pixel_texture", sizeof(ClPixelTextureParams) + 2 * sizeof(void*)},
+        {"accum", sizeof(ClAccumParams) + 2 * sizeof(void*)},
     };
     for (const auto& [kernel, bytes] : argumentBytes) {
         EXPECT_LE(bytes, limit) << kernel;
@@ -126,6 +134,14 @@ TEST(Layout, EveryParamsStructFitsTheKernelArgumentSpace)
     EXPECT_EQ(sizeof(ClBlendParams), 208u);
     EXPECT_EQ(sizeof(ClHarcParams), 160u);
     EXPECT_EQ(sizeof(ClSphericalParams), 192u);
+    EXPECT_EQ(sizeof(ClSlice3dOverBackgroundParams), 32u);
+    EXPECT_EQ(sizeof(ClIso3dFinishParams), 48u);
+    EXPECT_EQ(sizeof(ClStack2dIsoFinishParams), 32u);
+    EXPECT_EQ(sizeof(ClPixelTransfer), 128u);
+    EXPECT_EQ(sizeof(ClPixelTransferParams), 144u);
+    EXPECT_EQ(sizeof(ClDrawPixelsParams), 208u);
+    EXPECT_EQ(sizeof(ClPixelTextureParams), 64u);
+    EXPECT_EQ(sizeof(ClAccumParams), 12u);
     // Fragment-program uniforms: float4s only, within the raster stage's uniform count.
     EXPECT_EQ(sizeof(ClSlice3dUniforms), 160u);
     EXPECT_EQ(sizeof(ClIso3dUniforms), 112u);

@@ -22,6 +22,9 @@
 #include <limits>
 
 namespace clvr {
+
+static_assert(sizeof(ClIso3dFinishParams) == 48, "also probed on the device by tests/layout_test.cpp");
+
 namespace {
 
 // Figure 7: how far behind the box entry (in slices) the depth buffer is put. The first slice inside the box
@@ -325,13 +328,14 @@ Image4f Iso3dRendererImpl::render(FrameStats& stats)
         raster::applyPixelTransfer(device_, *framebuffer_, light);
     }
     const std::size_t pixels = framebuffer_->pixelCount();
-    int a = 0;
-    finish_.setArg(a++, framebuffer_->color());
-    finish_.setArg(a++, framebuffer_->depth());
-    finish_.setArg(a++, static_cast<cl_uint>(pixels));
-    finish_.setArg(a++, static_cast<cl_int>(shaded ? 1 : 0));
-    finish_.setArg(a++, toCl4(iso_.color, 1.0));
-    finish_.setArg(a++, toCl4(image_.background, 0.0));
+    ClIso3dFinishParams finish{};
+    finish.surface = toCl4(iso_.color, 1.0);
+    finish.background = toCl4(image_.background, 0.0);
+    finish.n = static_cast<cl_uint>(pixels);
+    finish.shaded = shaded ? 1 : 0;
+    finish_.setArg(0, framebuffer_->color());
+    finish_.setArg(1, framebuffer_->depth());
+    finish_.setArg(2, finish);
     device_.launch("iso3d: finish", finish_, pixels);
     Image4f image = framebuffer_->readColor(device_);
 

@@ -21,8 +21,10 @@
 #include <limits>
 
 namespace clvr {
-namespace {
 
+static_assert(sizeof(ClSlice3dOverBackgroundParams) == 32, "also probed on the device by tests/layout_test.cpp");
+
+namespace {
 
 class Slice3dRenderer final : public Renderer {
 public:
@@ -143,7 +145,7 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
         brickGrid_ = buildBrickGrid(volume);
         const BrickGrid& grid = brickGrid_;
         std::vector<cl_uchar> flags = emptyBricks(grid, scene.transferFunction);
-        brickSetupMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        brickSetupMs_ = msSince(t0);
         brickDims_ = grid.dims;
         emptyBrickCount_ = static_cast<std::uint64_t>(std::count(flags.begin(), flags.end(), cl_uchar(1)));
         emptyBricks_ = device_.upload("slice3d empty-space radii", emptySpaceRadii(grid.dims, flags));
@@ -191,9 +193,9 @@ void Slice3dRenderer::setClipPlacement(const glm::dvec3& offset, const glm::dmat
 
 Image4f Slice3dRenderer::render(FrameStats& stats)
 {
-    const auto start = std::chrono::steady_clock::now();
+    const FrameClock clock;
     Image4f image = options_.path == Slice3dOptions::Path::Fused ? renderFused(stats) : renderRaster(stats);
-    stats.frameMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    finishFrame(device_, clock, stats);
     stats.extra["slices"] = plan_.count;
     stats.extra["slice_spacing"] = plan_.deltaS;
     stats.extra["depth_range"] = {plan_.depthMin, plan_.depthMax};
@@ -220,7 +222,7 @@ void Slice3dRenderer::setTransferFunction(const TransferFunction& tf)
         const auto t0 = std::chrono::steady_clock::now();
         const std::vector<cl_uchar> flags = emptyBricks(brickGrid_, tf);
         const std::vector<cl_uchar> radii = emptySpaceRadii(brickGrid_.dims, flags);
-        brickSetupMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        brickSetupMs_ = msSince(t0);
         emptyBrickCount_ = static_cast<std::uint64_t>(std::count(flags.begin(), flags.end(), cl_uchar(1)));
         device_.queue().enqueueWriteBuffer(emptyBricks_, CL_TRUE, 0, radii.size(), radii.data());
     } else {
@@ -283,7 +285,6 @@ Image4f Slice3dRenderer::renderFused(FrameStats& stats)
     stats.extra["bricks"] = {brickDims_.x, brickDims_.y, brickDims_.z};
     stats.extra["empty_bricks"] = emptyBrickCount_;
     stats.extra["brick_setup_ms"] = brickSetupMs_;
-    stats.passes = device_.takePassTimes();
     return image;
 }
 
@@ -339,12 +340,13 @@ Image4f Slice3dRenderer::renderRaster(FrameStats& stats)
         drawStats = rasterizer_.takeStats();
     }
     const std::size_t pixels = framebuffer_->pixelCount();
+    ClSlice3dOverBackgroundParams over{};
+    over.background = toCl4(image_.background, 0.0);
+    over.count = static_cast<cl_int>(pixels);
     overBackground_.setArg(0, framebuffer_->color());
-    overBackground_.setArg(1, static_cast<cl_int>(pixels));
-    overBackground_.setArg(2, toCl4(image_.background, 0.0));
+    overBackground_.setArg(1, over);
     device_.launch("slice3d: over background", overBackground_, pixels);
     Image4f image = framebuffer_->readColor(device_);
-    stats.passes = device_.takePassTimes();
     stats.samples = drawStats.fragments;  // fragments of slice polygons; those outside the grid are discarded
     stats.extra["triangles"] = drawStats.triangles;
     if (clipMesh_) {

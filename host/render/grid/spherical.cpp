@@ -7,6 +7,7 @@
 #include "host/render/camera_args.h"
 #include "host/render/options_util.h"
 #include "host/render/transfer_function_upload.h"
+#include "kernels/slice3d_params.h"  // ClSlice3dOverBackgroundParams: the last pass is slice3d's
 #include "kernels/spherical_params.h"
 #include "raster/framebuffer.h"
 #include "raster/texture.h"
@@ -322,9 +323,11 @@ Image4f SphericalRenderer::render(FrameStats& stats)
     for (std::size_t k = 0; k < shells_.size(); ++k)
         renderPass(k, false);
     const std::size_t pixels = image_->pixelCount();
+    ClSlice3dOverBackgroundParams over{};
+    over.background = f4(imageSpec_.background);
+    over.count = static_cast<cl_int>(pixels);
     overBackground_.setArg(0, image_->color());
-    overBackground_.setArg(1, static_cast<cl_int>(pixels));
-    overBackground_.setArg(2, f4(imageSpec_.background));
+    overBackground_.setArg(1, over);
     device_.launch("spherical: over background", overBackground_, pixels);
     Image4f image = image_->readColor(device_);
     finishFrame(device_, clock, stats);

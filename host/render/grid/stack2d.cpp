@@ -12,6 +12,7 @@
 #include "host/optics/gradient_volume.h"
 #include "host/optics/reflectance_map.h"
 #include "host/render/transfer_function_upload.h"
+#include "kernels/slice3d_params.h"  // ClSlice3dOverBackgroundParams: the last pass is slice3d's
 #include "kernels/stack2d_params.h"
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
@@ -24,6 +25,9 @@
 #include <optional>
 
 namespace clvr {
+
+static_assert(sizeof(ClStack2dIsoFinishParams) == 32, "also probed on the device by tests/layout_test.cpp");
+
 namespace {
 
 cl_float4 cl4(float x, float y, float z, float w)
@@ -390,15 +394,19 @@ Image4f Stack2dRenderer::render(FrameStats& stats)
     const cl_float4 background{{static_cast<float>(image_.background.r), static_cast<float>(image_.background.g),
                                 static_cast<float>(image_.background.b), 0.0f}};
     if (iso_) {
+        ClStack2dIsoFinishParams finish{};
+        finish.background = background;
+        finish.count = static_cast<cl_int>(pixels);
         isoFinish_.setArg(0, framebuffer_->color());
         isoFinish_.setArg(1, framebuffer_->stencil());
-        isoFinish_.setArg(2, static_cast<cl_int>(pixels));
-        isoFinish_.setArg(3, background);
+        isoFinish_.setArg(2, finish);
         device_.launch("stack2d: iso-surface over background", isoFinish_, pixels);
     } else {
+        ClSlice3dOverBackgroundParams over{};
+        over.background = background;
+        over.count = static_cast<cl_int>(pixels);
         overBackground_.setArg(0, framebuffer_->color());
-        overBackground_.setArg(1, static_cast<cl_int>(pixels));
-        overBackground_.setArg(2, background);
+        overBackground_.setArg(1, over);
         device_.launch("stack2d: over background", overBackground_, pixels);
     }
     Image4f image = framebuffer_->readColor(device_);
