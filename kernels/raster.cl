@@ -181,7 +181,7 @@ long clvr_edge(int xa, int ya, int xb, int yb, int px, int py)
 }
 
 /* One fragment of triangle t at pixel (px, py) with exact edge values e0..e2, through GL's
- * per-fragment operations against the pixel's color c, depth d and stencil s (kept in registers). */
+ * per-fragment operations against the pixel's color c, depth d and stencil s (the item's private copy). */
 __attribute__((always_inline)) void clvr_shade(global const ClTriangle* t, global const float4* attr_over_w,
                                                long e0, long e1, long e2, int px, int py,
                                                const ClFragmentState* fs, const ClBlendState* bs,

@@ -229,7 +229,6 @@ struct Pass {
     std::array<cl::Buffer, 4> buffers;
     ClFragmentState fragment;
     ClBlendState blend;
-    int attributes = 0;             // the program's: its triangle records are CLVR_TRIANGLE_FLOAT4S(attributes) long
     TileGrid grid;                  // its rect is the viewport rectangle: the launch's extent and its tiles' origin
     std::size_t uniformBase = 0;    // first uniform in SetUpDraws::uniforms
     std::size_t uniformCount = 0;
@@ -351,7 +350,7 @@ void setUpDraw(SetUpDraws& out, const DrawState& state, Topology topology, const
     if (out.passes.empty() || out.passes.back().kernel() != kernel() || !sameBuffers(out.passes.back()) ||
         !sameBytes(out.passes.back().fragment, clFragment) || !sameBytes(out.passes.back().blend, clBlend) ||
         !sameBytes(out.passes.back().grid.rect, rect) || !sameUniforms(out.passes.back())) {
-        Pass p{kernel, program.buffers, clFragment, clBlend, attributes, TileGrid{rect, out.shape.tileW, out.shape.tileH},
+        Pass p{kernel, program.buffers, clFragment, clBlend, TileGrid{rect, out.shape.tileW, out.shape.tileH},
                out.uniforms.size(), uniformCount, out.triangles.size(), 0, out.tileCounts.size()};
         out.uniforms.insert(out.uniforms.end(), uniforms.begin(), uniforms.begin() + static_cast<std::ptrdiff_t>(uniformCount));
         out.tileCounts.resize(out.tileCounts.size() + static_cast<std::size_t>(p.grid.tilesX()) * p.grid.tilesY(), 0);
