@@ -19,7 +19,7 @@ grep -q bench_raster.h "$work/src/tools/bench.cpp" || sed -i \
   -e '/^int bench(const BenchOptions& options)$/{n;s|^{$|{\n    if (options.suite == "raster" \&\& options.scenes.empty())\n        return benchRaster(options);|}' \
   "$work/src/tools/bench.cpp"
 sed -i 's|"regular", "all"})|"regular", "all", "raster"})|' "$work/src/tools/commands.cpp"
-cmake -S "$work/src" -B "$work/before" -DCMAKE_BUILD_TYPE=Release -DCLVR_BUILD_BENCH=OFF > "$work/cmake.log"
+cmake -S "$work/src" -B "$work/before" -DCMAKE_BUILD_TYPE=Release > "$work/cmake.log"
 cmake --build "$work/before" -j2 --target clvr > "$work/build.log"
 export POCL_CACHE_DIR="${POCL_CACHE_DIR:-$work/pocl-cache}"
 "$work/before/clvr" bench --suite raster -o "$work/before.json"

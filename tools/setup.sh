@@ -50,7 +50,9 @@ ctest --test-dir build --output-on-failure -j "$jobs" --timeout 900
 
 if [ "${CLVR_SKIP_ASAN:-0}" != 1 ]; then
     echo "clvr setup: host code under ASan + UBSan (build-asan/)"
-    cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCLVR_SANITIZE=ON >/dev/null
+    # The tests share build/'s PoCL kernel cache: compiled kernels do not depend on the host build.
+    cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCLVR_SANITIZE=ON \
+        -DCLVR_POCL_CACHE_DIR="$PWD/build/pocl-cache" >/dev/null
     cmake --build build-asan -j "$jobs"
     # Every suite again: the host code is instrumented, PoCL's compiled kernels are not. Leaks inside
     # PoCL/LLVM (never freed compiler state) are suppressed; clvr's own are reported.
@@ -60,6 +62,6 @@ if [ "${CLVR_SKIP_ASAN:-0}" != 1 ]; then
     # DefaultScene.MatchesReferenceIntegral with a cold PoCL cache).
     export LSAN_OPTIONS="suppressions=$PWD/tests/lsan.supp:print_suppressions=0:intercept_tls_get_addr=0"
     export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
-    export POCL_CACHE_DIR="$PWD/build-asan/pocl-cache"
+    export POCL_CACHE_DIR="$PWD/build/pocl-cache"
     ctest --test-dir build-asan --output-on-failure -j "$jobs" --timeout 900
 fi
