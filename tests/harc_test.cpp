@@ -7,6 +7,7 @@
 
 #include "host/runtime/errors.h"
 #include "host/optics/psi_table.h"
+#include "tests/support/mesh_fixtures.h"
 #include "tests/support/test_util.h"
 
 #include <gtest/gtest.h>
@@ -23,6 +24,8 @@ namespace clvr {
 namespace {
 
 using nlohmann::json;
+using test::Box;
+using test::boxMesh;
 
 // Face adjacency by hand (sorted point triples), as buildTopology defines it.
 TetTopology handTopology(const TetMesh& mesh)
@@ -52,50 +55,6 @@ TetTopology handTopology(const TetMesh& mesh)
     std::sort(topo.boundary.begin(), topo.boundary.end(),
               [](const auto& a, const auto& b) { return a.tet != b.tet ? a.tet < b.tet : a.face < b.face; });
     return topo;
-}
-
-// Boxes of n x n x n cubes, each cube split into 6 tetrahedra along its main diagonal (Kuhn: conforming
-// between cubes), scalar s(x) = dot(gradient, x) + offset at the points.
-struct Box {
-    glm::dvec3 lo, hi;
-    int n;
-};
-
-void addBox(TetMesh& mesh, const Box& box)
-{
-    const unsigned base = static_cast<unsigned>(mesh.points.size());
-    const int m = box.n + 1;
-    for (int k = 0; k < m; ++k)
-        for (int j = 0; j < m; ++j)
-            for (int i = 0; i < m; ++i)
-                mesh.points.push_back(box.lo + (box.hi - box.lo) * glm::dvec3(i, j, k) / static_cast<double>(box.n));
-    auto id = [&](int i, int j, int k) { return base + static_cast<unsigned>((k * m + j) * m + i); };
-    const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-    for (int k = 0; k < box.n; ++k)
-        for (int j = 0; j < box.n; ++j)
-            for (int i = 0; i < box.n; ++i)
-                for (const auto& perm : perms) {
-                    glm::ivec3 c(i, j, k);
-                    glm::uvec4 tet;
-                    tet[0] = id(c.x, c.y, c.z);
-                    for (int s = 0; s < 3; ++s) {
-                        c[perm[s]] += 1;
-                        tet[s + 1] = id(c.x, c.y, c.z);
-                    }
-                    mesh.tets.push_back(tet);
-                }
-}
-
-TetMesh boxMesh(const std::vector<Box>& boxes, const glm::dvec3& gradient, double offset)
-{
-    TetMesh mesh;
-    mesh.source = "boxes";
-    for (const Box& b : boxes)
-        addBox(mesh, b);
-    for (const glm::dvec3& p : mesh.points)
-        mesh.scalars.push_back(glm::dot(gradient, p) + offset);
-    mesh.tetsRead = mesh.tets.size();
-    return mesh;
 }
 
 // Exact integral (double, ψ by quadrature) of a globally linear field over a union of disjoint boxes:

@@ -5,6 +5,7 @@
 #include "host/runtime/errors.h"
 #include "host/render/grid/blend.h"
 #include "host/render/tet/harc.h"
+#include "host/render/tet/tetslice.h"
 #include "host/render/grid/iso3d.h"
 #include "host/render/grid/planes.h"
 #include "host/render/grid/slice3d.h"
@@ -63,7 +64,7 @@ const std::vector<TechniqueInfo>& techniques()
 {
     static const std::vector<TechniqueInfo> all = {slice3dTechnique(), stack2dTechnique(), iso3dTechnique(),
                                                    planesTechnique(),  blendTechnique(),   sphericalTechnique(),
-                                                   harcTechnique()};
+                                                   harcTechnique(),    tetsliceTechnique()};
     return all;
 }
 

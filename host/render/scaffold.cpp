@@ -3,6 +3,7 @@
 
 #include "host/runtime/errors.h"
 
+#include <map>
 #include <numeric>
 #include <string>
 #include <vector>
@@ -51,6 +52,22 @@ void finishFrame(Device& device, const FrameClock& clock, FrameStats& stats, std
     for (PassTime& t : device.takePassTimes())
         stats.passes.push_back(std::move(t));
     stats.frameMs = clock.ms();
+}
+
+std::size_t mergePassesByName(std::vector<PassTime>& passes)
+{
+    const std::size_t count = passes.size();
+    std::vector<PassTime> merged;
+    std::map<std::string, std::size_t> at;
+    for (PassTime& p : passes) {
+        const auto [it, added] = at.try_emplace(p.name, merged.size());
+        if (added)
+            merged.push_back(std::move(p));
+        else
+            merged[it->second].ms += p.ms;
+    }
+    passes = std::move(merged);
+    return count;
 }
 
 }  // namespace clvr

@@ -54,4 +54,9 @@ std::uint64_t sumCounts(Device& device, const cl::Buffer& buffer, std::size_t co
 // stages) followed by the device's pass times since the last frame, and stats.frameMs the frame's wall time.
 void finishFrame(Device& device, const FrameClock& clock, FrameStats& stats, std::vector<PassTime> hostPasses = {});
 
+// Sums the pass times of equal names into one entry each, in the order each name first appears: for a
+// technique with launches per slice, so that --stats lists a handful of passes instead of thousands.
+// Returns how many entries there were.
+std::size_t mergePassesByName(std::vector<PassTime>& passes);
+
 }  // namespace clvr

@@ -1,0 +1,374 @@
+// host/render/tet/tetslice.cpp — options, active cell lists and the tetslice renderer: per slice two
+// face draws through the raster stage (raster/rasterizer.h), the accumulation buffer between them, and
+// kernels/tetslice.cl's composite pass.
+#include "host/render/tet/tetslice.h"
+
+#include "host/render/camera_args.h"
+#include "host/render/options_util.h"
+#include "host/render/scaffold.h"
+#include "host/render/slice_plan.h"
+#include "host/render/transfer_function_upload.h"
+#include "host/runtime/errors.h"
+#include "kernels/tetslice_params.h"
+#include "raster/framebuffer.h"
+#include "raster/pixel_transfer.h"
+#include "raster/rasterizer.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace clvr {
+
+static_assert(sizeof(ClTetsliceCompositeParams) == 112, "also probed on the device by tests/layout_test.cpp");
+static_assert(sizeof(ClTetsliceFinishParams) == 32);
+
+// ---- active cell lists --------------------------------------------------------------------------------
+
+namespace {
+
+// CSR of `key[c]` (a slice, or -1 for none) over slices 0 .. count-1: cells with key k in
+// cells[begin[k] .. begin[k+1]), in cell order.
+void bucketBySlice(const std::vector<int>& key, int count, std::vector<std::uint32_t>& begin,
+                   std::vector<std::uint32_t>& cells)
+{
+    begin.assign(static_cast<std::size_t>(count) + 1, 0);
+    for (int k : key)
+        if (k >= 0)
+            ++begin[static_cast<std::size_t>(k) + 1];
+    for (int k = 0; k < count; ++k)
+        begin[k + 1] += begin[k];
+    cells.resize(begin[count]);
+    std::vector<std::uint32_t> cursor(begin.begin(), begin.end() - 1);
+    for (std::size_t c = 0; c < key.size(); ++c)
+        if (key[c] >= 0)
+            cells[cursor[key[c]]++] = static_cast<std::uint32_t>(c);
+}
+
+}  // namespace
+
+ActiveCellLists::ActiveCellLists(const std::vector<double>& zMin, const std::vector<double>& zMax, double depthMin,
+                                 double deltaS, int count)
+    : count_(count), k_(count)
+{
+    // Slice k is at depthMin + (k + 0.5) deltaS; cell c is cut by the slices k with zMin <= depth(k) <= zMax.
+    std::vector<int> first(zMin.size(), -1), last(zMin.size(), -1);
+    for (std::size_t c = 0; c < zMin.size(); ++c) {
+        const double lo = std::ceil((zMin[c] - depthMin) / deltaS - 0.5);
+        const double hi = std::floor((zMax[c] - depthMin) / deltaS - 0.5);
+        const double k0 = std::max(lo, 0.0), k1 = std::min(hi, static_cast<double>(count - 1));
+        if (!(k0 <= k1))
+            continue;  // between two slices, or outside the slab (NaN-safe: false for NaN)
+        first[c] = static_cast<int>(k0);
+        last[c] = static_cast<int>(k1);
+        ++listed_;
+    }
+    // Back to front, a cell starts at its farthest slice and ends after its nearest.
+    bucketBySlice(last, count, startBegin_, startAt_);
+    bucketBySlice(first, count, endBegin_, endAt_);
+    place_.assign(zMin.size(), 0);
+}
+
+const std::vector<std::uint32_t>& ActiveCellLists::next()
+{
+    if (k_ <= 0)
+        throw InternalError("ActiveCellLists::next called more than count times");
+    // Cells whose nearest slice was the previous one leave (swap with the last, O(1) each).
+    if (pendingEnd_) {
+        for (std::uint32_t i = endBegin_[k_]; i < endBegin_[k_ + 1]; ++i) {
+            const std::uint32_t cell = endAt_[i];
+            const std::uint32_t at = place_[cell];
+            active_[at] = active_.back();
+            place_[active_[at]] = at;
+            active_.pop_back();
+        }
+    }
+    --k_;
+    for (std::uint32_t i = startBegin_[k_]; i < startBegin_[k_ + 1]; ++i) {
+        place_[startAt_[i]] = static_cast<std::uint32_t>(active_.size());
+        active_.push_back(startAt_[i]);
+    }
+    pendingEnd_ = true;
+    return active_;
+}
+
+// ---- the renderer -------------------------------------------------------------------------------------
+
+namespace {
+
+constexpr std::uint32_t kMaxCells = 1u << 24;  // ids as two 12-bit halves in float channels
+constexpr float kNoFace = -1.0f;               // the id channel's clear value: no face passed here
+
+class TetsliceRenderer final : public Renderer {
+public:
+    TetsliceRenderer(Device& device, const Scene& scene, const TetMesh& mesh);
+    Image4f render(FrameStats& stats) override;
+    std::uint64_t residentBytes() const override { return residentBytes_; }
+    void setTransferFunction(const TransferFunction& tf) override
+    {
+        tf_.replace(device_, "tetslice transfer function", tf, residentBytes_);
+    }
+
+private:
+    Device& device_;
+    TetsliceOptions options_;
+    Camera camera_;  // relative to shift_
+    ImageSpec image_;
+    glm::dvec3 shift_{0.0}, lo_{0.0}, hi_{0.0};  // lo_, hi_: the mesh box, shifted
+    std::vector<glm::dvec3> points_;               // shifted
+    std::vector<float> scalars_;
+    std::vector<std::array<std::uint32_t, 12>> faces_;  // per cell: face i's points, counter-clockwise from outside
+    std::uint64_t tetsRead_ = 0, tetsDegenerate_ = 0;
+    TransferFunctionUpload tf_;
+    raster::Rasterizer rasterizer_;
+    raster::Framebuffer fb_;
+    cl::Buffer image_buffer_;
+    cl::Kernel composite_, finish_;
+    std::uint64_t residentBytes_ = 0;
+};
+
+TetsliceRenderer::TetsliceRenderer(Device& device, const Scene& scene, const TetMesh& mesh)
+    : device_(device), options_(parseTetsliceOptions(scene.options)), image_(scene.image), rasterizer_(device),
+      fb_(device, scene.image.width, scene.image.height, true)
+{
+    if (mesh.tets.empty())
+        throw InputError(mesh.source + ": tetslice needs a mesh with at least one tetrahedron");
+    if (mesh.tets.size() > kMaxCells)
+        throw InputError(mesh.source + ": tetslice takes at most 2^24 tetrahedra (cell ids in two 12-bit halves), got " +
+                         std::to_string(mesh.tets.size()));
+    const glm::dvec3 lo = mesh.boundsMin(), hi = mesh.boundsMax();
+    shift_ = 0.5 * (lo + hi);
+    lo_ = lo - shift_;
+    hi_ = hi - shift_;
+    camera_ = frameCamera(scene, lo, hi);
+    camera_.position -= shift_;
+    camera_.focalPoint -= shift_;
+    tetsRead_ = mesh.tetsRead ? mesh.tetsRead : mesh.tets.size();
+    tetsDegenerate_ = mesh.tetsDegenerate;
+
+    points_.reserve(mesh.points.size());
+    for (const glm::dvec3& p : mesh.points)
+        points_.push_back(p - shift_);
+    scalars_.assign(mesh.scalars.begin(), mesh.scalars.end());
+    faces_.resize(mesh.tets.size());
+    for (std::size_t c = 0; c < mesh.tets.size(); ++c) {
+        const glm::uvec4& t = mesh.tets[c];
+        for (int i = 0; i < 4; ++i) {
+            std::uint32_t a = t[(i + 1) % 4], b = t[(i + 2) % 4], v = t[(i + 3) % 4];
+            const glm::dvec3 n = glm::cross(points_[b] - points_[a], points_[v] - points_[a]);
+            if (glm::dot(n, points_[t[i]] - points_[a]) > 0.0)  // the normal points at the opposite vertex
+                std::swap(b, v);
+            faces_[c][3 * i] = a;
+            faces_[c][3 * i + 1] = b;
+            faces_[c][3 * i + 2] = v;
+        }
+    }
+
+    tf_.upload(device_, "tetslice transfer function", scene.transferFunction);
+    const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
+    image_buffer_ = device_.buffer("tetslice image", pixels * sizeof(cl_float4));
+    composite_ = device_.kernel("tetslice.cl", "tetslice_composite");
+    finish_ = device_.kernel("tetslice.cl", "tetslice_finish");
+    // Resident for the data: the transfer function. The mesh stays on the host; each slice's faces are
+    // uploaded by the raster stage.
+    residentBytes_ = tf_.bytes();
+}
+
+Image4f TetsliceRenderer::render(FrameStats& stats)
+{
+    const FrameClock clock;
+    const SlicePlan plan = planSlices(camera_, lo_, hi_, options_.slices, options_.sliceSpacing);
+    const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
+    device_.queue().enqueueFillBuffer(image_buffer_, cl_float4{{0.0f, 0.0f, 0.0f, 0.0f}}, 0,
+                                      pixels * sizeof(cl_float4));
+
+    // Per point: eye depth, clip position, vertex color (scalar, -, -, normalized eye depth t). The
+    // alpha test compares t with the slice's t (GL clamps the reference to [0, 1]): t = 0 at the slab's
+    // front, 1 at its back.
+    auto t0 = std::chrono::steady_clock::now();
+    const glm::dvec3 forward = camera_.forward();
+    const double tScale = plan.depthMax > plan.depthMin ? 1.0 / (plan.depthMax - plan.depthMin) : 1.0;
+    const double nearZ = plan.count ? 0.5 * plan.depth(0) : 1.0;
+    const double farZ = 2.0 * plan.depthMax + 1.0;
+    const glm::dmat4 viewProjection =
+        camera_.projectionMatrix(image_.width, image_.height, nearZ, farZ) * camera_.viewMatrix();
+    std::vector<double> z(points_.size());
+    std::vector<raster::Vertex> pointVertex(points_.size());
+    for (std::size_t p = 0; p < points_.size(); ++p) {
+        z[p] = glm::dot(points_[p] - camera_.position, forward);
+        pointVertex[p].position = glm::vec4(viewProjection * glm::dvec4(points_[p], 1.0));
+        pointVertex[p].attributes[0] =
+            glm::vec4(scalars_[p], 0.0f, 0.0f, static_cast<float>((z[p] - plan.depthMin) * tScale));
+    }
+    // Per cell: its eye-depth range, and which faces face away from the eye (drawn in the back-face pass)
+    // or towards it (front-face pass), decided once per frame in double: GL's culling, except that a face
+    // seen exactly edge-on is kept (as a front face) instead of dropped.
+    const std::size_t cells = faces_.size();
+    std::vector<double> zMin(cells), zMax(cells);
+    std::vector<std::uint8_t> backMask(cells, 0);
+    for (std::size_t c = 0; c < cells; ++c) {
+        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+        std::uint8_t mask = 0;
+        for (int i = 0; i < 4; ++i) {
+            const glm::dvec3& a = points_[faces_[c][3 * i]];
+            const glm::dvec3& b = points_[faces_[c][3 * i + 1]];
+            const glm::dvec3& v = points_[faces_[c][3 * i + 2]];
+            const glm::dvec3 n = glm::cross(b - a, v - a);  // outward
+            const double facing = camera_.parallel ? glm::dot(n, forward) : glm::dot(n, a - camera_.position);
+            if (facing > 0.0)
+                mask |= static_cast<std::uint8_t>(1u << i);
+            lo = std::min({lo, z[faces_[c][3 * i]], z[faces_[c][3 * i + 1]], z[faces_[c][3 * i + 2]]});
+            hi = std::max({hi, z[faces_[c][3 * i]], z[faces_[c][3 * i + 1]], z[faces_[c][3 * i + 2]]});
+        }
+        zMin[c] = lo;
+        zMax[c] = hi;
+        backMask[c] = mask;
+    }
+    ActiveCellLists lists(zMin, zMax, plan.depthMin, plan.deltaS > 0.0 ? plan.deltaS : 1.0, plan.count);
+    const double setUpMs = msSince(t0);
+
+    // The two draws' state (GL: glAlphaFunc, glDepthFunc, glStencilFunc/Op; the color buffer is float).
+    raster::DrawState back;
+    back.fragment.alpha.test = true;
+    back.fragment.alpha.func = raster::CompareFunc::GEqual;
+    back.fragment.depth.test = true;
+    back.fragment.depth.func = raster::CompareFunc::Less;
+    back.fragment.stencil.test = true;
+    back.fragment.stencil.func = raster::CompareFunc::Always;
+    back.fragment.stencil.ref = 1;
+    back.fragment.stencil.dppass = raster::StencilOp::Replace;  // set where the alpha and depth tests pass
+    raster::DrawState front;
+    front.fragment.alpha.test = true;
+    front.fragment.alpha.func = raster::CompareFunc::LEqual;
+    front.fragment.depth.test = true;
+    front.fragment.depth.func = raster::CompareFunc::Greater;  // the farthest front face at or before d
+    front.fragment.stencil.test = true;
+    front.fragment.stencil.func = raster::CompareFunc::Equal;  // only where a back face was found
+    front.fragment.stencil.ref = 1;
+    front.fragment.stencil.writeMask = 0;
+
+    ClTetsliceCompositeParams params{};
+    params.camera = toClCamera(camera_, image_.width, image_.height);
+    params.width = image_.width;
+    params.height = image_.height;
+    params.tf_count = tf_.count();
+    params.delta_s = static_cast<float>(plan.deltaS);
+    const glm::vec4 clear(0.0f, kNoFace, kNoFace, 0.0f);
+
+    std::vector<raster::Vertex> backFaces, frontFaces;
+    std::vector<std::uint32_t> cellsPerSlice(static_cast<std::size_t>(plan.count), 0);
+    std::uint64_t cellsDrawn = 0;
+    double buildMs = 0.0;
+    for (int n = 0; n < plan.count; ++n) {
+        const std::vector<std::uint32_t>& active = lists.next();
+        const int k = lists.slice();
+        cellsPerSlice[k] = static_cast<std::uint32_t>(active.size());
+        cellsDrawn += active.size();
+        if (active.empty())
+            continue;
+        t0 = std::chrono::steady_clock::now();
+        backFaces.clear();
+        frontFaces.clear();
+        for (const std::uint32_t c : active) {
+            // Vertex colors: (scalar, id low 12 bits, id high 12 bits, t); ids are exact in float.
+            const glm::vec2 id(static_cast<float>(c & 0xfffu), static_cast<float>(c >> 12));
+            for (int i = 0; i < 4; ++i) {
+                std::vector<raster::Vertex>& out = (backMask[c] >> i) & 1u ? backFaces : frontFaces;
+                for (int j = 0; j < 3; ++j) {
+                    raster::Vertex v = pointVertex[faces_[c][3 * i + j]];
+                    v.attributes[0].y = id.x;
+                    v.attributes[0].z = id.y;
+                    out.push_back(v);
+                }
+            }
+        }
+        buildMs += msSince(t0);
+        const float d = static_cast<float>((plan.depth(k) - plan.depthMin) * tScale);
+        back.fragment.alpha.ref = d;
+        front.fragment.alpha.ref = d;
+
+        fb_.clearColor(device_, clear);
+        fb_.clearDepth(device_, 1.0f);
+        fb_.clearStencil(device_, 0);
+        rasterizer_.draw(fb_, back, raster::Topology::Triangles, backFaces);
+        raster::accumulate(device_, fb_, raster::AccumOp::Load, 1.0f);  // the back faces' image, kept
+        fb_.clearColor(device_, clear);
+        fb_.clearDepth(device_, 0.0f);
+        rasterizer_.draw(fb_, front, raster::Topology::Triangles, frontFaces);
+
+        params.depth = d;
+        int a = 0;
+        composite_.setArg(a++, image_buffer_);
+        composite_.setArg(a++, fb_.color());
+        composite_.setArg(a++, fb_.accum());
+        composite_.setArg(a++, tf_.buffer());
+        composite_.setArg(a++, params);
+        device_.launch("tetslice: composite", composite_, image_.width, image_.height);
+    }
+
+    ClTetsliceFinishParams finish{};
+    finish.background = toCl4(image_.background);
+    finish.count = static_cast<cl_int>(pixels);
+    finish_.setArg(0, image_buffer_);
+    finish_.setArg(1, finish);
+    device_.launch("tetslice: over background", finish_, pixels);
+    Image4f image = readImage(device_, image_buffer_, image_.width, image_.height);
+    const raster::DrawStats drawn = rasterizer_.takeStats();
+
+    finishFrame(device_, clock, stats,
+                {{"tetslice: eye depths, facing, active cell lists (host)", setUpMs},
+                 {"tetslice: face vertices of the active cells (host)", buildMs}});
+    stats.extra["launches"] = mergePassesByName(stats.passes) - 2;  // per pass name: its launches summed
+    stats.extra["points"] = points_.size();
+    stats.extra["tets"] = tetsRead_;
+    stats.extra["tets_rendered"] = cells;
+    stats.extra["tets_degenerate"] = tetsDegenerate_;
+    stats.extra["resident_bytes"] = residentBytes_;
+    stats.extra["slices"] = plan.count;
+    stats.extra["slice_spacing"] = plan.deltaS;
+    stats.extra["cells_listed"] = lists.cellsListed();
+    stats.extra["cells_drawn"] = cellsDrawn;
+    stats.extra["cells_per_slice"] = cellsPerSlice;  // slice 0 = nearest
+    stats.extra["raster_triangles"] = drawn.triangles;
+    stats.extra["raster_fragments"] = drawn.fragments;
+    return image;
+}
+
+}  // namespace
+
+TechniqueInfo tetsliceTechnique()
+{
+    TechniqueInfo t;
+    t.name = "tetslice";
+    t.data = DataKind::Mesh;
+    t.description = "direct slicing of tetrahedral grids through cell faces, seeds/000 §4.2 (docs/tetslice.md)";
+    t.options = {slicesInfo(), sliceSpacingInfo()};
+    t.makeForMesh = makeTetsliceRenderer;
+    return t;
+}
+
+TetsliceOptions parseTetsliceOptions(const nlohmann::json& options)
+{
+    static const TechniqueInfo& info = technique("tetslice");
+    checkSlicesOrSpacing(options);
+    TetsliceOptions o;
+    forEachOption(options, info, [&](const std::string& key, const nlohmann::json& value) {
+        if (key == "slices")
+            o.slices = slicesOption(value);
+        else if (key == "slice_spacing")
+            o.sliceSpacing = sliceSpacingOption(value);
+        else
+            unparsedOption(info, key);
+    });
+    return o;
+}
+
+std::unique_ptr<Renderer> makeTetsliceRenderer(Device& device, const Scene& scene, const TetMesh& mesh)
+{
+    return std::make_unique<TetsliceRenderer>(device, scene, mesh);
+}
+
+}  // namespace clvr

@@ -1,0 +1,269 @@
+// tests/tetslice_test.cpp — direct slicing of tetrahedral grids through cell faces (host/render/tet/tetslice.h):
+// options, the active cell lists against a brute-force cut test, and images against the exact
+// tetrahedral reference (host/reference/tet_reference.h): a convex box grid and boxes with a gap (both
+// cameras), the paper's meshes (bluntfin, the oxygen post) and a non-convex TetGen mesh, each with the
+// error falling as the slice count grows; identical bits twice; a transfer-function change.
+#include "host/render/tet/tetslice.h"
+
+#include "host/io/mesh_io.h"
+#include "host/model/scene.h"
+#include "host/reference/tet_reference.h"
+#include "host/runtime/errors.h"
+#include "tests/support/mesh_fixtures.h"
+#include "tests/support/test_util.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace clvr {
+namespace {
+
+using nlohmann::json;
+
+TEST(TetsliceOptions, ParsesAndRejects)
+{
+    EXPECT_EQ(parseTetsliceOptions(json::object()).slices, 256);
+    EXPECT_EQ(parseTetsliceOptions(json{{"slices", 64}}).slices, 64);
+    EXPECT_DOUBLE_EQ(parseTetsliceOptions(json{{"slice_spacing", 0.01}}).sliceSpacing, 0.01);
+    EXPECT_THROW(parseTetsliceOptions(json{{"slices", 0}}), InputError);
+    EXPECT_THROW(parseTetsliceOptions(json{{"slices", "many"}}), InputError);
+    EXPECT_THROW(parseTetsliceOptions(json{{"slice_spacing", -1.0}}), InputError);
+    EXPECT_THROW(parseTetsliceOptions(json{{"slices", 8}, {"slice_spacing", 0.1}}), InputError);
+    EXPECT_THROW(parseTetsliceOptions(json{{"integration", "full"}}), InputError);  // harc's, not ours
+}
+
+// Every slice's active list holds exactly the cells it cuts (zMin <= depth(k) <= zMax), walked back to front.
+TEST(TetsliceActiveCells, EachSliceListsExactlyTheCellsItCuts)
+{
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> at(-0.5, 10.5), size(0.0, 1.5);
+    std::vector<double> zMin(2000), zMax(2000);
+    for (std::size_t c = 0; c < zMin.size(); ++c) {
+        zMin[c] = at(rng);
+        zMax[c] = zMin[c] + (c % 7 == 0 ? 0.0 : size(rng));  // some flat cells
+    }
+    const double depthMin = 0.0, deltaS = 0.1;
+    const int count = 100;
+    ActiveCellLists lists(zMin, zMax, depthMin, deltaS, count);
+    std::uint64_t listedOnce = 0;
+    std::vector<int> seen(zMin.size(), 0);
+    for (int n = 0; n < count; ++n) {
+        std::vector<std::uint32_t> got = lists.next();
+        const int k = lists.slice();
+        ASSERT_EQ(k, count - 1 - n);
+        const double depth = depthMin + (k + 0.5) * deltaS;
+        std::vector<std::uint32_t> want;
+        for (std::uint32_t c = 0; c < zMin.size(); ++c)
+            if (zMin[c] <= depth && depth <= zMax[c])
+                want.push_back(c);
+        std::sort(got.begin(), got.end());
+        ASSERT_EQ(got, want) << "slice " << k;
+        for (std::uint32_t c : got)
+            listedOnce += seen[c]++ == 0 ? 1 : 0;
+    }
+    EXPECT_EQ(lists.cellsListed(), listedOnce);
+    EXPECT_GT(listedOnce, 100u);
+    EXPECT_LT(listedOnce, zMin.size());  // thin cells between slices and cells outside the slab are never drawn
+    EXPECT_THROW(lists.next(), InternalError);
+}
+
+Camera perspective(glm::dvec3 position, glm::dvec3 focal, double angle)
+{
+    Camera c;
+    c.position = position;
+    c.focalPoint = focal;
+    c.viewUp = {0.0, 1.0, 0.0};
+    c.viewAngle = angle;
+    return c;
+}
+
+Scene makeScene(const Camera& camera, const TransferFunction& tf, int size, json options = json::object())
+{
+    Scene s;
+    s.technique = "tetslice";
+    s.camera = camera;
+    s.image = ImageSpec{size, size, {0.1, 0.2, 0.3}};
+    s.transferFunction = tf;
+    s.options = std::move(options);
+    return s;
+}
+
+Image4f renderTetslice(const Scene& scene, const TetMesh& mesh, FrameStats* statsOut = nullptr)
+{
+    auto renderer = makeTetsliceRenderer(test::device(), scene, mesh);
+    FrameStats stats;
+    Image4f image = renderer->render(stats);
+    if (statsOut)
+        *statsOut = stats;
+    return image;
+}
+
+// The worst channel's max and mean absolute error.
+struct Error {
+    double maxAbs = 0.0, meanAbs = 0.0;
+};
+
+Error errorOf(const char* what, int slices, const Image4f& image, const Image4d& expected)
+{
+    const test::ImageError e = test::imageError(image, expected);
+    EXPECT_EQ(e.nanCount, 0u) << what;
+    Error out;
+    for (int ch = 0; ch < 4; ++ch) {
+        out.maxAbs = std::max(out.maxAbs, e.maxAbs[ch]);
+        out.meanAbs = std::max(out.meanAbs, e.meanAbs[ch]);
+    }
+    std::printf("%s, %d slices: max |error| %.3g, mean %.3g\n", what, slices, out.maxAbs, out.meanAbs);
+    return out;
+}
+
+// The mesh against the exact reference at each slice count: the mean error falls at every step, and
+// the finest within `finalMean` (mean) and `finalMax` (max).
+void expectConvergence(const std::string& what, const TetMesh& mesh, const Scene& base, const std::vector<int>& counts,
+                       double finalMean, double finalMax)
+{
+    const Image4d expected = tetReferenceIntegral(mesh, base.transferFunction, *base.camera, base.image);
+    double lastMean = 1e30;
+    Error e;
+    for (const int n : counts) {
+        Scene scene = base;
+        scene.options = json{{"slices", n}};
+        FrameStats stats;
+        const Image4f image = renderTetslice(scene, mesh, &stats);
+        e = errorOf(what.c_str(), n, image, expected);
+        EXPECT_LT(e.meanAbs, lastMean) << what << ", " << n << " slices";
+        lastMean = e.meanAbs;
+        EXPECT_EQ(stats.extra["slices"].get<int>(), n);
+    }
+    EXPECT_LT(e.meanAbs, finalMean) << what;
+    EXPECT_LT(e.maxAbs, finalMax) << what;
+}
+
+TransferFunction rampTf()
+{
+    return TransferFunction({{0.0, {0.0, 0.0, 0.2}, 0.0},
+                             {0.3, {1.0, 0.5, 0.0}, 3.0},
+                             {0.55, {0.2, 1.0, 0.3}, 0.5},
+                             {0.8, {1.0, 1.0, 1.0}, 6.0},
+                             {1.0, {0.3, 0.2, 1.0}, 1.0}});
+}
+
+TEST(Tetslice, ConvexBoxGridConvergesToTheExactIntegral)
+{
+    const TetMesh mesh = test::boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, 4}}, {0.6, 0.25, -0.4}, 0.35);
+    for (const bool parallel : {false, true}) {
+        Camera camera = perspective({1.9, 1.4, 2.6}, {0.5, 0.5, 0.5}, 35.0);
+        if (parallel) {
+            camera.parallel = true;
+            camera.parallelScale = 1.0;
+        }
+        expectConvergence(parallel ? "box grid, parallel" : "box grid, perspective", mesh,
+                          makeScene(camera, rampTf(), 64), {32, 128, 512}, 2e-3, 2e-2);
+    }
+}
+
+// Two boxes with a gap along the view direction: slices in the gap cut no cell; their back face and
+// front face belong to different cells, so they add nothing.
+TEST(Tetslice, GapBetweenBoxesAddsNothing)
+{
+    const TetMesh mesh = test::boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 0.4}, 3}, {{0.0, 0.0, 0.7}, {1.0, 1.0, 1.1}, 3}},
+                                       {0.3, 0.5, 0.2}, 0.1);
+    const Camera camera = perspective({0.9, 0.7, 3.2}, {0.5, 0.5, 0.5}, 40.0);
+    expectConvergence("two boxes with a gap", mesh, makeScene(camera, rampTf(), 64), {32, 128, 512}, 2e-3, 2e-2);
+}
+
+TEST(Tetslice, IdenticalBitsTwiceAndCellCounts)
+{
+    const TetMesh mesh = test::boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, 3}}, {0.6, 0.25, -0.4}, 0.35);
+    const Scene scene = makeScene(perspective({1.9, 1.4, 2.6}, {0.5, 0.5, 0.5}, 35.0), rampTf(), 48, json{{"slices", 64}});
+    auto renderer = makeTetsliceRenderer(test::device(), scene, mesh);
+    FrameStats a, b;
+    const Image4f first = renderer->render(a);
+    const Image4f second = renderer->render(b);
+    ASSERT_EQ(first.pixels().size(), second.pixels().size());
+    EXPECT_EQ(std::memcmp(first.pixels().data(), second.pixels().data(), first.pixels().size() * sizeof(glm::vec4)), 0);
+    const auto perSlice = a.extra["cells_per_slice"].get<std::vector<std::uint64_t>>();
+    ASSERT_EQ(perSlice.size(), 64u);
+    std::uint64_t sum = 0;
+    for (std::uint64_t n : perSlice)
+        sum += n;
+    EXPECT_EQ(sum, a.extra["cells_drawn"].get<std::uint64_t>());
+    // Each slice draws only the cells it cuts: a cell of this 3x3x3 grid spans about a third of the
+    // slab's depth, so well under half of all (cell, slice) pairs; every cell is cut by some slice.
+    EXPECT_LT(sum * 2, mesh.tets.size() * perSlice.size());
+    EXPECT_EQ(a.extra["cells_listed"].get<std::uint64_t>(), mesh.tets.size());
+    EXPECT_GT(a.extra["raster_triangles"].get<std::uint64_t>(), sum);  // about 4 faces per drawn cell
+}
+
+TEST(Tetslice, TransferFunctionChangeEqualsAFreshRenderer)
+{
+    const TetMesh mesh = test::boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, 3}}, {0.6, 0.25, -0.4}, 0.35);
+    const Scene scene = makeScene(perspective({1.9, 1.4, 2.6}, {0.5, 0.5, 0.5}, 35.0), rampTf(), 32, json{{"slices", 48}});
+    Scene other = scene;
+    other.transferFunction = TransferFunction({{0.0, {1.0, 0.0, 0.0}, 2.0}, {1.0, {0.0, 1.0, 1.0}, 0.5}});
+    auto renderer = makeTetsliceRenderer(test::device(), scene, mesh);
+    FrameStats stats;
+    renderer->render(stats);
+    renderer->setTransferFunction(other.transferFunction);
+    const Image4f changed = renderer->render(stats);
+    const Image4f fresh = renderTetslice(other, mesh);
+    EXPECT_EQ(std::memcmp(changed.pixels().data(), fresh.pixels().data(), fresh.pixels().size() * sizeof(glm::vec4)), 0);
+}
+
+// ---- the paper's meshes and a non-convex TetGen mesh ----------------------------------------------------
+
+// The harc tests' camera: fitted to the bounds, looking from an oblique direction.
+Camera meshCamera(const TetMesh& mesh)
+{
+    const glm::dvec3 lo = mesh.boundsMin(), hi = mesh.boundsMax(), center = 0.5 * (lo + hi);
+    const double radius = 0.5 * glm::length(hi - lo);
+    return perspective(center + radius * glm::dvec3(1.3, 0.9, 2.2), center, 34.0);
+}
+
+TEST(TetsliceMeshes, BluntfinConverges)
+{
+    TetMesh mesh = loadMesh(json{{"file", test::sharedData("bluntfin/bluntfinxyz.bin")},
+                                 {"q_file", test::sharedData("bluntfin/bluntfinq.bin")},
+                                 {"scalar", "density"}},
+                            "/");
+    const TransferFunction tf({{0.2, {0.0, 0.0, 0.3}, 0.0},
+                               {0.8, {0.1, 0.3, 1.0}, 0.1},
+                               {1.5, {0.2, 1.0, 0.3}, 0.4},
+                               {2.5, {1.0, 0.8, 0.1}, 0.8},
+                               {4.0, {1.0, 0.2, 0.1}, 1.5}});
+    expectConvergence("bluntfin", mesh, makeScene(meshCamera(mesh), tf, 48), {64, 256, 1024}, 2e-3, 5e-2);
+}
+
+TEST(TetsliceMeshes, PostConverges)
+{
+    TetMesh mesh = loadMesh(json{{"file", test::sharedData("post/post.vtk")}}, "/");
+    const glm::dvec2 range = mesh.scalarRange();
+    auto at = [&](double f) { return range.x + f * (range.y - range.x); };
+    const double size = glm::length(mesh.boundsMax() - mesh.boundsMin());
+    const TransferFunction tf({{at(0.0), {0.1, 0.1, 0.5}, 0.0},
+                               {at(0.3), {0.2, 0.6, 1.0}, 1.0 / size},
+                               {at(0.6), {0.9, 0.9, 0.2}, 3.0 / size},
+                               {at(1.0), {1.0, 0.3, 0.1}, 8.0 / size}});
+    expectConvergence("post", mesh, makeScene(meshCamera(mesh), tf, 48), {64, 256, 1024}, 2e-3, 5e-2);
+}
+
+// The shipped torus (a TetGen mesh made from data/surfaces at load time), seen nearly edge-on so that
+// rays cross the near tube, the hole and the far tube.
+TEST(TetsliceMeshes, TetgenTorusThroughItsHoleConverges)
+{
+    Scene scene = loadScene(test::repoData("scenes/torus.json"));
+    const TetMesh mesh = loadMesh(*scene.mesh);
+    scene.technique = "tetslice";
+    scene.image.width = scene.image.height = 48;
+    scene.camera = perspective({0.3, -2.6, 0.35}, {0.0, 0.0, 0.0}, 40.0);
+    expectConvergence("torus through its hole", mesh, scene, {64, 256, 1024}, 2e-3, 5e-2);
+}
+
+}  // namespace
+}  // namespace clvr
