@@ -11,6 +11,7 @@
 #include "slice3d_params.h"
 #include "spherical_params.h"
 #include "stack2d_params.h"
+#include "tetiso_params.h"
 #include "tetslice_params.h"
 
 /* out[0] = the number of entries n, out[1 .. n] the entries. */

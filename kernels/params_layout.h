@@ -218,3 +218,13 @@ CLVR_LAYOUT_FIELD(ClTetsliceFinishParams, count)
 CLVR_LAYOUT_FIELD(ClTetsliceFinishParams, pad0)
 CLVR_LAYOUT_FIELD(ClTetsliceFinishParams, pad1)
 CLVR_LAYOUT_FIELD(ClTetsliceFinishParams, pad2)
+
+CLVR_LAYOUT_SIZE(ClTetisoUniforms)
+CLVR_LAYOUT_FIELD(ClTetisoUniforms, size)
+
+CLVR_LAYOUT_SIZE(ClTetisoParams)
+CLVR_LAYOUT_FIELD(ClTetisoParams, background)
+CLVR_LAYOUT_FIELD(ClTetisoParams, count)
+CLVR_LAYOUT_FIELD(ClTetisoParams, equal)
+CLVR_LAYOUT_FIELD(ClTetisoParams, iso)
+CLVR_LAYOUT_FIELD(ClTetisoParams, pass)

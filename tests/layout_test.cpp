@@ -15,6 +15,7 @@
 #include "kernels/slice3d_params.h"
 #include "kernels/spherical_params.h"
 #include "kernels/stack2d_params.h"
+#include "kernels/tetiso_params.h"
 #include "kernels/tetslice_params.h"
 #include "kernels/texture.h"
 
@@ -125,6 +126,7 @@ TEST(Layout, EveryParamsStructFitsTheKernelArgumentSpace)
         {"accum", sizeof(ClAccumParams) + 2 * sizeof(void*)},
         {"tetslice_composite", sizeof(ClTetsliceCompositeParams) + 4 * sizeof(void*)},
         {"tetslice_finish", sizeof(ClTetsliceFinishParams) + 1 * sizeof(void*)},
+        {"tetiso_weights", sizeof(ClTetisoParams) + 3 * sizeof(void*)},
     };
     for (const auto& [kernel, bytes] : argumentBytes) {
         EXPECT_LE(bytes, limit) << kernel;
@@ -140,6 +142,7 @@ TEST(Layout, EveryParamsStructFitsTheKernelArgumentSpace)
     EXPECT_EQ(sizeof(ClSlice3dOverBackgroundParams), 32u);
     EXPECT_EQ(sizeof(ClTetsliceCompositeParams), 112u);
     EXPECT_EQ(sizeof(ClTetsliceFinishParams), 32u);
+    EXPECT_EQ(sizeof(ClTetisoParams), 32u);
     EXPECT_EQ(sizeof(ClIso3dFinishParams), 48u);
     EXPECT_EQ(sizeof(ClStack2dIsoFinishParams), 32u);
     EXPECT_EQ(sizeof(ClPixelTransfer), 128u);

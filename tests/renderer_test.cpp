@@ -58,7 +58,7 @@ const TetMesh& cubeMesh()
     return mesh;
 }
 
-// A small scene every technique can render: the iso-surface for iso3d, lights where they are allowed.
+// A small scene every technique can render: the iso-surface for iso3d and tetiso, lights where they are allowed.
 Scene sceneFor(const TechniqueInfo& t, const json& options)
 {
     Scene s;
@@ -68,7 +68,7 @@ Scene sceneFor(const TechniqueInfo& t, const json& options)
     s.transferFunction = TransferFunction({{0.0, {0.2, 0.4, 1.0}, 0.0}, {0.4, {0.3, 0.6, 1.0}, 2.0},
                                            {0.6, {1.0, 0.8, 0.3}, 4.0}, {1.0, {1.0, 0.9, 0.7}, 1.0}});
     s.options = options;
-    if (t.name == "iso3d")
+    if (t.name == "iso3d" || t.name == "tetiso")
         s.iso = isoAt(0.5);
     if (t.name == "planes" || t.name == "blend" || t.name == "stack2d")
         s.lighting = test::twoLightLighting();

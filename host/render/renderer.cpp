@@ -5,6 +5,7 @@
 #include "host/runtime/errors.h"
 #include "host/render/grid/blend.h"
 #include "host/render/tet/harc.h"
+#include "host/render/tet/tetiso.h"
 #include "host/render/tet/tetslice.h"
 #include "host/render/grid/iso3d.h"
 #include "host/render/grid/planes.h"
@@ -64,7 +65,7 @@ const std::vector<TechniqueInfo>& techniques()
 {
     static const std::vector<TechniqueInfo> all = {slice3dTechnique(), stack2dTechnique(), iso3dTechnique(),
                                                    planesTechnique(),  blendTechnique(),   sphericalTechnique(),
-                                                   harcTechnique(),    tetsliceTechnique()};
+                                                   harcTechnique(),    tetsliceTechnique(), tetisoTechnique()};
     return all;
 }
 

@@ -14,4 +14,8 @@ struct EmbeddedKernel {
 
 const std::vector<EmbeddedKernel>& embeddedKernels();
 
+// The source of kernels/<name> (e.g. "slice3d.cl"), for fragment programs built from a kernel file;
+// InternalError when this build has no such file (host/runtime/kernel_sources.cpp).
+std::string_view embeddedKernelSource(std::string_view name);
+
 }  // namespace clvr

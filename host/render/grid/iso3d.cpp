@@ -145,10 +145,7 @@ Iso3dRendererImpl::Iso3dRendererImpl(Device& device, const Scene& scene, const V
 
     framebuffer_ = std::make_unique<raster::Framebuffer>(device_, image_.width, image_.height);
     finish_ = device_.kernel("iso3d.cl", "iso3d_finish");
-    std::string_view source;
-    for (const EmbeddedKernel& k : embeddedKernels())
-        if (k.name == "iso3d.cl")
-            source = k.source;
+    const std::string_view source = embeddedKernelSource("iso3d.cl");
     fragmentProgram_.source = "#define CLVR_ISO3D_FRAGMENT 1\n" + std::string(source);
     fragmentProgram_.attributes = 1;  // the world position
     fragmentProgram_.buffers[0] = volume_;

@@ -153,10 +153,7 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
     } else {
         framebuffer_ = std::make_unique<raster::Framebuffer>(device_, image_.width, image_.height);
         overBackground_ = device_.kernel("slice3d.cl", "slice3d_over_background");
-        std::string_view source;
-        for (const EmbeddedKernel& k : embeddedKernels())
-            if (k.name == "slice3d.cl")
-                source = k.source;
+        const std::string_view source = embeddedKernelSource("slice3d.cl");
         fragmentProgram_.source = std::string("#define CLVR_SLICE3D_FRAGMENT 1\n") +
                                   (clipTexture_ ? "#define CLVR_SLICE3D_CLIP_TEXTURE 1\n" : "") + std::string(source);
         fragmentProgram_.attributes = clipTexture_ ? 2 : 1;  // world position, clip-texture coordinates

@@ -178,10 +178,7 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
 
     framebuffer_ = std::make_unique<raster::Framebuffer>(device_, image_.width, image_.height);
     overBackground_ = device_.kernel("slice3d.cl", "slice3d_over_background");
-    std::string_view source;
-    for (const EmbeddedKernel& k : embeddedKernels())
-        if (k.name == "stack2d.cl")
-            source = k.source;
+    const std::string_view source = embeddedKernelSource("stack2d.cl");
     fragmentProgram_.source = "#define CLVR_STACK2D_FRAGMENT 1\n" +
                               std::string(clipTexture_ ? "#define CLVR_STACK2D_CLIP_TEXTURE 1\n" : "") + std::string(source);
     fragmentProgram_.attributes = clipTexture_ ? 3 : 2;  // texture coordinates, slab, clip-texture coordinates

@@ -22,10 +22,7 @@ constexpr float kNoLayerYet = -1e30f;  // the peel threshold before the first la
 
 std::string fragmentSource()
 {
-    for (const EmbeddedKernel& k : embeddedKernels())
-        if (k.name == "harc_entry.cl")
-            return "#define CLVR_HARC_ENTRY_FRAGMENT 1\n" + std::string(k.source);
-    throw InternalError("kernels/harc_entry.cl is not embedded in this build");
+    return "#define CLVR_HARC_ENTRY_FRAGMENT 1\n" + std::string(embeddedKernelSource("harc_entry.cl"));
 }
 
 }  // namespace

@@ -3,6 +3,8 @@
 // kernels/tetslice.cl's composite pass.
 #include "host/render/tet/tetslice.h"
 
+#include "host/render/tet/cell_faces.h"
+
 #include "host/render/camera_args.h"
 #include "host/render/options_util.h"
 #include "host/render/scaffold.h"
@@ -99,7 +101,6 @@ const std::vector<std::uint32_t>& ActiveCellLists::next()
 
 namespace {
 
-constexpr std::uint32_t kMaxCells = 1u << 24;  // ids as two 12-bit halves in float channels
 constexpr float kNoFace = -1.0f;               // the id channel's clear value: no face passed here
 
 class TetsliceRenderer final : public Renderer {
@@ -118,9 +119,8 @@ private:
     Camera camera_;  // relative to shift_
     ImageSpec image_;
     glm::dvec3 shift_{0.0}, lo_{0.0}, hi_{0.0};  // lo_, hi_: the mesh box, shifted
-    std::vector<glm::dvec3> points_;               // shifted
+    CellFaces cells_;
     std::vector<float> scalars_;
-    std::vector<std::array<std::uint32_t, 12>> faces_;  // per cell: face i's points, counter-clockwise from outside
     std::uint64_t tetsRead_ = 0, tetsDegenerate_ = 0;
     TransferFunctionUpload tf_;
     raster::Rasterizer rasterizer_;
@@ -131,16 +131,11 @@ private:
 };
 
 TetsliceRenderer::TetsliceRenderer(Device& device, const Scene& scene, const TetMesh& mesh)
-    : device_(device), options_(parseTetsliceOptions(scene.options)), image_(scene.image), rasterizer_(device),
+    : device_(device), options_(parseTetsliceOptions(scene.options)), image_(scene.image),
+      shift_(0.5 * (mesh.boundsMin() + mesh.boundsMax())), cells_(mesh, shift_, "tetslice"), rasterizer_(device),
       fb_(device, scene.image.width, scene.image.height, true)
 {
-    if (mesh.tets.empty())
-        throw InputError(mesh.source + ": tetslice needs a mesh with at least one tetrahedron");
-    if (mesh.tets.size() > kMaxCells)
-        throw InputError(mesh.source + ": tetslice takes at most 2^24 tetrahedra (cell ids in two 12-bit halves), got " +
-                         std::to_string(mesh.tets.size()));
     const glm::dvec3 lo = mesh.boundsMin(), hi = mesh.boundsMax();
-    shift_ = 0.5 * (lo + hi);
     lo_ = lo - shift_;
     hi_ = hi - shift_;
     camera_ = frameCamera(scene, lo, hi);
@@ -149,23 +144,7 @@ TetsliceRenderer::TetsliceRenderer(Device& device, const Scene& scene, const Tet
     tetsRead_ = mesh.tetsRead ? mesh.tetsRead : mesh.tets.size();
     tetsDegenerate_ = mesh.tetsDegenerate;
 
-    points_.reserve(mesh.points.size());
-    for (const glm::dvec3& p : mesh.points)
-        points_.push_back(p - shift_);
     scalars_.assign(mesh.scalars.begin(), mesh.scalars.end());
-    faces_.resize(mesh.tets.size());
-    for (std::size_t c = 0; c < mesh.tets.size(); ++c) {
-        const glm::uvec4& t = mesh.tets[c];
-        for (int i = 0; i < 4; ++i) {
-            std::uint32_t a = t[(i + 1) % 4], b = t[(i + 2) % 4], v = t[(i + 3) % 4];
-            const glm::dvec3 n = glm::cross(points_[b] - points_[a], points_[v] - points_[a]);
-            if (glm::dot(n, points_[t[i]] - points_[a]) > 0.0)  // the normal points at the opposite vertex
-                std::swap(b, v);
-            faces_[c][3 * i] = a;
-            faces_[c][3 * i + 1] = b;
-            faces_[c][3 * i + 2] = v;
-        }
-    }
 
     tf_.upload(device_, "tetslice transfer function", scene.transferFunction);
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
@@ -195,37 +174,28 @@ Image4f TetsliceRenderer::render(FrameStats& stats)
     const double farZ = 2.0 * plan.depthMax + 1.0;
     const glm::dmat4 viewProjection =
         camera_.projectionMatrix(image_.width, image_.height, nearZ, farZ) * camera_.viewMatrix();
-    std::vector<double> z(points_.size());
-    std::vector<raster::Vertex> pointVertex(points_.size());
-    for (std::size_t p = 0; p < points_.size(); ++p) {
-        z[p] = glm::dot(points_[p] - camera_.position, forward);
-        pointVertex[p].position = glm::vec4(viewProjection * glm::dvec4(points_[p], 1.0));
+    const std::vector<glm::dvec3>& points = cells_.points();
+    std::vector<double> z(points.size());
+    std::vector<raster::Vertex> pointVertex(points.size());
+    for (std::size_t p = 0; p < points.size(); ++p) {
+        z[p] = glm::dot(points[p] - camera_.position, forward);
+        pointVertex[p].position = glm::vec4(viewProjection * glm::dvec4(points[p], 1.0));
         pointVertex[p].attributes[0] =
             glm::vec4(scalars_[p], 0.0f, 0.0f, static_cast<float>((z[p] - plan.depthMin) * tScale));
     }
     // Per cell: its eye-depth range, and which faces face away from the eye (drawn in the back-face pass)
-    // or towards it (front-face pass), decided once per frame in double: GL's culling, except that a face
-    // seen exactly edge-on is kept (as a front face) instead of dropped.
-    const std::size_t cells = faces_.size();
+    // or towards it (front-face pass).
+    const std::size_t cells = cells_.cellCount();
+    const std::vector<std::uint8_t> backMask = cells_.backFacing(camera_);
     std::vector<double> zMin(cells), zMax(cells);
-    std::vector<std::uint8_t> backMask(cells, 0);
     for (std::size_t c = 0; c < cells; ++c) {
         double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-        std::uint8_t mask = 0;
-        for (int i = 0; i < 4; ++i) {
-            const glm::dvec3& a = points_[faces_[c][3 * i]];
-            const glm::dvec3& b = points_[faces_[c][3 * i + 1]];
-            const glm::dvec3& v = points_[faces_[c][3 * i + 2]];
-            const glm::dvec3 n = glm::cross(b - a, v - a);  // outward
-            const double facing = camera_.parallel ? glm::dot(n, forward) : glm::dot(n, a - camera_.position);
-            if (facing > 0.0)
-                mask |= static_cast<std::uint8_t>(1u << i);
-            lo = std::min({lo, z[faces_[c][3 * i]], z[faces_[c][3 * i + 1]], z[faces_[c][3 * i + 2]]});
-            hi = std::max({hi, z[faces_[c][3 * i]], z[faces_[c][3 * i + 1]], z[faces_[c][3 * i + 2]]});
+        for (const std::uint32_t p : cells_.faces()[c]) {
+            lo = std::min(lo, z[p]);
+            hi = std::max(hi, z[p]);
         }
         zMin[c] = lo;
         zMax[c] = hi;
-        backMask[c] = mask;
     }
     ActiveCellLists lists(zMin, zMax, plan.depthMin, plan.deltaS > 0.0 ? plan.deltaS : 1.0, plan.count);
     const double setUpMs = msSince(t0);
@@ -272,19 +242,9 @@ Image4f TetsliceRenderer::render(FrameStats& stats)
         t0 = std::chrono::steady_clock::now();
         backFaces.clear();
         frontFaces.clear();
-        for (const std::uint32_t c : active) {
-            // Vertex colors: (scalar, id low 12 bits, id high 12 bits, t); ids are exact in float.
-            const glm::vec2 id(static_cast<float>(c & 0xfffu), static_cast<float>(c >> 12));
-            for (int i = 0; i < 4; ++i) {
-                std::vector<raster::Vertex>& out = (backMask[c] >> i) & 1u ? backFaces : frontFaces;
-                for (int j = 0; j < 3; ++j) {
-                    raster::Vertex v = pointVertex[faces_[c][3 * i + j]];
-                    v.attributes[0].y = id.x;
-                    v.attributes[0].z = id.y;
-                    out.push_back(v);
-                }
-            }
-        }
+        // Vertex colors (scalar, id low 12 bits, id high 12 bits, t); ids are exact in float.
+        cells_.appendFaces(active, backMask, true, pointVertex, 1u, backFaces);
+        cells_.appendFaces(active, backMask, false, pointVertex, 1u, frontFaces);
         buildMs += msSince(t0);
         const float d = static_cast<float>((plan.depth(k) - plan.depthMin) * tScale);
         back.fragment.alpha.ref = d;
@@ -322,7 +282,7 @@ Image4f TetsliceRenderer::render(FrameStats& stats)
                 {{"tetslice: eye depths, facing, active cell lists (host)", setUpMs},
                  {"tetslice: face vertices of the active cells (host)", buildMs}});
     stats.extra["launches"] = mergePassesByName(stats.passes) - 2;  // per pass name: its launches summed
-    stats.extra["points"] = points_.size();
+    stats.extra["points"] = points.size();
     stats.extra["tets"] = tetsRead_;
     stats.extra["tets_rendered"] = cells;
     stats.extra["tets_degenerate"] = tetsDegenerate_;
