@@ -148,6 +148,11 @@ TEST(BenchMesh, FiguresNeedMeshStatsAndAPositiveTime)
             EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
         }
     }
+    // The cell-face techniques count the cells they draw instead of traversal steps.
+    nlohmann::json faces = extra;
+    faces.erase("steps");
+    faces["cells_drawn"] = 7;
+    EXPECT_EQ(clvr::tools::meshFigures(faces, 10.0).steps, 7u);
 }
 
 // A small surface scene: meshed once, then read from the cache as the same mesh; another option meshes again.
@@ -344,5 +349,36 @@ TEST(BenchRegular, ScenesAreValidAndPairsDifferOnlyWhereTheyShould)
             differsOnlyIn(name.substr(0, name.size() - 8) + ".json", "/intermediate");
         if (name.ends_with("-p4.json"))
             differsOnlyIn(name.substr(0, name.size() - 8) + ".json", "/slices_per_polygon");
+    }
+}
+
+// ---- cell-face bench scenes (tools/make_tetfaces_bench.py, `clvr bench --suite tetfaces`) --------------
+
+// The suite lists exactly the tetfaces-* files; every scene is valid, 400x400 as seeds/000's experiments,
+// and each harc scene is its tetslice twin with only the technique and the options changed.
+TEST(BenchTetfaces, ScenesAreValidAndHarcTwinsDifferOnlyInTheTechnique)
+{
+    const std::vector<std::filesystem::path> files = benchScenesStartingWith("tetfaces-");
+    std::vector<std::string> listed = clvr::tools::benchSuiteScenes("tetfaces");
+    std::vector<std::string> present;
+    for (const auto& file : files)
+        present.push_back(file.filename().string());
+    std::sort(listed.begin(), listed.end());
+    EXPECT_EQ(listed, present);
+    ASSERT_EQ(files.size(), 11u);  // 4 meshes x (tetslice, harc) + the automaton x (tetiso, tetslice, harc)
+    for (const auto& file : files) {
+        const clvr::Scene scene = clvr::loadScene(file);
+        const std::string name = file.filename().string();
+        EXPECT_EQ(scene.image.width, 400) << name;
+        EXPECT_EQ(scene.image.height, 400) << name;
+        EXPECT_TRUE(name.ends_with("-" + scene.technique + ".json")) << name;
+        if (scene.technique == "harc") {
+            std::string twin = name;
+            twin.replace(twin.size() - std::string("harc.json").size(), std::string::npos, "tetslice.json");
+            const clvr::Scene other = clvr::loadScene(file.parent_path() / twin);
+            EXPECT_TRUE(*scene.mesh == *other.mesh) << name;
+            EXPECT_EQ(scene.camera->position, other.camera->position) << name;
+            EXPECT_EQ(other.options["slices"].get<int>(), 400) << name;
+        }
     }
 }

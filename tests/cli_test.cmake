@@ -314,3 +314,21 @@ expect_error(2 ${out} "--threads: want a whole number of threads" ${CLVR} render
 expect_error(2 ${out} "--threads: want a whole number of threads" ${CLVR} render -o ${out} ${TINY} --threads x)
 expect_error(2 ${out} "CLVR_THREADS: want a whole number of threads"
   ${CMAKE_COMMAND} -E env CLVR_THREADS=-3 ${CLVR} render -o ${out} ${TINY})
+
+# The cell-face techniques (docs/tetslice.md, docs/tetiso.md) from the command line: a small generated
+# automaton renders, bad options and a missing "iso" are one line each, no image left behind.
+set(AUTOMATON --set "mesh={\"generator\":\"automaton\",\"cells\":60,\"grid\":6}" --set image.width=32 --set image.height=32)
+expect_run(0 "wrote .*tetslice" ${CLVR} render ${SRC}/data/scenes/bluntfin-tetslice.json ${AUTOMATON}
+  --set options.slices=32 --single-frame -o ${WORK}/tetslice.png)
+expect_png(${WORK}/tetslice.png 32 32)
+expect_run(0 "wrote .*tetiso" ${CLVR} render ${SRC}/data/scenes/torus-tetiso.json ${AUTOMATON}
+  --single-frame -o ${WORK}/tetiso.png)
+expect_png(${WORK}/tetiso.png 32 32)
+expect_error(2 ${out} "options.slices: must be an integer in \\[1, 65536\\], got 0"
+  ${CLVR} render ${SRC}/data/scenes/bluntfin-tetslice.json ${AUTOMATON} --set options.slices=0 -o ${out})
+expect_error(2 ${out} "options.weights: must be \"interpolated\" or \"equal\""
+  ${CLVR} render ${SRC}/data/scenes/torus-tetiso.json ${AUTOMATON} --set options.weights='"half"' -o ${out})
+expect_error(2 ${out} "iso: technique tetiso needs \"iso\""
+  ${CLVR} render ${SRC}/data/scenes/torus-tetiso.json ${AUTOMATON} --unset iso -o ${out})
+expect_error(2 ${out} "mesh.cells must be an integer"
+  ${CLVR} render ${SRC}/data/scenes/torus-tetiso.json --set "mesh={\"generator\":\"automaton\",\"cells\":-4}" -o ${out})

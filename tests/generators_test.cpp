@@ -2,10 +2,14 @@
 // [-1,1]^3 grid mapping, the sphere and blobs fields, and bad names and dims.
 #include "host/runtime/errors.h"
 #include "host/io/generators.h"
+#include "host/io/mesh_io.h"
+#include "host/model/data_spec.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
+#include <tuple>
 
 namespace {
 
@@ -106,3 +110,60 @@ TEST(Generators, UnknownNameAndBadDimsThrowInputError)
 }
 
 }  // namespace
+
+namespace clvr {
+
+// seeds/000's binary cellular automaton: distinct cubes of the lattice, 12 tetrahedra and 9 own points
+// each, value 1 at the center and 0 at the corners, every tetrahedron of volume h^3 / 12.
+TEST(Generators, AutomatonCellsAreSeparateCubesOfTwelveTets)
+{
+    const int cells = 500, grid = 12;
+    TetMesh mesh = automatonMesh(cells, grid);
+    ASSERT_EQ(mesh.points.size(), 9u * cells);
+    ASSERT_EQ(mesh.tets.size(), 12u * cells);
+    const double h = 2.0 / grid;
+    std::set<std::tuple<long, long, long>> cubes;
+    for (int c = 0; c < cells; ++c) {
+        const glm::dvec3 center = mesh.points[9 * c + 8];
+        EXPECT_EQ(mesh.scalars[9 * c + 8], 1.0);
+        for (int k = 0; k < 8; ++k)
+            EXPECT_EQ(mesh.scalars[9 * c + k], 0.0);
+        cubes.insert({std::lround((center.x + 1.0) / h - 0.5), std::lround((center.y + 1.0) / h - 0.5),
+                      std::lround((center.z + 1.0) / h - 0.5)});
+        for (int t = 0; t < 12; ++t) {
+            const glm::uvec4 tet = mesh.tets[12 * c + t];
+            for (int k = 0; k < 4; ++k)
+                EXPECT_EQ(tet[k] / 9, static_cast<unsigned>(c));  // no vertex of another cube
+            const double v6 = signedVolume6(mesh.points[tet[0]], mesh.points[tet[1]], mesh.points[tet[2]], mesh.points[tet[3]]);
+            EXPECT_NEAR(std::abs(v6) / 6.0, h * h * h / 12.0, 1e-12);
+        }
+    }
+    EXPECT_EQ(cubes.size(), static_cast<std::size_t>(cells));  // distinct
+    checkMesh(mesh);
+    EXPECT_EQ(mesh.tetsDegenerate, 0u);
+    EXPECT_EQ(mesh.tets.size(), 12u * cells);
+    EXPECT_THROW(automatonMesh(0, 10), InputError);
+    EXPECT_THROW(automatonMesh(1001, 10), InputError);
+    EXPECT_THROW(automatonMesh(1, 0), InputError);
+}
+
+TEST(Generators, AutomatonMeshSpecParsesLoadsAndRejects)
+{
+    const TetMesh mesh = loadMesh(nlohmann::json{{"generator", "automaton"}, {"cells", 100}, {"grid", 10}}, "/");
+    EXPECT_EQ(mesh.tets.size(), 1200u);
+    EXPECT_EQ(parseMeshSpec(nlohmann::json{{"generator", "automaton"}}, "/").cells, 8000);
+    EXPECT_THROW(parseMeshSpec(nlohmann::json{{"generator", "bunny"}}, "/"), InputError);
+    EXPECT_THROW(parseMeshSpec(nlohmann::json{{"generator", "automaton"}, {"cells", -1}}, "/"), InputError);
+    EXPECT_THROW(parseMeshSpec(nlohmann::json{{"generator", "automaton"}, {"size", 3}}, "/"), InputError);
+    EXPECT_THROW(loadMesh(nlohmann::json{{"generator", "automaton"}, {"cells", 2000}, {"grid", 10}}, "/"), InputError);
+}
+
+TEST(Generators, KernelFieldGlowsAtTheLCorner)
+{
+    EXPECT_DOUBLE_EQ(kernelField({-0.5, -0.5, -0.5}), 1.0);
+    EXPECT_NEAR(kernelField({-0.5, -0.5, -0.5 + 0.3}), 0.1 + 0.9 * std::exp(-0.5), 1e-12);
+    EXPECT_GT(kernelField({0.9, -0.9, -0.1}), 0.1);
+    EXPECT_LT(kernelField({0.9, -0.9, -0.1}), 0.11);
+}
+
+}  // namespace clvr

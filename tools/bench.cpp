@@ -275,7 +275,7 @@ nlohmann::json benchMeshScene(Device& device, const fs::path& scenePath, const S
                         {"steps_per_s", f.stepsPerS},
                         {"bytes_per_tet", f.bytesPerTet},
                         {"resident_bytes", renderer->residentBytes()},
-                        {"integration", stats.extra.value("integration", std::string("?"))},
+                        {"integration", stats.extra.value("integration", std::string("-"))},
                         {"image", clvrPng.string()},
                         {"extra", stats.extra}};
     r["passes"] = nlohmann::json::array();

@@ -42,6 +42,14 @@ std::vector<std::string> benchSuiteScenes(const std::string& suite)
         regular.push_back(std::string("reg-cliptex-") + volume + ".json");
     }
     regular.push_back("reg-spherical-atmosphere.json");
+    // The cell-face techniques (tools/make_tetfaces_bench.py): seeds/000's Table 1 and cellular automaton,
+    // each beside harc on the same scene.
+    std::vector<std::string> tetfaces;
+    for (const char* mesh : {"fedata0", "fedata1", "fedata2", "fedata3"})
+        for (const char* technique : {"tetslice", "harc"})
+            tetfaces.push_back(std::string("tetfaces-") + mesh + "-" + technique + ".json");
+    for (const char* technique : {"tetiso", "tetslice", "harc"})
+        tetfaces.push_back(std::string("tetfaces-automaton-") + technique + ".json");
     if (suite == "slice3d")
         return slice3d;
     if (suite == "harc")
@@ -50,14 +58,17 @@ std::vector<std::string> benchSuiteScenes(const std::string& suite)
         return rts;
     if (suite == "regular")
         return regular;
+    if (suite == "tetfaces")
+        return tetfaces;
     if (suite == "all") {
         std::vector<std::string> all = slice3d;
         all.insert(all.end(), harc.begin(), harc.end());
         all.insert(all.end(), rts.begin(), rts.end());
         all.insert(all.end(), regular.begin(), regular.end());
+        all.insert(all.end(), tetfaces.begin(), tetfaces.end());
         return all;
     }
-    throw InputError("--suite: unknown suite \"" + suite + "\" (known: slice3d, harc, rts, regular, all)");
+    throw InputError("--suite: unknown suite \"" + suite + "\" (known: slice3d, harc, rts, regular, tetfaces, all)");
 }
 
 }  // namespace clvr::tools

@@ -165,7 +165,7 @@ int run(int argc, char** argv)
                              "harc-bluntfin-10-full, harc-tetgen-1m), rts (rts-*: planes and blend, tools/make_rts_bench.py), "
                              "regular (reg-*: iso3d, stack2d, clipping, tools/make_regular_bench.py), all, or raster "
                              "(no scenes: the raster stage on 100,000 small triangles, tools/bench_raster.h)")
-        ->check(CLI::IsMember({"slice3d", "harc", "rts", "regular", "all", "raster"}))
+        ->check(CLI::IsMember({"slice3d", "harc", "rts", "regular", "tetfaces", "all", "raster"}))
         ->capture_default_str();
     benchCommand->add_option("-o,--output", benchOptions.outJson, "figures as JSON; images go beside it")
         ->capture_default_str();

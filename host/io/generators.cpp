@@ -1,6 +1,8 @@
 // host/io/generators.cpp — procedural regular volumes on [-1,1]^3 (see generators.h for the definitions).
 #include "host/io/generators.h"
 
+#include "host/model/mesh.h"
+
 #include "host/runtime/errors.h"
 
 #include <algorithm>
@@ -54,6 +56,59 @@ double blobsField(const glm::dvec3& p)
         sum += b.amplitude * std::exp(-glm::dot(d, d) / (2.0 * b.sigma * b.sigma));
     }
     return std::min(sum, 1.0);
+}
+
+double kernelField(const glm::dvec3& p)
+{
+    const glm::dvec3 d = p - glm::dvec3(-0.5, -0.5, -0.5);
+    return 0.1 + 0.9 * std::exp(-glm::dot(d, d) / (2.0 * 0.3 * 0.3));
+}
+
+TetMesh automatonMesh(int cells, int grid)
+{
+    if (grid < 1 || grid > 1024)
+        throw InputError("mesh generator automaton: grid must be in [1, 1024], got " + std::to_string(grid));
+    const std::uint64_t lattice = static_cast<std::uint64_t>(grid) * grid * grid;
+    if (cells < 1 || static_cast<std::uint64_t>(cells) > lattice)
+        throw InputError("mesh generator automaton: cells must be in [1, grid^3 = " + std::to_string(lattice) +
+                         "], got " + std::to_string(cells));
+    // The living cells: the first `cells` of a Fisher-Yates shuffle of the lattice (splitmix64, fixed seed).
+    std::vector<std::uint32_t> order(lattice);
+    for (std::uint64_t i = 0; i < lattice; ++i)
+        order[i] = static_cast<std::uint32_t>(i);
+    std::uint64_t state = 0x5eed5eed5eedULL;
+    const auto next = [&state] {
+        std::uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
+        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+        z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+        return z ^ (z >> 31);
+    };
+    for (std::uint64_t i = 0; i < static_cast<std::uint64_t>(cells); ++i)
+        std::swap(order[i], order[i + next() % (lattice - i)]);
+    std::sort(order.begin(), order.begin() + cells);
+
+    TetMesh mesh;
+    mesh.source = "generator automaton (" + std::to_string(cells) + " cells of " + std::to_string(grid) + "^3)";
+    const double h = 2.0 / grid;
+    // The cube's 6 faces as corner indices (bit 0: +x, bit 1: +y, bit 2: +z), each split along one diagonal.
+    static const int kFaces[6][4] = {{0, 2, 6, 4}, {1, 5, 7, 3}, {0, 4, 5, 1}, {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 6, 7, 5}};
+    for (int n = 0; n < cells; ++n) {
+        const std::uint32_t c = order[static_cast<std::size_t>(n)];
+        const glm::dvec3 lo(-1.0 + h * (c % grid), -1.0 + h * ((c / grid) % grid), -1.0 + h * (c / grid / grid));
+        const auto base = static_cast<std::uint32_t>(mesh.points.size());
+        for (int k = 0; k < 8; ++k) {
+            mesh.points.push_back(lo + h * glm::dvec3(k & 1, (k >> 1) & 1, (k >> 2) & 1));
+            mesh.scalars.push_back(0.0);
+        }
+        mesh.points.push_back(lo + 0.5 * h);
+        mesh.scalars.push_back(1.0);
+        for (const auto& f : kFaces) {
+            mesh.tets.push_back(glm::uvec4(base + 8, base + f[0], base + f[1], base + f[2]));
+            mesh.tets.push_back(glm::uvec4(base + 8, base + f[0], base + f[2], base + f[3]));
+        }
+    }
+    mesh.tetsRead = mesh.tets.size();
+    return mesh;
 }
 
 double atmosphereField(const glm::dvec3& p)

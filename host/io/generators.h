@@ -3,6 +3,7 @@
 // (i,j,k) sits at -1 + 2*(i,j,k)/(n-1), so origin is (-1,-1,-1) and spacing 2/(n-1) per axis.
 #pragma once
 
+#include "host/model/mesh.h"
 #include "host/model/volume.h"
 
 #include <glm/glm.hpp>
@@ -28,6 +29,17 @@ double sphereField(const glm::dvec3& p);
 // "blobs": min(1, sum over four fixed Gaussians a_k exp(-|p - c_k|^2 / (2 sigma_k^2))), amplitudes a_k
 // 1, 0.75, 0.5 and 0.25; values in [0,1]. Centers and widths are in generators.cpp and docs/data-formats.md.
 double blobsField(const glm::dvec3& p);
+
+// "kernel": the "glowing kernel" of seeds/000's finite-element example, for the L-block part
+// (data/surfaces/l-block.poly, in [-1,1]^2 x [-1,0]): 0.1 + 0.9 exp(-|p - c|^2 / (2 0.3^2)) with c =
+// (-0.5, -0.5, -0.5), the center of the L's corner cube; values in (0.1, 1].
+double kernelField(const glm::dvec3& p);
+
+// "automaton" mesh (seeds/000 §5, the binary cellular automaton): `cells` distinct cubes of a grid x grid x
+// grid lattice over [-1,1]^3, picked by a fixed-seed shuffle, each split into 12 tetrahedra that share
+// its center (two per face), with no vertex shared between cubes: 9 points per cube, value 1 at the
+// center and 0 at the 8 corners. InputError unless 1 <= cells <= grid^3 and 1 <= grid <= 1024.
+TetMesh automatonMesh(int cells, int grid);
 
 // "atmosphere": a field meant as (phi, theta, r) data for the spherical technique (host/render/grid/spherical.h):
 // with (u, v, w) = (p + 1) / 2, phi = 2 pi u, theta = pi v, a cloud layer around w = 0.55 (Gaussian, width

@@ -3,6 +3,8 @@
 // every count from a header is compared with what the file can hold before anything is allocated.
 #include "host/io/mesh_io.h"
 
+#include "host/io/generators.h"
+
 #include "host/runtime/errors.h"
 #include "host/runtime/file_io.h"
 #include "host/io/tetgen_mesher.h"
@@ -1082,8 +1084,9 @@ TetMesh loadMesh(const MeshSpec& spec)
         options.scalar = spec.scalar;
         return meshSurface(spec.surface, options);  // checked by meshSurface
     }
-    TetMesh mesh = spec.kind == MeshSpec::Kind::Plot3d ? readPlot3d(spec.file, spec.qFile, spec.scalar)
-                                                       : readMeshFile(spec);
+    TetMesh mesh = spec.kind == MeshSpec::Kind::Generator ? automatonMesh(spec.cells, spec.grid)
+                   : spec.kind == MeshSpec::Kind::Plot3d  ? readPlot3d(spec.file, spec.qFile, spec.scalar)
+                                                          : readMeshFile(spec);
     checkMesh(mesh);
     if (mesh.tets.empty())
         throw InputError(mesh.source + ": no tetrahedra left (" + std::to_string(mesh.tetsRead) + " read, " +

@@ -123,8 +123,11 @@ void assignScalar(TetMesh& mesh, const std::string& scalar)
 {
     mesh.scalars.resize(mesh.points.size());
     const std::string name = asciiLower(scalar);
-    if (name == "marschner-lobb" || name == "sphere" || name == "blobs") {
-        double (*f)(const glm::dvec3&) = name == "sphere" ? sphereField : name == "blobs" ? blobsField : marschnerLobb;
+    if (name == "marschner-lobb" || name == "sphere" || name == "blobs" || name == "kernel") {
+        double (*f)(const glm::dvec3&) = name == "sphere"   ? sphereField
+                                         : name == "blobs"  ? blobsField
+                                         : name == "kernel" ? kernelField
+                                                            : marschnerLobb;
         for (std::size_t i = 0; i < mesh.points.size(); ++i)
             mesh.scalars[i] = f(mesh.points[i]);
         return;
@@ -132,7 +135,7 @@ void assignScalar(TetMesh& mesh, const std::string& scalar)
     const std::string ext = asciiLower(fs::path(scalar).extension().string());
     if (ext != ".nrrd" && ext != ".nhdr")
         throw InputError("mesh scalar " + scalar +
-                         ": neither a generator (marschner-lobb, sphere, blobs) nor a .nrrd/.nhdr volume");
+                         ": neither a generator (marschner-lobb, sphere, blobs, kernel) nor a .nrrd/.nhdr volume");
     const Volume volume = readNrrd(scalar);
     const glm::dvec3 lo = volume.boundsMin(), hi = volume.boundsMax();
     for (std::size_t i = 0; i < mesh.points.size(); ++i)
@@ -147,9 +150,9 @@ TetMesh meshSurface(const fs::path& surface, const MesherOptions& options)
         throw InputError(surface.string() + ": --quality and --max-volume must be positive");
     {
         const std::string s = asciiLower(options.scalar), e = asciiLower(fs::path(options.scalar).extension().string());
-        if (s != "marschner-lobb" && s != "sphere" && s != "blobs" && e != ".nrrd" && e != ".nhdr")
+        if (s != "marschner-lobb" && s != "sphere" && s != "blobs" && s != "kernel" && e != ".nrrd" && e != ".nhdr")
             throw InputError("mesh scalar " + options.scalar +
-                             ": neither a generator (marschner-lobb, sphere, blobs) nor a .nrrd/.nhdr volume");
+                             ": neither a generator (marschner-lobb, sphere, blobs, kernel) nor a .nrrd/.nhdr volume");
     }
     const std::string ext = asciiLower(surface.extension().string());
     if (ext != ".poly" && ext != ".smesh" && ext != ".off" && ext != ".stl")

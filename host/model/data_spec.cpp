@@ -231,6 +231,29 @@ MeshSpec parseMeshSpec(const json& spec, const fs::path& baseDir)
         throw InputError("scene: \"mesh\" must be an object such as {\"file\": \"x.vtk\"}");
     if (spec.contains("surface"))
         return parseSurfaceSpec(spec, baseDir);
+    if (spec.contains("generator")) {
+        // {"generator": "automaton", "cells": N, "grid": G}: a mesh made in code (host/io/generators.h).
+        for (auto it = spec.begin(); it != spec.end(); ++it)
+            if (it.key() != "generator" && it.key() != "cells" && it.key() != "grid")
+                throw InputError("scene: mesh." + it.key() + " is not a key of a generated mesh (generator, cells, grid)");
+        MeshSpec m;
+        m.kind = MeshSpec::Kind::Generator;
+        if (!spec["generator"].is_string() || spec["generator"].get<std::string>() != "automaton")
+            throw InputError("scene: mesh.generator must be \"automaton\", got " + shown(spec["generator"].dump(), 40));
+        m.generator = "automaton";
+        const auto integer = [&](const char* key, int lo, int hi, int& out) {
+            if (!spec.contains(key))
+                return;
+            const json& v = spec[key];
+            if (!v.is_number_integer() || v.get<std::int64_t>() < lo || v.get<std::int64_t>() > hi)
+                throw InputError(std::string("scene: mesh.") + key + " must be an integer in [" + std::to_string(lo) +
+                                 ", " + std::to_string(hi) + "], got " + shown(v.dump(), 40));
+            out = static_cast<int>(v.get<std::int64_t>());
+        };
+        integer("cells", 1, 1 << 24, m.cells);
+        integer("grid", 1, 1024, m.grid);
+        return m;
+    }
     for (auto it = spec.begin(); it != spec.end(); ++it)
         if (it.key() != "file" && it.key() != "q_file" && it.key() != "scalar")
             throw InputError("scene: mesh." + it.key() + " is not a mesh key (file, q_file, scalar, or surface)");

@@ -40,7 +40,7 @@ struct VolumeSpec {
 
 // The scene's "mesh": a tetrahedral mesh file, a PLOT3D grid and solution, or a surface TetGen meshes.
 struct MeshSpec {
-    enum class Kind { File, Plot3d, Surface };
+    enum class Kind { File, Plot3d, Surface, Generator };
     Kind kind = Kind::File;
     std::filesystem::path file;   // File, Plot3d: the mesh (.node, .ele, .vtk, .off) or the PLOT3D grid
     std::filesystem::path qFile;  // Plot3d: the solution
@@ -51,6 +51,9 @@ struct MeshSpec {
     std::string scalar;
     double quality = 0.0;    // Surface: TetGen -q bound (> 0), 0: none
     double maxVolume = 0.0;  // Surface: TetGen -a bound (> 0), 0: none
+    std::string generator;   // Generator: "automaton" (host/io/generators.h)
+    int cells = 8000;        // Generator: living cells
+    int grid = 40;           // Generator: cells per axis of the lattice
     bool operator==(const MeshSpec&) const = default;
 };
 

@@ -287,6 +287,8 @@ Image4f TetsliceRenderer::render(FrameStats& stats)
     stats.extra["tets_rendered"] = cells;
     stats.extra["tets_degenerate"] = tetsDegenerate_;
     stats.extra["resident_bytes"] = residentBytes_;
+    // The mesh stays on the host; each slice's faces go to the device through the raster stage.
+    stats.extra["bytes_per_tet"] = static_cast<double>(residentBytes_) / static_cast<double>(cells);
     stats.extra["slices"] = plan.count;
     stats.extra["slice_spacing"] = plan.deltaS;
     stats.extra["cells_listed"] = lists.cellsListed();
