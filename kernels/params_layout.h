@@ -212,13 +212,6 @@ CLVR_LAYOUT_FIELD(ClTetsliceCompositeParams, delta_s)
 CLVR_LAYOUT_FIELD(ClTetsliceCompositeParams, pad1)
 CLVR_LAYOUT_FIELD(ClTetsliceCompositeParams, pad2)
 
-CLVR_LAYOUT_SIZE(ClTetsliceFinishParams)
-CLVR_LAYOUT_FIELD(ClTetsliceFinishParams, background)
-CLVR_LAYOUT_FIELD(ClTetsliceFinishParams, count)
-CLVR_LAYOUT_FIELD(ClTetsliceFinishParams, pad0)
-CLVR_LAYOUT_FIELD(ClTetsliceFinishParams, pad1)
-CLVR_LAYOUT_FIELD(ClTetsliceFinishParams, pad2)
-
 CLVR_LAYOUT_SIZE(ClTetisoUniforms)
 CLVR_LAYOUT_FIELD(ClTetisoUniforms, size)
 

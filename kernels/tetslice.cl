@@ -3,6 +3,7 @@
 // the back-face draw left, in the accumulation buffer, per pixel the nearest back face at or beyond the
 // slice; the front-face draw left, in the color buffer, the farthest front face at or before it. Both
 // are (scalar, cell id low 12 bits, cell id high bits, eye depth); id low < 0 where no face passed.
+// The last pass, I + (1 - A) background, is slice3d's (slice3d_over_background).
 #include "clvr_common.h"
 #include "ray.h"
 #include "transfer_function.h"
@@ -41,12 +42,4 @@ kernel void tetslice_composite(global float4* image, global const float4* front,
     const float a = 1.0f - exp(-ct.w * delta);
     const float4 c = image[i];
     image[i] = (float4)(ct.xyz * a, a) + (1.0f - a) * c;
-}
-
-kernel void tetslice_finish(global float4* image, const ClTetsliceFinishParams p)
-{
-    CLVR_GUARD_1D(p.count);
-    const size_t i = get_global_id(0);
-    const float4 c = image[i];
-    image[i] = (float4)(c.xyz + (1.0f - c.w) * p.background.xyz, c.w);
 }

@@ -17,11 +17,4 @@ typedef struct {
     cl_float pad1, pad2;
 } ClTetsliceCompositeParams; /* 112 bytes */
 
-/* The last pass: premultiplied (I, A) -> I + (1 - A) background, A (tetslice_finish). */
-typedef struct {
-    cl_float4 background;  /* w = 0 */
-    cl_int count;          /* pixels */
-    cl_int pad0, pad1, pad2;
-} ClTetsliceFinishParams;  /* 32 bytes */
-
 #endif

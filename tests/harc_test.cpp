@@ -26,6 +26,7 @@ namespace {
 using nlohmann::json;
 using test::Box;
 using test::boxMesh;
+using test::perspective;
 
 // Face adjacency by hand (sorted point triples), as buildTopology defines it.
 TetTopology handTopology(const TetMesh& mesh)
@@ -118,25 +119,9 @@ TransferFunction rampTf()
                              {1.0, {0.3, 0.2, 1.0}, 1.0}});
 }
 
-Camera perspective(glm::dvec3 position, glm::dvec3 focal = {0.5, 0.5, 0.5}, double angle = 35.0)
-{
-    Camera c;
-    c.position = position;
-    c.focalPoint = focal;
-    c.viewUp = {0.0, 1.0, 0.0};
-    c.viewAngle = angle;
-    return c;
-}
-
 Scene makeScene(const Camera& camera, const TransferFunction& tf, int size, json options = json::object())
 {
-    Scene s;
-    s.technique = "harc";
-    s.camera = camera;
-    s.image = ImageSpec{size, size, {0.1, 0.2, 0.3}};
-    s.transferFunction = tf;
-    s.options = std::move(options);
-    return s;
+    return test::meshScene("harc", camera, tf, size, std::move(options));
 }
 
 Image4f renderHarc(const Scene& scene, const TetMesh& mesh, FrameStats* statsOut = nullptr)

@@ -125,7 +125,6 @@ TEST(Layout, EveryParamsStructFitsTheKernelArgumentSpace)
         {"pixel_texture", sizeof(ClPixelTextureParams) + 2 * sizeof(void*)},
         {"accum", sizeof(ClAccumParams) + 2 * sizeof(void*)},
         {"tetslice_composite", sizeof(ClTetsliceCompositeParams) + 4 * sizeof(void*)},
-        {"tetslice_finish", sizeof(ClTetsliceFinishParams) + 1 * sizeof(void*)},
         {"tetiso_weights", sizeof(ClTetisoParams) + 3 * sizeof(void*)},
     };
     for (const auto& [kernel, bytes] : argumentBytes) {
@@ -141,7 +140,6 @@ TEST(Layout, EveryParamsStructFitsTheKernelArgumentSpace)
     EXPECT_EQ(sizeof(ClSphericalParams), 192u);
     EXPECT_EQ(sizeof(ClSlice3dOverBackgroundParams), 32u);
     EXPECT_EQ(sizeof(ClTetsliceCompositeParams), 112u);
-    EXPECT_EQ(sizeof(ClTetsliceFinishParams), 32u);
     EXPECT_EQ(sizeof(ClTetisoParams), 32u);
     EXPECT_EQ(sizeof(ClIso3dFinishParams), 48u);
     EXPECT_EQ(sizeof(ClStack2dIsoFinishParams), 32u);

@@ -78,15 +78,7 @@ TEST(TetisoGradients, ALinearFieldGivesItsGradientAtEveryVertex)
         EXPECT_LT(glm::length(v - g), 1e-12);
 }
 
-Camera perspective(glm::dvec3 position, glm::dvec3 focal, double angle)
-{
-    Camera c;
-    c.position = position;
-    c.focalPoint = focal;
-    c.viewUp = {0.0, 1.0, 0.0};
-    c.viewAngle = angle;
-    return c;
-}
+using test::perspective;
 
 // A cone field about `center` on a box grid: s = 1 - |x - center|, its iso-surface at s = iso the sphere
 // of radius 1 - iso; rays from outside enter below the iso-value and cross it upwards first (with
@@ -208,15 +200,12 @@ glm::dvec3 coneNormal(const glm::dvec3& p)
 
 Scene isoScene(const Camera& camera, int size, double iso, json options = json::object())
 {
-    Scene s;
-    s.technique = "tetiso";
-    s.camera = camera;
-    s.image = ImageSpec{size, size, {0.1, 0.2, 0.3}};
-    s.transferFunction = TransferFunction({{0.0, {1.0, 0.8, 0.6}, 1.0}, {1.0, {1.0, 0.8, 0.6}, 1.0}});
+    Scene s = test::meshScene("tetiso", camera,
+                              TransferFunction({{0.0, {1.0, 0.8, 0.6}, 1.0}, {1.0, {1.0, 0.8, 0.6}, 1.0}}), size,
+                              std::move(options));
     IsoSpec spec;
     spec.value = iso;
     s.iso = spec;
-    s.options = std::move(options);
     return s;
 }
 

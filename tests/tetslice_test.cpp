@@ -74,25 +74,11 @@ TEST(TetsliceActiveCells, EachSliceListsExactlyTheCellsItCuts)
     EXPECT_THROW(lists.next(), InternalError);
 }
 
-Camera perspective(glm::dvec3 position, glm::dvec3 focal, double angle)
-{
-    Camera c;
-    c.position = position;
-    c.focalPoint = focal;
-    c.viewUp = {0.0, 1.0, 0.0};
-    c.viewAngle = angle;
-    return c;
-}
+using test::perspective;
 
 Scene makeScene(const Camera& camera, const TransferFunction& tf, int size, json options = json::object())
 {
-    Scene s;
-    s.technique = "tetslice";
-    s.camera = camera;
-    s.image = ImageSpec{size, size, {0.1, 0.2, 0.3}};
-    s.transferFunction = tf;
-    s.options = std::move(options);
-    return s;
+    return test::meshScene("tetslice", camera, tf, size, std::move(options));
 }
 
 Image4f renderTetslice(const Scene& scene, const TetMesh& mesh, FrameStats* statsOut = nullptr)

@@ -1,12 +1,19 @@
-// tests/support/mesh_fixtures.h — tetrahedral meshes made in code for the mesh techniques' tests
-// (tests/harc_test.cpp, tests/tetslice_test.cpp): boxes of Kuhn-split cubes with a globally linear field,
-// whose exact integral tests/harc_test.cpp computes independently and host/reference/tet_reference.h too.
+// tests/support/mesh_fixtures.h — what the mesh techniques' tests share (tests/harc_test.cpp,
+// tests/tetslice_test.cpp, tests/tetiso_test.cpp): boxes of Kuhn-split cubes with a globally linear field
+// (whose exact integral tests/harc_test.cpp computes independently, host/reference/tet_reference.h too), a
+// perspective camera, and a scene for a mesh technique.
 #pragma once
 
+#include "host/model/camera.h"
 #include "host/model/mesh.h"
+#include "host/model/scene.h"
+#include "host/model/transfer_function.h"
 
 #include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
 
+#include <string>
+#include <utility>
 #include <vector>
 
 namespace clvr::test {
@@ -53,6 +60,30 @@ inline TetMesh boxMesh(const std::vector<Box>& boxes, const glm::dvec3& gradient
         mesh.scalars.push_back(glm::dot(gradient, p) + offset);
     mesh.tetsRead = mesh.tets.size();
     return mesh;
+}
+
+// A perspective camera with +y up.
+inline Camera perspective(glm::dvec3 position, glm::dvec3 focal = {0.5, 0.5, 0.5}, double angle = 35.0)
+{
+    Camera c;
+    c.position = position;
+    c.focalPoint = focal;
+    c.viewUp = {0.0, 1.0, 0.0};
+    c.viewAngle = angle;
+    return c;
+}
+
+// A size x size scene of `technique` with `camera`, `tf`, `options`, on the background (0.1, 0.2, 0.3).
+inline Scene meshScene(const std::string& technique, const Camera& camera, const TransferFunction& tf, int size,
+                       nlohmann::json options = nlohmann::json::object())
+{
+    Scene s;
+    s.technique = technique;
+    s.camera = camera;
+    s.image = ImageSpec{size, size, {0.1, 0.2, 0.3}};
+    s.transferFunction = tf;
+    s.options = std::move(options);
+    return s;
 }
 
 }  // namespace clvr::test

@@ -11,6 +11,7 @@
 #include "host/render/slice_plan.h"
 #include "host/render/transfer_function_upload.h"
 #include "host/runtime/errors.h"
+#include "kernels/slice3d_params.h"  // ClSlice3dOverBackgroundParams: the last pass is slice3d's
 #include "kernels/tetslice_params.h"
 #include "raster/framebuffer.h"
 #include "raster/pixel_transfer.h"
@@ -26,7 +27,6 @@
 namespace clvr {
 
 static_assert(sizeof(ClTetsliceCompositeParams) == 112, "also probed on the device by tests/layout_test.cpp");
-static_assert(sizeof(ClTetsliceFinishParams) == 32);
 
 // ---- active cell lists --------------------------------------------------------------------------------
 
@@ -150,7 +150,7 @@ TetsliceRenderer::TetsliceRenderer(Device& device, const Scene& scene, const Tet
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
     image_buffer_ = device_.buffer("tetslice image", pixels * sizeof(cl_float4));
     composite_ = device_.kernel("tetslice.cl", "tetslice_composite");
-    finish_ = device_.kernel("tetslice.cl", "tetslice_finish");
+    finish_ = device_.kernel("slice3d.cl", "slice3d_over_background");
     // Resident for the data: the transfer function. The mesh stays on the host; each slice's faces are
     // uploaded by the raster stage.
     residentBytes_ = tf_.bytes();
@@ -269,7 +269,7 @@ Image4f TetsliceRenderer::render(FrameStats& stats)
         device_.launch("tetslice: composite", composite_, image_.width, image_.height);
     }
 
-    ClTetsliceFinishParams finish{};
+    ClSlice3dOverBackgroundParams finish{};
     finish.background = toCl4(image_.background);
     finish.count = static_cast<cl_int>(pixels);
     finish_.setArg(0, image_buffer_);
