@@ -110,14 +110,7 @@ Image4d boxReference(const std::vector<Box>& boxes, const glm::dvec3& gradient, 
     return image;
 }
 
-TransferFunction rampTf()
-{
-    return TransferFunction({{0.0, {0.0, 0.0, 0.2}, 0.0},
-                             {0.3, {1.0, 0.5, 0.0}, 3.0},
-                             {0.55, {0.2, 1.0, 0.3}, 0.5},
-                             {0.8, {1.0, 1.0, 1.0}, 6.0},
-                             {1.0, {0.3, 0.2, 1.0}, 1.0}});
-}
+TransferFunction rampTf() { return test::rampTransferFunction(); }
 
 Scene makeScene(const Camera& camera, const TransferFunction& tf, int size, json options = json::object())
 {

@@ -5,6 +5,7 @@
 #include "host/optics/preintegration_table.h"
 
 #include "host/reference/tet_reference.h"
+#include "tests/support/mesh_fixtures.h"
 #include "tests/support/test_util.h"
 
 #include <gtest/gtest.h>
@@ -18,14 +19,7 @@ namespace {
 
 // Five control points with τ up to 6 per unit and color kinks: segments of length up to lMax = 1.5
 // reach optical depths near 9, α close to 1.
-TransferFunction rampTf()
-{
-    return TransferFunction({{0.0, {0.0, 0.0, 0.2}, 0.0},
-                             {0.3, {1.0, 0.5, 0.0}, 3.0},
-                             {0.55, {0.2, 1.0, 0.3}, 0.5},
-                             {0.8, {1.0, 1.0, 1.0}, 6.0},
-                             {1.0, {0.3, 0.2, 1.0}, 1.0}});
-}
+TransferFunction rampTf() { return test::rampTransferFunction(); }
 
 glm::dvec4 exactSegment(const TransferFunction& tf, double sF, double sB, double l)
 {

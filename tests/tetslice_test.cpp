@@ -131,14 +131,7 @@ void expectConvergence(const std::string& what, const TetMesh& mesh, const Scene
     EXPECT_LT(e.maxAbs, finalMax) << what;
 }
 
-TransferFunction rampTf()
-{
-    return TransferFunction({{0.0, {0.0, 0.0, 0.2}, 0.0},
-                             {0.3, {1.0, 0.5, 0.0}, 3.0},
-                             {0.55, {0.2, 1.0, 0.3}, 0.5},
-                             {0.8, {1.0, 1.0, 1.0}, 6.0},
-                             {1.0, {0.3, 0.2, 1.0}, 1.0}});
-}
+TransferFunction rampTf() { return test::rampTransferFunction(); }
 
 TEST(Tetslice, ConvexBoxGridConvergesToTheExactIntegral)
 {

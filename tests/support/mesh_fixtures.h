@@ -62,6 +62,17 @@ inline TetMesh boxMesh(const std::vector<Box>& boxes, const glm::dvec3& gradient
     return mesh;
 }
 
+// Five control points on [0, 1] with tau up to 6 per unit and color kinks (the harc, tetslice and
+// pre-integration tests' transfer function): segments of length 1.5 reach optical depths near 9.
+inline TransferFunction rampTransferFunction()
+{
+    return TransferFunction({{0.0, {0.0, 0.0, 0.2}, 0.0},
+                             {0.3, {1.0, 0.5, 0.0}, 3.0},
+                             {0.55, {0.2, 1.0, 0.3}, 0.5},
+                             {0.8, {1.0, 1.0, 1.0}, 6.0},
+                             {1.0, {0.3, 0.2, 1.0}, 1.0}});
+}
+
 // A perspective camera with +y up.
 inline Camera perspective(glm::dvec3 position, glm::dvec3 focal = {0.5, 0.5, 0.5}, double angle = 35.0)
 {
