@@ -112,6 +112,22 @@ TEST(Device, ChoiceByIndexNameAndBadSpec)
     EXPECT_EQ(clvr::chooseDevice(all[0].name.substr(0, 4)).name, all[0].name);
     EXPECT_THROW(clvr::chooseDevice("no-such-device-xyz"), clvr::DeviceError);
     EXPECT_THROW(clvr::chooseDevice("99"), clvr::DeviceError);
+    EXPECT_THROW(clvr::chooseDevice("99999999999999999999999"), clvr::DeviceError);  // no overflow
+    // A device type picks the first device of that type (case-insensitive), or names the type it lacks.
+    for (const char* type : {"cpu", "GPU", "accelerator"}) {
+        const std::string want = type == std::string("cpu") ? "CPU" : type == std::string("GPU") ? "GPU" : "accelerator";
+        const auto first = std::find_if(all.begin(), all.end(), [&](const auto& d) { return d.type == want; });
+        if (first != all.end()) {
+            EXPECT_EQ(clvr::chooseDevice(type).name, first->name) << type;
+        } else {
+            try {
+                clvr::chooseDevice(type);
+                ADD_FAILURE() << "no error for " << type;
+            } catch (const clvr::DeviceError& e) {
+                EXPECT_NE(std::string(e.what()).find("no OpenCL device of type"), std::string::npos) << e.what();
+            }
+        }
+    }
 }
 
 TEST(Device, OversizedBufferIsAClearDeviceError)

@@ -85,11 +85,22 @@ const Found& pick(const std::vector<Found>& found, const std::string& spec)
         return found.front();
     }
     if (std::all_of(rule.begin(), rule.end(), [](unsigned char c) { return std::isdigit(c); })) {
-        const unsigned long index = std::stoul(rule);
+        // At most 9 digits: no overflow, and no machine has a billion devices.
+        const unsigned long index = rule.size() <= 9 ? std::stoul(rule) : ~0ul;
         if (index >= found.size())
-            throw DeviceError(source + " " + rule + ": there are only " + std::to_string(found.size()) +
-                              " OpenCL devices (see clvr info)");
+            throw DeviceError(source + " " + rule + ": " +
+                              (found.size() == 1 ? std::string("there is only 1 OpenCL device")
+                                                 : "there are only " + std::to_string(found.size()) + " OpenCL devices") +
+                              ", numbered from 0 (see clvr info)");
         return found[index];
+    }
+    // A device type: the first device of that type.
+    const std::string lower = asciiLower(rule);
+    if (lower == "cpu" || lower == "gpu" || lower == "accelerator") {
+        for (const Found& f : found)
+            if (asciiLower(f.listing.type) == lower)
+                return f;
+        throw DeviceError(source + " " + rule + ": no OpenCL device of type " + lower + " (see clvr info)");
     }
     for (const Found& f : found)
         if (asciiLower(f.listing.name).find(asciiLower(rule)) != std::string::npos ||
