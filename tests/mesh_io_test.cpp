@@ -377,7 +377,7 @@ TEST(MeshIo, MalformedVtk)
     edited("SCALARS scalars double 1\n", "VECTORS v double\n");
     expectError([&] { clvr::readVtkUnstructured(dir / "t.vtk"); }, "", "t.vtk");
     writeFile(dir / "t.vtk", "hello\n");
-    expectError([&] { clvr::readVtkUnstructured(dir / "t.vtk"); }, "not a VTK legacy file", "t.vtk");
+    expectError([&] { clvr::readVtkUnstructured(dir / "t.vtk"); }, "expected \"# vtk DataFile Version x.y\"", "t.vtk");
 }
 
 TEST(MeshIo, MalformedPlot3d)

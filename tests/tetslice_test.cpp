@@ -246,3 +246,23 @@ TEST(TetsliceMeshes, TetgenTorusThroughItsHoleConverges)
 
 }  // namespace
 }  // namespace clvr
+
+namespace clvr {
+namespace {
+
+// Inverted cells are reoriented by checkMesh and counted in --stats (tets_reoriented), degenerate ones too.
+TEST(Tetslice, StatsCountReorientedAndDegenerateCells)
+{
+    TetMesh mesh = test::boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, 2}}, {0.6, 0.25, -0.4}, 0.35);
+    checkMesh(mesh);  // the Kuhn split orients half the cells negatively
+    ASSERT_GT(mesh.tetsReoriented, 0u);
+    auto renderer = makeTetsliceRenderer(test::device(), makeScene(test::perspective({1.9, 1.4, 2.6}), rampTf(), 16,
+                                                                   json{{"slices", 8}}), mesh);
+    FrameStats stats;
+    renderer->render(stats);
+    EXPECT_EQ(stats.extra["tets_reoriented"].get<std::uint64_t>(), mesh.tetsReoriented);
+    EXPECT_EQ(stats.extra["tets_degenerate"].get<std::uint64_t>(), mesh.tetsDegenerate);
+}
+
+}  // namespace
+}  // namespace clvr

@@ -435,7 +435,8 @@ TetMesh readVtkUnstructured(const fs::path& path, const std::string& scalar)
     VtkReader in(path);
     const std::string first = in.rawLine();
     if (first.rfind("# vtk DataFile Version", 0) != 0)
-        throw InputError(in.file() + ": not a VTK legacy file (the first line is " + shown(first) + ")");
+        throw InputError(in.file() + ": not a VTK legacy file (the first line is " + shown(first) +
+                         ", expected \"# vtk DataFile Version x.y\")");
     int major = 0;
     std::sscanf(first.c_str() + 22, "%d", &major);
     in.rawLine();  // title
