@@ -134,6 +134,35 @@ TEST(SurfaceIo, BadFilesAreInputErrorsNamingTheLine)
     }
 }
 
+// Two closed tetrahedra that overlap (issue 15: TetGen's mesher segfaulted on them) and an open surface:
+// one InputError each, before or instead of meshing.
+TEST(SurfaceIo, SelfIntersectingAndOpenSurfacesAreInputErrors)
+{
+    test::TempDir dir;
+    const std::string tet = "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+    test::writeFile(dir / "crossing.off", "OFF\n8 8 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n"
+                                          "0.2 0.2 0.2\n1.2 0.2 0.2\n0.2 1.2 0.2\n0.2 0.2 1.2\n" + tet +
+                                          "3 4 6 5\n3 4 5 7\n3 4 7 6\n3 5 6 7\n");
+    test::writeFile(dir / "open.off", "OFF\n4 3 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n");
+    test::writeFile(dir / "apart.off", "OFF\n8 8 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n"
+                                       "3 3 3\n4 3 3\n3 4 3\n3 3 4\n" + tet +
+                                       "3 4 6 5\n3 4 5 7\n3 4 7 6\n3 5 6 7\n");
+    const std::pair<const char*, const char*> cases[] = {
+        {"crossing.off", "the surface intersects itself"},
+        {"open.off", "TetGen made no tetrahedra"},
+    };
+    for (const auto& [file, message] : cases) {
+        try {
+            meshSurface(dir / file, MesherOptions{});
+            ADD_FAILURE() << file << ": no InputError";
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+        }
+    }
+    // The same two tetrahedra apart are a valid (two-part) surface.
+    EXPECT_GE(meshSurface(dir / "apart.off", MesherOptions{}).tets.size(), 2u);
+}
+
 TEST(SurfaceIo, MeshingPrintsNothingAndMatchesTetgensOwnReader)
 {
     const std::filesystem::path torus = test::repoData("surfaces/torus.off");

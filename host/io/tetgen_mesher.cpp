@@ -175,6 +175,21 @@ TetMesh meshSurface(const fs::path& surface, const MesherOptions& options)
     if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z))
         throw InputError(surface.string() + ": the surface is flat (its bounding box has zero extent), not closed");
 
+    // A surface that intersects itself crashes TetGen's mesher (a segfault inside tetrahedralize, not an
+    // error code). TetGen's own check ("d": detect intersecting facets, no meshing) reports such facets
+    // without crashing: refuse the surface when it finds any.
+    {
+        tetgenio check;
+        auto detect = cString("pdQz");
+        try {
+            tetrahedralize(detect.data(), &in, &check);
+        } catch (int code) {
+            throw InputError(surface.string() + ": TetGen failed checking the surface: " + tetgenError(code));
+        }
+        if (check.numberoftrifaces > 0)
+            throw InputError(surface.string() + ": the surface intersects itself (" + std::to_string(check.numberoftrifaces) +
+                             " facets cross others): TetGen needs a closed surface without self-intersections");
+    }
     auto switches = cString(tetgenSwitches(options));
     try {
         tetrahedralize(switches.data(), &in, &out);
