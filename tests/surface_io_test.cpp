@@ -163,6 +163,24 @@ TEST(SurfaceIo, SelfIntersectingAndOpenSurfacesAreInputErrors)
     EXPECT_GE(meshSurface(dir / "apart.off", MesherOptions{}).tets.size(), 2u);
 }
 
+// A scalar volume the mesh lies entirely outside of gives an error, not a constant border value.
+TEST(SurfaceIo, ScalarVolumeMissingTheMeshIsAnInputError)
+{
+    test::TempDir dir;
+    test::writeFile(dir / "far.nrrd", std::string("NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nspace dimension: 3\n"
+                                                  "space origin: (100,100,100)\nencoding: raw\n\n") +
+                                          std::string("\x01\x02\x03\x04\x05\x06\x07\x08", 8));
+    MesherOptions options;
+    options.scalar = (dir / "far.nrrd").string();
+    try {
+        meshSurface(test::repoData("surfaces/torus.off"), options);
+        ADD_FAILURE() << "no InputError";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("no point of the mesh lies inside the volume's bounds"), std::string::npos)
+            << e.what();
+    }
+}
+
 TEST(SurfaceIo, MeshingPrintsNothingAndMatchesTetgensOwnReader)
 {
     const std::filesystem::path torus = test::repoData("surfaces/torus.off");

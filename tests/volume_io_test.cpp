@@ -4,6 +4,7 @@
 // giving a one-line InputError that names the file. Files are written to a temporary directory.
 #include "host/runtime/errors.h"
 #include "host/io/volume_io.h"
+#include "host/io/generators.h"
 #include "tests/support/test_util.h"
 
 #include <gtest/gtest.h>
@@ -630,6 +631,20 @@ TEST(VolumeIo, NrrdDataTooShortSaysBothSizes)
     EXPECT_TRUE(throwsInputError([&] { clvr::readNrrd(dir / "l.nrrd"); }, {"l.nrrd", "value 2", "not a number"}));
 }
 
+// A header that claims a huge volume over a few bytes of data is a short file, said before any memory
+// bound (issue 15: it was reported as needing 30517 MiB).
+TEST(VolumeIo, NrrdHugeHeaderOverAShortFileIsAShortFile)
+{
+    TempDir dir;
+    const std::string header = "NRRD0004\ntype: float\ndimension: 3\nsizes: 2000 2000 2000\nendian: little\nencoding: ";
+    writeFile(dir / "raw.nrrd", header + "raw\n\n" + std::string(64, '\0'));
+    EXPECT_TRUE(throwsInputError([&] { clvr::readNrrd(dir / "raw.nrrd"); },
+                                 {"raw.nrrd", "= 32000000000 bytes, file has 64 bytes"}));
+    writeFile(dir / "gz.nrrd", header + "gzip\n\n" + std::string(64, '\0'));
+    EXPECT_TRUE(throwsInputError([&] { clvr::readNrrd(dir / "gz.nrrd"); },
+                                 {"gz.nrrd", "gzip data is truncated: header says", "64 compressed bytes cannot hold that many"}));
+}
+
 TEST(VolumeIo, NrrdGzipTruncatedOrCorrupt)
 {
     TempDir dir;
@@ -656,10 +671,13 @@ TEST(VolumeIo, NrrdGzipTruncatedOrCorrupt)
     writeFile(dir / "huge.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 512 512 512\nendian: little\n"
                                  "encoding: gzip\n\n" + z);
     EXPECT_TRUE(throwsInputError([&] { clvr::readNrrd(dir / "huge.nrrd"); }, {"huge.nrrd", "truncated"}));
-    // ... and one larger than half the machine's memory by the host-memory check.
+    // ... and one larger than half the machine's memory too: the short data is said first (the host-memory
+    // bound applies once the data could be there; the generator below reaches it).
     writeFile(dir / "huger.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 4096 2048 1024\nendian: little\n"
                                   "encoding: gzip\n\n" + z);
-    EXPECT_TRUE(throwsInputError([&] { clvr::readNrrd(dir / "huger.nrrd"); }, {"huger.nrrd", "MiB of memory"}));
+    EXPECT_TRUE(throwsInputError([&] { clvr::readNrrd(dir / "huger.nrrd"); }, {"huger.nrrd", "truncated"}));
+    EXPECT_TRUE(throwsInputError([&] { clvr::generateVolume("sphere", {4096, 2048, 1024}); },
+                                 {"generator sphere", "MiB of memory"}));
 }
 
 TEST(VolumeIo, NanAndInfinityInFloatData)

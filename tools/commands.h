@@ -10,6 +10,10 @@ namespace clvr::tools {
 // errors (InputError, DeviceError, BuildError) for main() to report.
 int run(int argc, char** argv);
 
+// InputError unless `path` names a file in an existing, writable directory ("PATH: directory D does not
+// exist", ...); `what` names the option in the message. Every command checks its outputs before working.
+void checkWritable(const std::string& path, const std::string& what);
+
 // `clvr render` (docs/cli.md).
 struct RenderOptions {
     std::string scene;                   // scene file; empty or "default": the embedded default scene

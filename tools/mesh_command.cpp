@@ -4,6 +4,7 @@
 #include "host/runtime/errors.h"
 #include "host/io/mesh_io.h"
 #include "host/io/tetgen_mesher.h"
+#include "tools/commands.h"
 
 #include <CLI/CLI.hpp>
 
@@ -40,7 +41,7 @@ CLI::App* addMeshCommand(CLI::App& app)
         ->check(CLI::NonNegativeNumber)
         ->capture_default_str();
     mesh->add_option("--scalar", o.mesher.scalar,
-                     "point scalar: a generator (marschner-lobb, sphere, blobs) evaluated at each point, or a "
+                     "point scalar: a generator (marschner-lobb, sphere, blobs, kernel) evaluated at each point, or a "
                      ".nrrd/.nhdr volume sampled there")
         ->capture_default_str();
     return mesh;
@@ -49,12 +50,17 @@ CLI::App* addMeshCommand(CLI::App& app)
 int runMeshCommand()
 {
     const MeshCommandOptions& o = meshOptions();
+    for (const char* ext : {".node", ".ele", ".neigh"})
+        checkWritable(o.base + ext, "-o");  // before meshing, as clvr render checks before rendering
     const TetMesh mesh = meshSurface(o.surface, o.mesher);
     writeTetgen(mesh, o.base);
     const glm::dvec2 range = mesh.scalarRange();
     std::cout << "wrote " << o.base << ".node and " << o.base << ".ele: " << mesh.points.size() << " points, "
               << mesh.tets.size() << " tetrahedra (TetGen -" << tetgenSwitches(o.mesher) << "), scalar " << range.x
               << ".." << range.y << "\n";
+    if (range.x == range.y)  // e.g. a surface in the empty corner of a volume: not an error, but say it
+        std::cerr << "clvr: note: the scalar is " << range.x
+                  << " at every point of the mesh (is the surface where the scalar varies?)\n";
     return 0;
 }
 

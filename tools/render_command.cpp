@@ -49,23 +49,6 @@ std::string lowerExtension(const fs::path& p)
     return ext;
 }
 
-// The folder `path` will be written into must exist and be writable; checked before any rendering.
-void checkWritable(const std::string& path, const std::string& what)
-{
-    if (path.empty())
-        throw InputError(what + " path is empty");
-    const fs::path p(path);
-    if (p.filename().empty() || p.filename() == "." || p.filename() == "..")
-        throw InputError(path + ": " + what + " path names a directory, not a file");
-    const fs::path dir = p.parent_path().empty() ? fs::path(".") : p.parent_path();
-    std::error_code ec;
-    if (!fs::is_directory(dir, ec))
-        throw InputError(path + ": directory " + dir.string() + " does not exist");
-    if (::access(dir.c_str(), W_OK) != 0)
-        throw InputError(path + ": directory " + dir.string() + " is not writable");
-    if (fs::is_directory(p, ec))
-        throw InputError(path + ": is a directory");
-}
 
 // Writes `text` to `path` through a temporary file in the same folder, renamed into place.
 void writeFileAtomically(const std::string& path, const std::string& text)
@@ -282,6 +265,23 @@ int render(const RenderOptions& options)
          << steady.frameMs << " ms/frame)";
     std::cout << line.str() << std::endl;
     return 0;
+}
+
+void checkWritable(const std::string& path, const std::string& what)
+{
+    if (path.empty())
+        throw InputError(what + " path is empty");
+    const fs::path p(path);
+    if (p.filename().empty() || p.filename() == "." || p.filename() == "..")
+        throw InputError(path + ": " + what + " path names a directory, not a file");
+    const fs::path dir = p.parent_path().empty() ? fs::path(".") : p.parent_path();
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec))
+        throw InputError(path + ": directory " + dir.string() + " does not exist");
+    if (::access(dir.c_str(), W_OK) != 0)
+        throw InputError(path + ": directory " + dir.string() + " is not writable");
+    if (fs::is_directory(p, ec))
+        throw InputError(path + ": is a directory");
 }
 
 }  // namespace clvr::tools

@@ -57,7 +57,11 @@ void writeImage(const std::string& path, const Image4f& image)
     std::error_code ec;
     if (!ok) {
         std::filesystem::remove(tmp, ec);
-        throw InputError(path + ": cannot write image: " + (error.empty() ? "write failed" : error));
+        // The writer names the temporary file; the user named `path`.
+        std::string said = error.empty() ? "write failed" : error;
+        for (std::size_t at; (at = said.find(tmp.string())) != std::string::npos;)
+            said.replace(at, tmp.string().size(), path);
+        throw InputError(path + ": cannot write image: " + said);
     }
     std::filesystem::rename(tmp, target, ec);
     if (ec) {

@@ -138,8 +138,19 @@ void assignScalar(TetMesh& mesh, const std::string& scalar)
                          ": neither a generator (marschner-lobb, sphere, blobs, kernel) nor a .nrrd/.nhdr volume");
     const Volume volume = readNrrd(scalar);
     const glm::dvec3 lo = volume.boundsMin(), hi = volume.boundsMax();
-    for (std::size_t i = 0; i < mesh.points.size(); ++i)
-        mesh.scalars[i] = volume.sample(glm::clamp(mesh.points[i], lo, hi)).value_or(0.0);
+    std::size_t inside = 0;
+    for (std::size_t i = 0; i < mesh.points.size(); ++i) {
+        const glm::dvec3& p = mesh.points[i];
+        inside += glm::all(glm::greaterThanEqual(p, lo)) && glm::all(glm::lessThanEqual(p, hi)) ? 1 : 0;
+        mesh.scalars[i] = volume.sample(glm::clamp(p, lo, hi)).value_or(0.0);
+    }
+    // Clamping suits a surface that pokes out a little; one entirely outside would only repeat the
+    // volume's border values: say so instead of rendering a constant.
+    if (inside == 0)
+        throw InputError("mesh scalar " + scalar + ": no point of the mesh lies inside the volume's bounds (" +
+                         std::to_string(lo.x) + ", " + std::to_string(lo.y) + ", " + std::to_string(lo.z) + ") .. (" +
+                         std::to_string(hi.x) + ", " + std::to_string(hi.y) + ", " + std::to_string(hi.z) +
+                         "): move or scale the surface into the volume");
 }
 
 TetMesh meshSurface(const fs::path& surface, const MesherOptions& options)

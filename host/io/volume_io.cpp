@@ -117,7 +117,9 @@ std::string dimsText(const std::vector<long long>& sizes)
 // Sizes and files.
 
 // The grid point count, or InputError: every size must be a positive int and the product at most kMaxVoxels.
-std::uint64_t checkedVoxelCount(const std::string& source, const std::vector<long long>& sizes)
+// `checkMemory`: also InputError when the volume would take more than half of the machine's memory; a
+// reader that can first check the file holds the data (NRRD) passes false and checks memory after that.
+std::uint64_t checkedVoxelCount(const std::string& source, const std::vector<long long>& sizes, bool checkMemory = true)
 {
     std::uint64_t count = 1;
     bool overflow = false;
@@ -134,7 +136,8 @@ std::uint64_t checkedVoxelCount(const std::string& source, const std::vector<lon
         throw InputError(source + ": " + dimsText(sizes) + " is too large (" +
                          (overflow ? std::string("the product overflows") : std::to_string(count) + " grid points") +
                          ", the limit is 2^34)");
-    checkHostMemoryForVoxels(source, count);
+    if (checkMemory)
+        checkHostMemoryForVoxels(source, count);
     return count;
 }
 
@@ -656,6 +659,7 @@ void readNrrdData(const NrrdHeader& h, const fs::path& file, std::uint64_t start
         const std::uint64_t available = size > pos ? size - pos : 0;
         if (available < bytes)
             throw tooShort(available);
+        checkHostMemoryForVoxels(source, first + count);
         std::vector<unsigned char> raw(static_cast<std::size_t>(bytes));
         readExactly(in, file, pos, reinterpret_cast<char*>(raw.data()), bytes);
         out.resize(static_cast<std::size_t>(first + count));
@@ -670,8 +674,9 @@ void readNrrdData(const NrrdHeader& h, const fs::path& file, std::uint64_t start
     // gzip and ascii: the rest of the file, whole.
     const std::uint64_t rest = size > pos ? size - pos : 0;
     if (*h.encoding == NrrdEncoding::Gzip && !gzipCanHold(rest, bytes + skip))
-        throw InputError(source + ": gzip data is truncated (" + std::to_string(rest) +
-                         " compressed bytes cannot hold " + sizeText + ")");
+        throw InputError(source + ": gzip data is truncated: " + sizeText + ", and " + std::to_string(rest) +
+                         " compressed bytes cannot hold that many");
+    checkHostMemoryForVoxels(source, first + count);
     std::vector<unsigned char> data(static_cast<std::size_t>(rest));
     if (rest)
         readExactly(in, file, pos, reinterpret_cast<char*>(data.data()), rest);
@@ -765,7 +770,8 @@ Volume readNrrd(const fs::path& path)
     if (static_cast<long long>(h.sizes->size()) != dim)
         throw InputError(source + ": sizes has " + std::to_string(h.sizes->size()) + " entries for dimension " +
                          std::to_string(dim));
-    const std::uint64_t count = checkedVoxelCount(source, *h.sizes);
+    // Memory is checked once the data is known to be there (readNrrdData): a short file says so first.
+    const std::uint64_t count = checkedVoxelCount(source, *h.sizes, false);
     // Dimension 4 is read only as one scalar per grid point with an explicit first axis of size 1.
     const std::size_t skipAxes = dim == 4 ? 1 : 0;
     if (dim == 4 && (*h.sizes)[0] != 1)
@@ -827,8 +833,6 @@ Volume readNrrd(const fs::path& path)
     const std::string sizes = dimsText(*h.sizes) + " x " + std::to_string(elem) + " bytes";
     if (h.dataFiles.empty()) {
         const std::string sizeText = "header says " + sizes + " = " + std::to_string(count * elem) + " bytes";
-        if (*h.encoding == NrrdEncoding::Raw)
-            v.values.reserve(static_cast<std::size_t>(count));  // the size is checked before values are read
         readNrrdData(h, path, h.dataOffset, count, v.values, v.dims, sizeText);
     } else {
         // Several files share the samples equally, in order (slices of the slowest axis, usually).
@@ -850,8 +854,10 @@ Volume readNrrd(const fs::path& path)
             plausible = !ec && (*h.encoding == NrrdEncoding::Raw ? fileBytes >= per * elem
                                                                   : gzipCanHold(fileBytes, per * elem));
         }
-        if (plausible)
+        if (plausible) {
+            checkHostMemoryForVoxels(source, count);
             v.values.reserve(static_cast<std::size_t>(count));
+        }
         for (std::uint64_t f = 0; f < files; ++f)
             readNrrdData(h, h.dataFiles[f], 0, per, v.values, v.dims, sizeText);
     }
