@@ -104,7 +104,7 @@ inline int reflectanceMapSizeOption(const nlohmann::json& value)
 // Their registry entries, each with the default of the technique that lists it.
 inline OptionInfo slicesInfo(int slices = 256)
 {
-    return {"slices", slices, "", "view-aligned slices across the volume's eye-depth range"};
+    return {"slices", slices, "", "view-aligned slices across the data's eye-depth range"};
 }
 inline OptionInfo sliceSpacingInfo()
 {
