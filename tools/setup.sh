@@ -63,5 +63,7 @@ if [ "${CLVR_SKIP_ASAN:-0}" != 1 ]; then
     export LSAN_OPTIONS="suppressions=$PWD/tests/lsan.supp:print_suppressions=0:intercept_tls_get_addr=0"
     export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
     export POCL_CACHE_DIR="$PWD/build/pocl-cache"
-    ctest --test-dir build-asan --output-on-failure -j "$jobs" --timeout 900
+    # TetsliceMeshes.* (tetslice on bluntfin, the post and the torus at up to 1,024 slices) run in the
+    # release pass only: under ASan they take a minute for host code the Tetslice.* box-grid tests run too.
+    ctest --test-dir build-asan --output-on-failure -j "$jobs" --timeout 900 -E '^TetsliceMeshes\.'
 fi

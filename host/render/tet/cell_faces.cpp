@@ -53,6 +53,7 @@ void CellFaces::appendFaces(const std::vector<std::uint32_t>& cells, const std::
                             bool back, const std::vector<raster::Vertex>& pointVertex, unsigned idAttributes,
                             std::vector<raster::Vertex>& out) const
 {
+    out.reserve(out.size() + 6 * cells.size());  // a cell has about two back and two front faces: 6 vertices
     for (const std::uint32_t c : cells) {
         const float idLo = static_cast<float>(c & 0xfffu), idHi = static_cast<float>(c >> 12);
         for (int i = 0; i < 4; ++i) {
