@@ -54,6 +54,26 @@ void finishFrame(Device& device, const FrameClock& clock, FrameStats& stats, std
     stats.frameMs = clock.ms();
 }
 
+MeshCounts MeshCounts::of(const TetMesh& mesh)
+{
+    MeshCounts c;
+    c.points = mesh.points.size();
+    c.read = mesh.tetsRead ? mesh.tetsRead : mesh.tets.size();
+    c.rendered = mesh.tets.size();
+    c.degenerate = mesh.tetsDegenerate;
+    c.reoriented = mesh.tetsReoriented;
+    return c;
+}
+
+void MeshCounts::report(FrameStats& stats) const
+{
+    stats.extra["points"] = points;
+    stats.extra["tets"] = read;
+    stats.extra["tets_rendered"] = rendered;
+    stats.extra["tets_degenerate"] = degenerate;
+    stats.extra["tets_reoriented"] = reoriented;
+}
+
 std::size_t mergePassesByName(std::vector<PassTime>& passes)
 {
     const std::size_t count = passes.size();

@@ -8,6 +8,7 @@
 
 #include "host/model/camera.h"
 #include "host/model/image.h"
+#include "host/model/mesh.h"
 #include "host/model/scene.h"
 #include "host/model/volume.h"
 #include "host/render/renderer.h"
@@ -53,6 +54,15 @@ std::uint64_t sumCounts(Device& device, const cl::Buffer& buffer, std::size_t co
 // Ends a frame's bookkeeping: stats.passes becomes `hostPasses` (timed by the renderer itself, e.g. host
 // stages) followed by the device's pass times since the last frame, and stats.frameMs the frame's wall time.
 void finishFrame(Device& device, const FrameClock& clock, FrameStats& stats, std::vector<PassTime> hostPasses = {});
+
+// What a mesh technique reports of its mesh in --stats (docs/cli.md): points, tets (as read or split),
+// tets_rendered, tets_degenerate (zero-volume cells checkMesh dropped), tets_reoriented (inverted cells
+// whose vertex order it fixed). Taken at set-up, since a renderer outlives the caller's mesh.
+struct MeshCounts {
+    std::uint64_t points = 0, read = 0, rendered = 0, degenerate = 0, reoriented = 0;
+    static MeshCounts of(const TetMesh& mesh);
+    void report(FrameStats& stats) const;
+};
 
 // Sums the pass times of equal names into one entry each, in the order each name first appears: for a
 // technique with launches per slice, so that --stats lists a handful of passes instead of thousands.

@@ -62,7 +62,7 @@ private:
     cl::Kernel kernel_;
     std::unique_ptr<HarcRasterEntries> rasterEntries_;  // options_.entry == Raster
     std::uint64_t residentBytes_ = 0;
-    std::uint64_t pointCount_ = 0, tetCount_ = 0, tetsRead_ = 0, tetsDegenerate_ = 0, tetsReoriented_ = 0;
+    MeshCounts counts_;
     // Full pre-integration (options_.integration == Full): the table on the device, its s range (the
     // hull of the transfer function's and the mesh's), its l range and the last build's time.
     cl::Buffer full_;
@@ -88,14 +88,10 @@ HarcRenderer::HarcRenderer(Device& device, const Scene& scene, const TetMesh& me
     shift_ = 0.5 * (lo + hi);
     camera_ = frameCamera(scene, lo, hi);
 
-    tetCount_ = mesh.tets.size();
-    pointCount_ = mesh.points.size();
-    tetsRead_ = mesh.tetsRead ? mesh.tetsRead : mesh.tets.size();
-    tetsDegenerate_ = mesh.tetsDegenerate;
-    tetsReoriented_ = mesh.tetsReoriented;
+    counts_ = MeshCounts::of(mesh);
     maxSteps_ = options_.maxSteps
                     ? options_.maxSteps
-                    : static_cast<std::uint64_t>(4.0 * std::cbrt(static_cast<double>(tetCount_))) + 10000;
+                    : static_cast<std::uint64_t>(4.0 * std::cbrt(static_cast<double>(counts_.rendered))) + 10000;
 
     const std::vector<cl_float4> tets = packHarcTets(mesh, topology, shift_);
     tets_ = device_.upload("harc tetrahedra (80 bytes each)", tets);
@@ -219,12 +215,8 @@ Image4f HarcRenderer::render(FrameStats& stats)
         hostPasses.push_back({"harc: entry lists (host)", entryMs});
     }
     finishFrame(device_, clock, stats, std::move(hostPasses));
-    stats.extra["points"] = pointCount_;
-    stats.extra["tets"] = tetsRead_;
-    stats.extra["tets_rendered"] = tetCount_;
-    stats.extra["tets_degenerate"] = tetsDegenerate_;
-    stats.extra["tets_reoriented"] = tetsReoriented_;  // inverted cells whose vertex order checkMesh fixed
-    stats.extra["bytes_per_tet"] = static_cast<double>(residentBytes_) / static_cast<double>(tetCount_);
+    counts_.report(stats);
+    stats.extra["bytes_per_tet"] = static_cast<double>(residentBytes_) / static_cast<double>(counts_.rendered);
     stats.extra["tet_layout_bytes"] = kHarcBytesPerTet;
     stats.extra["resident_bytes"] = residentBytes_;
     stats.extra["psi_table"] = std::to_string(psiTable().size) + "x" + std::to_string(psiTable().size);

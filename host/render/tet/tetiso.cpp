@@ -173,7 +173,7 @@ private:
     std::uint64_t candidates_ = 0;          // the cells of its interval's bit-stream
     std::uint64_t streamBytes_ = 0;
     int emptyIntervals_ = 0;
-    std::uint64_t tetsRead_ = 0, tetsDegenerate_ = 0, tetsReoriented_ = 0;
+    MeshCounts counts_;
     raster::Rasterizer rasterizer_;
     raster::Framebuffer fb_;
     // Per direction of the crossing (0 upwards, 1 downwards): the kept back-face image, the cell-id test
@@ -200,9 +200,7 @@ Tetiso::Tetiso(Device& device, const Scene& scene, const TetMesh& mesh)
     camera_ = frameCamera(scene, lo, hi);
     camera_.position -= shift_;
     camera_.focalPoint -= shift_;
-    tetsRead_ = mesh.tetsRead ? mesh.tetsRead : mesh.tets.size();
-    tetsDegenerate_ = mesh.tetsDegenerate;
-    tetsReoriented_ = mesh.tetsReoriented;
+    counts_ = MeshCounts::of(mesh);
 
     // All scalar values scaled to [0, 1] (§4.3; GL clamps the alpha-test reference to [0, 1]).
     const glm::dvec2 range = mesh.scalarRange();
@@ -380,11 +378,7 @@ Image4f Tetiso::render(FrameStats& stats)
     const raster::DrawStats drawn = rasterizer_.takeStats();
 
     finishFrame(device_, clock, stats, {{"tetiso: vertex colors, facing, face lists (host)", setUpMs}});
-    stats.extra["points"] = points.size();
-    stats.extra["tets"] = tetsRead_;
-    stats.extra["tets_rendered"] = cells_.cellCount();
-    stats.extra["tets_degenerate"] = tetsDegenerate_;
-    stats.extra["tets_reoriented"] = tetsReoriented_;  // inverted cells whose vertex order checkMesh fixed
+    counts_.report(stats);
     stats.extra["iso_value"] = iso_.value;
     stats.extra["weights"] = options_.weights == TetisoOptions::Weights::Equal ? "equal" : "interpolated";
     stats.extra["intervals"] = options_.intervals;

@@ -121,7 +121,7 @@ private:
     glm::dvec3 shift_{0.0}, lo_{0.0}, hi_{0.0};  // lo_, hi_: the mesh box, shifted
     CellFaces cells_;
     std::vector<float> scalars_;
-    std::uint64_t tetsRead_ = 0, tetsDegenerate_ = 0, tetsReoriented_ = 0;
+    MeshCounts counts_;
     TransferFunctionUpload tf_;
     raster::Rasterizer rasterizer_;
     raster::Framebuffer fb_;
@@ -141,9 +141,7 @@ TetsliceRenderer::TetsliceRenderer(Device& device, const Scene& scene, const Tet
     camera_ = frameCamera(scene, lo, hi);
     camera_.position -= shift_;
     camera_.focalPoint -= shift_;
-    tetsRead_ = mesh.tetsRead ? mesh.tetsRead : mesh.tets.size();
-    tetsDegenerate_ = mesh.tetsDegenerate;
-    tetsReoriented_ = mesh.tetsReoriented;
+    counts_ = MeshCounts::of(mesh);
 
     scalars_.assign(mesh.scalars.begin(), mesh.scalars.end());
 
@@ -283,11 +281,7 @@ Image4f TetsliceRenderer::render(FrameStats& stats)
                 {{"tetslice: eye depths, facing, active cell lists (host)", setUpMs},
                  {"tetslice: face vertices of the active cells (host)", buildMs}});
     stats.extra["launches"] = mergePassesByName(stats.passes) - 2;  // per pass name: its launches summed
-    stats.extra["points"] = points.size();
-    stats.extra["tets"] = tetsRead_;
-    stats.extra["tets_rendered"] = cells;
-    stats.extra["tets_degenerate"] = tetsDegenerate_;
-    stats.extra["tets_reoriented"] = tetsReoriented_;  // inverted cells whose vertex order checkMesh fixed
+    counts_.report(stats);
     stats.extra["resident_bytes"] = residentBytes_;
     // The mesh stays on the host; each slice's faces go to the device through the raster stage.
     stats.extra["bytes_per_tet"] = static_cast<double>(residentBytes_) / static_cast<double>(cells);
