@@ -144,6 +144,8 @@ Comparison compare(const Scene& scene, const TetMesh& mesh, glm::dvec3 (*normal)
     FrameStats stats;
     const Image4f image = renderer->render(stats);
     const std::vector<double> z = renderer->hitDepth();
+    EXPECT_EQ(stats.extra["pixels_hit"].get<std::size_t>(),
+              static_cast<std::size_t>(std::count_if(z.begin(), z.end(), [](double v) { return std::isfinite(v); })));
     const int size = scene.image.width;
     const IsoReference ref = isoReference(mesh, *scene.camera, size, scene.iso->value);
     const glm::dvec3 light = scene.iso->lightFor(*scene.camera);

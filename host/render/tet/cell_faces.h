@@ -18,6 +18,9 @@ namespace clvr {
 // Cell ids travel in two float channels as 12-bit halves (exact after rounding an interpolated constant).
 inline constexpr std::uint32_t kMaxFaceCells = 1u << 24;
 
+// The id channels' clear value in the face draws' frame buffer: no face passed at this pixel.
+inline constexpr float kNoFace = -1.0f;
+
 class CellFaces {
 public:
     // The mesh relative to `shift` (float precision near the origin). InputError for an empty mesh or

@@ -136,7 +136,6 @@ std::vector<glm::dvec3> averagedVertexGradients(const TetMesh& mesh)
 
 namespace {
 
-constexpr float kNoFace = -1.0f;  // the id channel's clear value: no face passed here
 
 std::string fragmentSource()
 {
@@ -149,7 +148,7 @@ public:
     Image4f render(FrameStats& stats) override;
     std::uint64_t residentBytes() const override { return 0; }  // everything is drawn from the host
     void setTransferFunction(const TransferFunction& tf) override { color_ = surfaceColor(tf); }
-    std::vector<double> hitDepth() const override { return hitDepth_; }
+    std::vector<double> hitDepth() override;
 
 private:
     glm::dvec3 surfaceColor(const TransferFunction& tf) const
@@ -182,7 +181,7 @@ private:
     raster::FragmentProgram frontProgram_[2];
     cl::Buffer chosen_, image_buffer_;
     cl::Kernel weightsKernel_, nearer_, add_, finish_;
-    std::vector<double> hitDepth_;
+    double hitZLo_ = 0.0, hitTScale_ = 1.0;  // the last frame's normalization of the depth channel t
 };
 
 Tetiso::Tetiso(Device& device, const Scene& scene, const TetMesh& mesh)
@@ -367,14 +366,11 @@ Image4f Tetiso::render(FrameStats& stats)
     launch(finish_, "tetiso: accumulation buffer over background", {&image_buffer_, &fb_.accum()});
 
     Image4f image = readImage(device_, image_buffer_, image_.width, image_.height);
-    const std::vector<cl_float4> w = device_.download<cl_float4>(chosen_, pixels);
-    hitDepth_.assign(pixels, std::numeric_limits<double>::infinity());
-    std::uint64_t hits = 0;
-    for (std::size_t i = 0; i < pixels; ++i)
-        if (w[i].s[2] != 0.0f) {
-            hitDepth_[i] = zLo + static_cast<double>(w[i].s[1]) / tScale;
-            ++hits;
-        }
+    hitZLo_ = zLo;
+    hitTScale_ = tScale;
+    std::uint64_t hits = 0;  // alpha is the coverage: q + (1 - q) where a surface was found, else 0
+    for (const glm::vec4& c : image.pixels())
+        hits += c.a > 0.0f ? 1 : 0;
     const raster::DrawStats drawn = rasterizer_.takeStats();
 
     finishFrame(device_, clock, stats, {{"tetiso: vertex colors, facing, face lists (host)", setUpMs}});
@@ -394,6 +390,17 @@ Image4f Tetiso::render(FrameStats& stats)
     stats.extra["resident_bytes"] = 0;
     stats.extra["bytes_per_tet"] = 0.0;  // the mesh stays on the host; the faces are drawn from there
     return image;
+}
+
+std::vector<double> Tetiso::hitDepth()
+{
+    const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
+    const std::vector<cl_float4> w = device_.download<cl_float4>(chosen_, pixels);
+    std::vector<double> z(pixels, std::numeric_limits<double>::infinity());
+    for (std::size_t i = 0; i < pixels; ++i)
+        if (w[i].s[2] != 0.0f)
+            z[i] = hitZLo_ + static_cast<double>(w[i].s[1]) / hitTScale_;
+    return z;
 }
 
 }  // namespace

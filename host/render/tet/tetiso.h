@@ -82,8 +82,9 @@ std::vector<glm::dvec3> averagedVertexGradients(const TetMesh& mesh);
 class TetisoRenderer : public Renderer {
 public:
     // Eye depth (distance to the image plane along the view direction) of the surface per pixel, row 0 at
-    // the top, +infinity where no surface was found: (1 - q) z_f + q z_b of the last frame.
-    virtual std::vector<double> hitDepth() const = 0;
+    // the top, +infinity where no surface was found: (1 - q) z_f + q z_b of the last frame. Reads the
+    // device's weights back (a frame does not), as iso3d's hitDepth() reads its depth buffer.
+    virtual std::vector<double> hitDepth() = 0;
 };
 std::unique_ptr<TetisoRenderer> makeTetisoRenderer(Device& device, const Scene& scene, const TetMesh& mesh);
 

@@ -101,7 +101,6 @@ const std::vector<std::uint32_t>& ActiveCellLists::next()
 
 namespace {
 
-constexpr float kNoFace = -1.0f;               // the id channel's clear value: no face passed here
 
 class TetsliceRenderer final : public Renderer {
 public:
