@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <unordered_map>
 
 namespace clvr {
 
@@ -72,10 +73,14 @@ TetMesh automatonMesh(int cells, int grid)
     if (cells < 1 || static_cast<std::uint64_t>(cells) > lattice)
         throw InputError("mesh generator automaton: cells must be in [1, grid^3 = " + std::to_string(lattice) +
                          "], got " + std::to_string(cells));
-    // The living cells: the first `cells` of a Fisher-Yates shuffle of the lattice (splitmix64, fixed seed).
-    std::vector<std::uint32_t> order(lattice);
-    for (std::uint64_t i = 0; i < lattice; ++i)
-        order[i] = static_cast<std::uint32_t>(i);
+    // The living cells: the first `cells` of a Fisher-Yates shuffle of the lattice (splitmix64, fixed
+    // seed), run sparsely: only the entries a swap moved are stored, so memory follows `cells`, not the
+    // lattice (a 1024^3 lattice would otherwise take 4 GiB for 8,000 cells).
+    std::unordered_map<std::uint64_t, std::uint32_t> moved;
+    const auto at = [&moved](std::uint64_t i) {
+        const auto it = moved.find(i);
+        return it == moved.end() ? static_cast<std::uint32_t>(i) : it->second;
+    };
     std::uint64_t state = 0x5eed5eed5eedULL;
     const auto next = [&state] {
         std::uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
@@ -83,9 +88,14 @@ TetMesh automatonMesh(int cells, int grid)
         z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
         return z ^ (z >> 31);
     };
-    for (std::uint64_t i = 0; i < static_cast<std::uint64_t>(cells); ++i)
-        std::swap(order[i], order[i + next() % (lattice - i)]);
-    std::sort(order.begin(), order.begin() + cells);
+    std::vector<std::uint32_t> order(static_cast<std::size_t>(cells));
+    for (std::uint64_t i = 0; i < static_cast<std::uint64_t>(cells); ++i) {
+        const std::uint64_t j = i + next() % (lattice - i);
+        const std::uint32_t vi = at(i), vj = at(j);
+        order[i] = vj;
+        moved[j] = vi;  // position i is never read again
+    }
+    std::sort(order.begin(), order.end());
 
     TetMesh mesh;
     mesh.source = "generator automaton (" + std::to_string(cells) + " cells of " + std::to_string(grid) + "^3)";
