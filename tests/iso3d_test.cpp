@@ -90,15 +90,7 @@ HitComparison compareHits(const Scene& scene, const Volume& volume)
                     ++r.overOneSlice;
             } else if (hit != refHit(x, y)) {
                 ++r.coverageDiffers;
-                // A silhouette pixel has a neighbour (3x3) on the other side of the reference's coverage.
-                bool silhouette = false;
-                for (int dy = -1; dy <= 1; ++dy)
-                    for (int dx = -1; dx <= 1; ++dx) {
-                        const int xx = x + dx, yy = y + dy;
-                        if (xx >= 0 && yy >= 0 && xx < w && yy < h && refHit(xx, yy) != refHit(x, y))
-                            silhouette = true;
-                    }
-                if (!silhouette)
+                if (!test::atSilhouette(refHit, x, y, w, h))
                     ++r.coverageDiffersInside;
             }
         }

@@ -173,14 +173,7 @@ Comparison compare(const Scene& scene, const TetMesh& mesh, glm::dvec3 (*normal)
                 }
             } else if (hit != refHit(x, y)) {
                 ++c.coverageDiffers;
-                bool silhouette = false;
-                for (int dy = -1; dy <= 1; ++dy)
-                    for (int dx = -1; dx <= 1; ++dx) {
-                        const int xx = x + dx, yy = y + dy;
-                        if (xx >= 0 && yy >= 0 && xx < size && yy < size && refHit(xx, yy) != refHit(x, y))
-                            silhouette = true;
-                    }
-                c.coverageDiffersInside += silhouette ? 0 : 1;
+                c.coverageDiffersInside += test::atSilhouette(refHit, x, y, size, size) ? 0 : 1;
             }
         }
     c.meanShadeError = c.bothHit ? shadeSum / c.bothHit : 0.0;

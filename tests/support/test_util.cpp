@@ -166,4 +166,15 @@ int Rng::integer(int lo, int hi)
     return lo + static_cast<int>(next() % static_cast<std::uint64_t>(hi - lo + 1));
 }
 
+bool atSilhouette(const std::function<bool(int, int)>& covered, int x, int y, int width, int height)
+{
+    for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+            const int xx = x + dx, yy = y + dy;
+            if (xx >= 0 && yy >= 0 && xx < width && yy < height && covered(xx, yy) != covered(x, y))
+                return true;
+        }
+    return false;
+}
+
 }  // namespace clvr::test

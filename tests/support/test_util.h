@@ -15,6 +15,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 
 namespace clvr::test {
@@ -49,6 +50,11 @@ ImageError imageError(const Image4f& actual, const Image4d& expected);
 // Per channel max and mean absolute error against `expected`; fails on NaN or size mismatch.
 // On failure writes test_output/<suite>.<test>/{actual,expected,diff}.exr and says so.
 testing::AssertionResult imagesNear(const Image4f& actual, const Image4d& expected, Tolerance tolerance);
+
+// True when a pixel of the 3x3 neighbourhood of (x, y) inside the width x height image is on the other
+// side of `covered` than (x, y): a silhouette pixel of the coverage, where a surface renderer and its
+// reference may disagree on whether the pixel's ray hits.
+bool atSilhouette(const std::function<bool(int, int)>& covered, int x, int y, int width, int height);
 
 // A fresh directory under the system temporary directory (named after the running test), removed
 // with everything in it when it goes out of scope. Tests write malformed files here, never in the repo.
