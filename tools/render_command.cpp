@@ -49,7 +49,6 @@ std::string lowerExtension(const fs::path& p)
     return ext;
 }
 
-
 // Writes `text` to `path` through a temporary file in the same folder, renamed into place.
 void writeFileAtomically(const std::string& path, const std::string& text)
 {

@@ -119,23 +119,39 @@ std::string tetgenSwitches(const MesherOptions& options)
     return s.str();
 }
 
+namespace {
+
+// The generator a mesh scalar names (host/io/generators.h), or nullptr when it names none.
+double (*scalarGenerator(const std::string& scalar))(const glm::dvec3&)
+{
+    const std::string name = asciiLower(scalar);
+    return name == "marschner-lobb" ? marschnerLobb
+           : name == "sphere"       ? sphereField
+           : name == "blobs"        ? blobsField
+           : name == "kernel"       ? kernelField
+                                    : nullptr;
+}
+
+// InputError unless `scalar` names a generator or a .nrrd/.nhdr volume (checked before TetGen runs).
+void checkScalar(const std::string& scalar)
+{
+    const std::string ext = asciiLower(fs::path(scalar).extension().string());
+    if (!scalarGenerator(scalar) && ext != ".nrrd" && ext != ".nhdr")
+        throw InputError("mesh scalar " + scalar +
+                         ": neither a generator (marschner-lobb, sphere, blobs, kernel) nor a .nrrd/.nhdr volume");
+}
+
+}  // namespace
+
 void assignScalar(TetMesh& mesh, const std::string& scalar)
 {
     mesh.scalars.resize(mesh.points.size());
-    const std::string name = asciiLower(scalar);
-    if (name == "marschner-lobb" || name == "sphere" || name == "blobs" || name == "kernel") {
-        double (*f)(const glm::dvec3&) = name == "sphere"   ? sphereField
-                                         : name == "blobs"  ? blobsField
-                                         : name == "kernel" ? kernelField
-                                                            : marschnerLobb;
+    if (double (*f)(const glm::dvec3&) = scalarGenerator(scalar)) {
         for (std::size_t i = 0; i < mesh.points.size(); ++i)
             mesh.scalars[i] = f(mesh.points[i]);
         return;
     }
-    const std::string ext = asciiLower(fs::path(scalar).extension().string());
-    if (ext != ".nrrd" && ext != ".nhdr")
-        throw InputError("mesh scalar " + scalar +
-                         ": neither a generator (marschner-lobb, sphere, blobs, kernel) nor a .nrrd/.nhdr volume");
+    checkScalar(scalar);
     const Volume volume = readNrrd(scalar);
     const glm::dvec3 lo = volume.boundsMin(), hi = volume.boundsMax();
     std::size_t inside = 0;
@@ -159,12 +175,7 @@ TetMesh meshSurface(const fs::path& surface, const MesherOptions& options)
         throw InputError(surface.string() + ": no such file");
     if (!(options.quality >= 0.0) || !(options.maxVolume >= 0.0))
         throw InputError(surface.string() + ": --quality and --max-volume must be positive");
-    {
-        const std::string s = asciiLower(options.scalar), e = asciiLower(fs::path(options.scalar).extension().string());
-        if (s != "marschner-lobb" && s != "sphere" && s != "blobs" && s != "kernel" && e != ".nrrd" && e != ".nhdr")
-            throw InputError("mesh scalar " + options.scalar +
-                             ": neither a generator (marschner-lobb, sphere, blobs, kernel) nor a .nrrd/.nhdr volume");
-    }
+    checkScalar(options.scalar);
     const std::string ext = asciiLower(surface.extension().string());
     if (ext != ".poly" && ext != ".smesh" && ext != ".off" && ext != ".stl")
         throw InputError(surface.string() + ": unknown surface format \"" + ext + "\" (.poly, .smesh, .off, .stl)");
