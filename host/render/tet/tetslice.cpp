@@ -276,10 +276,11 @@ Image4f TetsliceRenderer::render(FrameStats& stats)
     Image4f image = readImage(device_, image_buffer_, image_.width, image_.height);
     const raster::DrawStats drawn = rasterizer_.takeStats();
 
-    finishFrame(device_, clock, stats,
-                {{"tetslice: eye depths, facing, active cell lists (host)", setUpMs},
-                 {"tetslice: face vertices of the active cells (host)", buildMs}});
-    stats.extra["launches"] = mergePassesByName(stats.passes) - 2;  // per pass name: its launches summed
+    std::vector<PassTime> hostPasses = {{"tetslice: eye depths, facing, active cell lists (host)", setUpMs},
+                                        {"tetslice: face vertices of the active cells (host)", buildMs}};
+    const std::size_t hostCount = hostPasses.size();
+    finishFrame(device_, clock, stats, std::move(hostPasses));
+    stats.extra["launches"] = mergePassesByName(stats.passes) - hostCount;  // per pass name: its launches summed
     counts_.report(stats);
     stats.extra["resident_bytes"] = residentBytes_;
     // The mesh stays on the host; each slice's faces go to the device through the raster stage.
