@@ -259,8 +259,10 @@ kernel void raster_fragments(global float4* color, global float* depth, global u
     const int gy0 = (int)get_global_id(1) << pass.item_h_log2;
     /* Shifts, not divisions: an integer division per work-item was once the launch's largest cost. */
     const uint tile = pass.tile_base + (uint)((gy0 >> pass.tile_h_log2) * pass.tiles_x + (gx0 >> pass.tile_w_log2));
-    const uint begin = tile_start[tile];
-    const uint end = tile_start[tile + 1];
+    const uint list_start = tile_start[tile], list_length = tile_start[tile + 1] - list_start;
+    const uint skipped = min(pass.list_first, list_length);
+    const uint begin = list_start + skipped;
+    const uint end = begin + min(pass.list_count, list_length - skipped);
     if (begin == end)
         return;
 

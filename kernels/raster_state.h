@@ -106,7 +106,9 @@ typedef struct {
  * rectangle rect_* (clipped to the frame buffer). Tiles of 2^tile_w_log2 x 2^tile_h_log2 pixels and
  * items of 2^item_w_log2 x 2^item_h_log2 pixels (one work-item each, inside one tile) start at the
  * rectangle's corner; tile t of the pass lists its triangles in tile_start[tile_base + t] ..
- * tile_start[tile_base + t + 1] of the submission's tile lists. */
+ * tile_start[tile_base + t + 1] of the submission's tile lists, and this launch walks the entries
+ * list_first .. list_first + list_count - 1 of each list (the whole list unless the device caps loop
+ * iterations: RasterShape::listChunk). */
 typedef struct {
     cl_int fb_width;
     cl_int rect_x, rect_y, rect_w, rect_h;
@@ -115,7 +117,7 @@ typedef struct {
     cl_uint tile_base;      /* the pass's first tile in tile_start */
     cl_uint uniform_base;   /* the pass's first uniform in the submission's uniforms */
     cl_ulong triangle_base; /* float4 offset of the pass's triangle 0 in the triangle buffer */
-    cl_uint pad0, pad1;
+    cl_uint list_first, list_count;
     ClFragmentState fragment;
     ClBlendState blend;
 } ClRasterPass; /* 176 bytes */

@@ -18,3 +18,15 @@ kernel void fill_uchar(global uchar* dst, const uchar value, const uint n)
     CLVR_GUARD_1D(n);
     dst[get_global_id(0)] = value;
 }
+
+/* out[0] = how many of n iterations a loop runs (Device::loopIterationCap). Each iteration reads memory,
+ * so no compiler can fold the loop; ones[] holds 16 ones. */
+kernel void loop_iterations(global uint* out, global const uint* ones, const uint n)
+{
+    if (get_global_id(0) != 0)
+        return;
+    uint k = 0u;
+    for (uint i = 0u; i < n; ++i)
+        k += ones[i & 15u];
+    out[0] = k;
+}

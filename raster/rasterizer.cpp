@@ -514,6 +514,12 @@ RasterShape RasterShape::forDevice(Device& device)
     RasterShape shape;
     if (device.device().getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_GPU)
         shape.itemW = shape.itemH = 1;
+    // A 1x1 item spends about 4 loop iterations on a triangle (list, row, pixel, row load); the rest of
+    // the 32 leaves room for loops in fragment programs.
+    if (const std::uint64_t cap = device.loopIterationCap()) {
+        shape.itemW = shape.itemH = 1;
+        shape.listChunk = static_cast<std::uint32_t>(std::max<std::uint64_t>(1, cap / 32));
+    }
     return shape;
 }
 
@@ -671,7 +677,17 @@ void Rasterizer::submit(Framebuffer& fb, SetUpDraws& draws)
         // work-item of a group in one stack array (its context arrays), far apart in memory.
         const std::size_t itemsX = (static_cast<std::size_t>(rect.width) + shape_.itemW - 1) / shape_.itemW;
         const std::size_t itemsY = (static_cast<std::size_t>(rect.height) + shape_.itemH - 1) / shape_.itemH;
-        device_.launch("raster: fragments", k, itemsX, itemsY, groupW, groupH);
+        cl_uint longest = 0;
+        const std::size_t passTiles = static_cast<std::size_t>(grid.tilesX()) * grid.tilesY();
+        for (std::size_t t = pass.tileBase; t < pass.tileBase + passTiles; ++t)
+            longest = std::max(longest, s.stagedTileStarts[t + 1] - s.stagedTileStarts[t]);
+        const cl_uint chunk = shape_.listChunk ? shape_.listChunk : std::max<cl_uint>(longest, 1);
+        for (cl_uint first = 0; first < longest; first += chunk) {
+            p.list_first = first;
+            p.list_count = chunk;
+            k.setArg(3, p);
+            device_.launch("raster: fragments", k, itemsX, itemsY, groupW, groupH);
+        }
         s.rowsCounted = std::max(s.rowsCounted, itemsY);
     }
     draws.clear();

@@ -91,8 +91,12 @@ DrawStats draw(Device& device, Framebuffer& fb, const DrawState& state, Topology
 struct RasterShape {
     int tileW = CLVR_TILE_SIZE, tileH = CLVR_TILE_SIZE;
     int itemW = CLVR_TILE_SIZE, itemH = CLVR_TILE_SIZE;
+    // Triangles of a tile list per launch: 0 walks each list in one launch; n > 0 launches a pass once per
+    // n entries of its longest list (each launch continues from the frame buffer the last one left).
+    std::uint32_t listChunk = 0;
     // A CPU walks each tile list once (item = tile); a GPU gives each pixel a work-item (1x1 items) and
-    // each tile a work-group's worth of them.
+    // each tile a work-group's worth of them. A device that caps loop iterations
+    // (Device::loopIterationCap) gets 1x1 items and lists cut to fit the cap with room to spare.
     static RasterShape forDevice(Device& device);
 };
 

@@ -47,6 +47,61 @@ TEST(Device, FillKernelWritesEveryElementOfAnOddSizedBuffer)
     EXPECT_GE(times[0].ms, 0.0);
 }
 
+// A requested work-group larger than the kernel allows (CL_KERNEL_WORK_GROUP_SIZE: 4096 on PoCL, 1024 on
+// rusticl, 256 to 1024 on GPUs) must not fail the launch: the group is only a hint.
+TEST(Device, GroupLargerThanTheKernelAllowsStillCoversTheRange)
+{
+    clvr::Device& device = clvr::test::device();
+    cl::Kernel k = device.kernel("util.cl", "fill2d", "kernel void fill2d(global float* x, uint w, uint h) {"
+                                                      " uint i = get_global_id(0), j = get_global_id(1);"
+                                                      " if (i < w && j < h) x[j * w + i] = (float)(j * w + i); }");
+    const std::size_t limit = k.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(device.device());
+    const cl_uint w = 300, h = 70;
+    std::vector<float> init(std::size_t(w) * h, -1.0f);
+    cl::Buffer buffer = device.upload("test buffer", init, CL_MEM_READ_WRITE);
+    k.setArg(0, buffer);
+    k.setArg(1, w);
+    k.setArg(2, h);
+    const std::size_t side = 128;  // 16384 work-items per group: more than any device allows
+    ASSERT_GT(side * side, limit);
+    device.launch("fill2d", k, w, h, side, side);
+    const std::vector<float> out = device.download<float>(buffer, init.size());
+    for (std::size_t i = 0; i < out.size(); ++i)
+        ASSERT_EQ(out[i], float(i)) << "element " << i;
+    device.takePassTimes();
+}
+
+// The raster stage keeps a whole tile's pixels in private arrays (kernels/raster.cl, CLVR_ITEM_PIXELS):
+// every element must keep its value under data-dependent indexing, whatever the array's size.
+TEST(Device, LargePrivateArraysKeepEveryElement)
+{
+    clvr::Device& device = clvr::test::device();
+    for (const int n : {16, 64, 128, 256}) {
+        const std::string source = "kernel void private_array(global float4* out, global const int* order) {"
+                                   " float4 c[N]; float d[N]; uint s[N];"
+                                   " for (int i = 0; i < N; ++i) { c[i] = (float4)(i, -i, 2 * i, 0.5f); d[i] = 1.0f; s[i] = 0u; }"
+                                   " for (int k = 0; k < N; ++k) { int l = order[k]; c[l].w += (float)l; d[l] += 1.0f; s[l] += 3u; }"
+                                   " for (int i = 0; i < N; ++i) out[i] = (float4)(c[i].x, c[i].w, d[i], (float)s[i]); }";
+        cl::Kernel k = device.kernel("util.cl", "private_array", source, "-DN=" + std::to_string(n));
+        std::vector<cl_int> order(n);
+        for (int i = 0; i < n; ++i)
+            order[i] = (i * 7 + 3) % n;  // a permutation: 7 is coprime to every n here
+        cl::Buffer out = device.upload("out", std::vector<cl_float4>(n), CL_MEM_READ_WRITE);
+        cl::Buffer ord = device.upload("order", order, CL_MEM_READ_ONLY);
+        k.setArg(0, out);
+        k.setArg(1, ord);
+        device.launch("private array", k, 1);
+        const auto got = device.download<cl_float4>(out, n);
+        for (int i = 0; i < n; ++i) {
+            ASSERT_EQ(got[i].s[0], float(i)) << "N " << n << " element " << i;
+            ASSERT_EQ(got[i].s[1], 0.5f + float(i)) << "N " << n << " element " << i;
+            ASSERT_EQ(got[i].s[2], 2.0f) << "N " << n << " element " << i;
+            ASSERT_EQ(got[i].s[3], 3.0f) << "N " << n << " element " << i;
+        }
+        device.takePassTimes();
+    }
+}
+
 TEST(Device, UploadShorterThanTheMinimumAllocationKeepsItsBytes)
 {
     // Buffers are at least 4 bytes; a 1-byte host block must be copied, not over-read (ASan

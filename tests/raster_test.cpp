@@ -973,6 +973,50 @@ TEST(RasterShape, EveryShapeGivesTheSameBits)
     device.takePassTimes();
 }
 
+// Tile lists of many triangles that each cover whole items, against the exact sum: the CPU shape (an
+// item is a 16x16 tile, its pixels in private arrays for the whole list), one pixel per item, lists cut
+// into launches of 7 entries, and the device's own shape. Found on Mesa's rusticl (llvmpipe), which stops
+// a work-item's loops after 65,535 iterations: items with long lists lost every pixel but their first
+// (docs/devices.md).
+TEST(RasterShape, LongListsOfFullTileTrianglesGiveTheExactSum)
+{
+    clvr::Device& device = clvr::test::device();
+    const raster::RasterShape shapes[] = {{16, 16, 16, 16}, {16, 16, 1, 1}, {16, 16, 16, 16, 7}, {8, 8, 1, 1, 7},
+                                          {16, 16, 1, 1, 1000}, raster::RasterShape::forDevice(device)};
+    const bool capped = device.loopIterationCap() != 0;
+    // 40 x 24: tiles cut by the frame buffer's edge. 12,000 quads: 24,000 triangles per tile list, over the
+    // cap even for 1x1 items (about 4 iterations per triangle).
+    const int w = 40, h = 24;
+    for (const int quads : {2, 12000}) {
+        std::vector<raster::Vertex> vertices;
+        for (int q = 0; q < quads; ++q) {
+            const auto a = windowVertex(-3.0, -2.0, w, h), b = windowVertex(w + 5.0, -1.0, w, h);
+            const auto c = windowVertex(w + 2.0, h + 4.0, w, h), d = windowVertex(-1.0, h + 3.0, w, h);
+            vertices.insert(vertices.end(), {a, b, c, a, c, d});
+        }
+        for (const raster::RasterShape& shape : shapes) {
+            if (quads > 100 && shape.listChunk == 7)
+                continue;  // 3,400 launches: the short lists test the cutting
+            if (quads > 100 && capped && shape.listChunk == 0)
+                continue;  // not a shape this device gets: a whole list would run past its cap
+            SCOPED_TRACE(std::to_string(quads) + " quads, items " + std::to_string(shape.itemW) + "x" +
+                         std::to_string(shape.itemH) + ", list chunk " + std::to_string(shape.listChunk));
+            raster::Framebuffer fb(device, w, h);
+            fb.clearColor(device, glm::vec4(0.0f));
+            raster::Rasterizer rasterizer(device, shape);
+            rasterizer.draw(fb, additiveOnes(), raster::Topology::Triangles, vertices);
+            EXPECT_EQ(rasterizer.takeStats().fragments, std::uint64_t(quads) * w * h);
+            const clvr::Image4f image = fb.readColor(device);
+            int wrong = 0;
+            for (int y = 0; y < h; ++y)
+                for (int x = 0; x < w; ++x)
+                    wrong += image.at(x, y).r != float(quads) || image.at(x, y).a != float(quads);
+            EXPECT_EQ(wrong, 0) << "pixels without the sum of " << quads << " ones, e.g. (1, 0): " << image.at(1, 0).r;
+        }
+    }
+    device.takePassTimes();
+}
+
 // FragmentProgram::attributes: the attributes a program reads are interpolated exactly as with all four,
 // the ones past the count read as zero, and a count out of range is an internal error.
 TEST(RasterFragmentProgram, AttributeCountKeepsTheReadOnesAndZeroesTheRest)

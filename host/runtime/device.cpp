@@ -272,7 +272,29 @@ void Device::launch(std::string name, const cl::Kernel& kernel, std::size_t widt
 {
     const std::size_t w = std::max<std::size_t>(1, (width + groupWidth - 1) / groupWidth) * groupWidth;
     const std::size_t h = std::max<std::size_t>(1, (height + groupHeight - 1) / groupHeight) * groupHeight;
-    enqueue(std::move(name), kernel, cl::NDRange(w, h), cl::NDRange(groupWidth, groupHeight));
+    const auto itemSizes = device_.getInfo<CL_DEVICE_MAX_WORK_ITEM_SIZES>();
+    const std::size_t kernelLimit = kernel.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(device_);
+    const bool fits = groupWidth * groupHeight <= kernelLimit && itemSizes.size() >= 2 &&
+                      groupWidth <= itemSizes[0] && groupHeight <= itemSizes[1];
+    enqueue(std::move(name), kernel, cl::NDRange(w, h), fits ? cl::NDRange(groupWidth, groupHeight) : cl::NullRange);
+}
+
+std::uint64_t Device::loopIterationCap()
+{
+    if (!loopIterationCap_) {
+        constexpr cl_uint kIterations = 1u << 24;
+        cl::Kernel k = kernel("util.cl", "loop_iterations");
+        cl::Buffer out = upload("loop probe result", std::vector<cl_uint>{0u}, CL_MEM_READ_WRITE);
+        cl::Buffer ones = upload("loop probe ones", std::vector<cl_uint>(16, 1u));
+        k.setArg(0, out);
+        k.setArg(1, ones);
+        k.setArg(2, kIterations);
+        cl::Event event;
+        queue_.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(1), cl::NullRange, nullptr, &event);
+        const cl_uint ran = download<cl_uint>(out, 1).front();
+        loopIterationCap_ = ran == kIterations ? 0 : ran;
+    }
+    return *loopIterationCap_;
 }
 
 std::vector<PassTime> Device::takePassTimes()

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <tuple>
@@ -67,6 +68,11 @@ public:
 
     // Milliseconds spent in clBuildProgram so far (cache hits cost nothing).
     double compileMs() const { return compileMs_; }
+
+    // 0 when a kernel's loops run to completion; otherwise how many iterations of a 2^24-iteration loop
+    // ran. Mesa's llvmpipe (rusticl) stops every loop of a work-item after 65,535 iterations counted over
+    // all its loops together, silently (docs/devices.md). Asked once, by running a loop.
+    std::uint64_t loopIterationCap();
     const std::vector<std::string>& warnings() const { return warnings_; }
 
     // Enqueues `kernel` with a name that --stats reports. A 1D count is padded up to a multiple
@@ -75,6 +81,9 @@ public:
     void launch(std::string name, const cl::Kernel& kernel, std::size_t count);
     void launch(std::string name, const cl::Kernel& kernel, std::size_t width, std::size_t height);
     // A 2D launch in work-groups of groupWidth x groupHeight (the range padded to multiples of them).
+    // The group is a speed hint: where the device or this kernel allows fewer work-items per group
+    // (CL_KERNEL_WORK_GROUP_SIZE, CL_DEVICE_MAX_WORK_ITEM_SIZES), the driver picks the group instead,
+    // so kernels launched this way must not depend on their group (no local memory, no barriers).
     void launch(std::string name, const cl::Kernel& kernel, std::size_t width, std::size_t height,
                 std::size_t groupWidth, std::size_t groupHeight);
 
@@ -113,6 +122,7 @@ private:
     std::vector<std::pair<std::string, cl::Event>> pending_;
     std::vector<std::string> warnings_;
     double compileMs_ = 0.0;
+    std::optional<std::uint64_t> loopIterationCap_;
 };
 
 }  // namespace clvr
