@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # tools/setup.sh — one command from a fresh Debian 12 machine (as root) to a result:
 #   bash tools/setup.sh          install what is missing, build, render the default scene to out/default.png
-#   bash tools/setup.sh test     install what is missing, build, run every test (ctest), then the host
-#                                code's tests again under AddressSanitizer + UndefinedBehaviorSanitizer
+#   bash tools/setup.sh test     install what is missing, build, run every test (ctest) on PoCL, the
+#                                kernel and image suites again on Mesa's rusticl (docs/devices.md), then
+#                                the host code's tests again under AddressSanitizer + UndefinedBehaviorSanitizer
 # Environment: JOBS (parallel build jobs, default: number of cores), CLVR_SKIP_ASAN=1 skips the sanitizer pass.
 set -euo pipefail
 mode="${1:-render}"
@@ -15,7 +16,7 @@ cd "$(dirname "$0")/.."
 jobs="${JOBS:-$(nproc)}"
 
 packages=(cmake make g++ pkg-config clang
-    pocl-opencl-icd ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers
+    pocl-opencl-icd mesa-opencl-icd ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers
     libglm-dev libopenimageio-dev openimageio-tools libtet1.5-dev nlohmann-json3-dev libcli11-dev
     libgtest-dev libbenchmark-dev zlib1g-dev)
 missing=()
@@ -46,7 +47,9 @@ if [ "$mode" = render ]; then
 fi
 
 echo "clvr setup: running every test (build/)"
-ctest --test-dir build --output-on-failure -j "$jobs" --timeout 900
+ctest --test-dir build --output-on-failure -j "$jobs" --timeout 900 -LE portable
+echo "clvr setup: the kernel and image suites on a second OpenCL implementation (Mesa rusticl, llvmpipe)"
+ctest --test-dir build --output-on-failure -j "$jobs" --timeout 900 -L portable
 
 if [ "${CLVR_SKIP_ASAN:-0}" != 1 ]; then
     echo "clvr setup: host code under ASan + UBSan (build-asan/)"
@@ -65,5 +68,5 @@ if [ "${CLVR_SKIP_ASAN:-0}" != 1 ]; then
     export POCL_CACHE_DIR="$PWD/build/pocl-cache"
     # TetsliceMeshes.* (tetslice on bluntfin, the post and the torus at up to 1,024 slices) run in the
     # release pass only: under ASan they take a minute for host code the Tetslice.* box-grid tests run too.
-    ctest --test-dir build-asan --output-on-failure -j "$jobs" --timeout 900 -E '^TetsliceMeshes\.'
+    ctest --test-dir build-asan --output-on-failure -j "$jobs" --timeout 900 -E '^TetsliceMeshes\.' -LE portable
 fi
