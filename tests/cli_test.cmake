@@ -315,6 +315,22 @@ expect_error(2 ${out} "--threads: want a whole number of threads" ${CLVR} render
 expect_error(2 ${out} "CLVR_THREADS: want a whole number of threads"
   ${CMAKE_COMMAND} -E env CLVR_THREADS=-3 ${CLVR} render -o ${out} ${TINY})
 
+# Meshes as they come (docs/meshes.md): an inverted tetrahedron is reoriented and a flat one dropped,
+# each counted in --stats and told in one stderr note; the image is still written.
+file(WRITE "${WORK}/fixed.node" "6 3 1 0\n0 0 0 0 0\n1 1 0 0 1\n2 0 1 0 2\n3 0 0 1 3\n4 1 1 1 4\n5 2 2 0 5\n")
+# tet 0 positive, tet 1 inverted (1 2 3 4 is positive), tet 2 flat (0 1 2 5, all in z = 0)
+file(WRITE "${WORK}/fixed.ele" "3 4 0\n0 0 1 2 3\n1 1 2 4 3\n2 0 1 2 5\n")
+expect_run(0 "clvr: note: the mesh had 1 zero-volume tetrahedra \\(dropped\\) and 1 inverted ones \\(reoriented\\)"
+  ${CLVR} render ${SRC}/data/scenes/bluntfin.json --set "mesh={\"file\": \"${WORK}/fixed.node\"}" ${SMALL}
+  --single-frame -o ${WORK}/fixed.png --stats ${WORK}/fixed.json)
+expect_png(${WORK}/fixed.png 64 64)
+file(READ "${WORK}/fixed.json" fixedStats)
+string(JSON reoriented GET "${fixedStats}" tets_reoriented)
+string(JSON degenerate GET "${fixedStats}" tets_degenerate)
+if(NOT reoriented EQUAL 1 OR NOT degenerate EQUAL 1)
+  message(FATAL_ERROR "fixed.json: tets_reoriented ${reoriented}, tets_degenerate ${degenerate}, want 1 and 1")
+endif()
+
 # The cell-face techniques (docs/tetslice.md, docs/tetiso.md) from the command line: a small generated
 # automaton renders, bad options and a missing "iso" are one line each, no image left behind.
 set(AUTOMATON --set "mesh={\"generator\":\"automaton\",\"cells\":60,\"grid\":6}" --set image.width=32 --set image.height=32)

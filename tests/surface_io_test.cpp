@@ -12,6 +12,8 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+
 #include <string>
 #include <vector>
 
@@ -134,8 +136,9 @@ TEST(SurfaceIo, BadFilesAreInputErrorsNamingTheLine)
     }
 }
 
-// Two closed tetrahedra that overlap (issue 15: TetGen's mesher segfaulted on them) and an open surface:
-// one InputError each, before or instead of meshing.
+// Surfaces as they come (issue 15): two closed tetrahedra that overlap (TetGen's mesher segfaulted on
+// them), an open one, two that share an edge (non-manifold), one with a zero-area facet, and an STL whose
+// repeated corners make a closed tetrahedron: one InputError each, before TetGen meshes anything.
 TEST(SurfaceIo, SelfIntersectingAndOpenSurfacesAreInputErrors)
 {
     test::TempDir dir;
@@ -147,9 +150,26 @@ TEST(SurfaceIo, SelfIntersectingAndOpenSurfacesAreInputErrors)
     test::writeFile(dir / "apart.off", "OFF\n8 8 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n"
                                        "3 3 3\n4 3 3\n3 4 3\n3 3 4\n" + tet +
                                        "3 4 6 5\n3 4 5 7\n3 4 7 6\n3 5 6 7\n");
+    test::writeFile(dir / "edge.off", "OFF\n6 8 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n0 -1 0\n0 0 -1\n" + tet +
+                                      "3 0 1 4\n3 0 5 1\n3 1 5 4\n3 0 4 5\n");
+    test::writeFile(dir / "flat.off", "OFF\n5 5 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n0.5 0 0\n3 0 2 1\n3 0 1 3\n3 1 2 3\n"
+                                      "3 0 3 2\n3 0 4 1\n");
+    std::string stl = "solid t\n";
+    const char* corners[4] = {"0 0 0", "1 0 0", "0 1 0", "0 0 1"};
+    for (const auto& f : {std::array{0, 2, 1}, std::array{0, 1, 3}, std::array{0, 3, 2}, std::array{1, 2, 3}}) {
+        stl += "facet normal 0 0 0\nouter loop\n";
+        for (int c : f)
+            stl += std::string("vertex ") + corners[c] + "\n";
+        stl += "endloop\nendfacet\n";
+    }
+    test::writeFile(dir / "tet.stl", stl + "endsolid t\n");
+    test::writeFile(dir / "open.stl", stl.substr(0, stl.rfind("facet normal")) + "endsolid t\n");
     const std::pair<const char*, const char*> cases[] = {
         {"crossing.off", "the surface intersects itself"},
-        {"open.off", "TetGen made no tetrahedra"},
+        {"open.off", "borders 1 facet: the surface is open (a hole)"},
+        {"open.stl", "borders 1 facet: the surface is open (a hole)"},
+        {"edge.off", "the edge (0, 0, 0) - (1, 0, 0) borders 4 facets: the surface is not a manifold"},
+        {"flat.off", "facet 4 (points 0 4 1) has zero area"},
     };
     for (const auto& [file, message] : cases) {
         try {
@@ -159,8 +179,9 @@ TEST(SurfaceIo, SelfIntersectingAndOpenSurfacesAreInputErrors)
             EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
         }
     }
-    // The same two tetrahedra apart are a valid (two-part) surface.
+    // The same two tetrahedra apart are a valid (two-part) surface, and the STL's 12 corners are 4 points.
     EXPECT_GE(meshSurface(dir / "apart.off", MesherOptions{}).tets.size(), 2u);
+    EXPECT_EQ(meshSurface(dir / "tet.stl", MesherOptions{}).tets.size(), 1u);
 }
 
 // A scalar volume the mesh lies entirely outside of gives an error, not a constant border value.

@@ -197,6 +197,17 @@ std::vector<std::string> outputPaths(const RenderOptions& options)
 }
 
 
+// One stderr note when checkMesh changed the mesh (docs/meshes.md): the counts are in --stats too.
+void noteMeshRepairs(const FrameStats& stats)
+{
+    const auto count = [&](const char* key) { return stats.extra.value(key, std::uint64_t{0}); };
+    const std::uint64_t dropped = count("tets_degenerate"), reoriented = count("tets_reoriented");
+    if (dropped == 0 && reoriented == 0)
+        return;
+    std::cerr << "clvr: note: the mesh had " << dropped << " zero-volume tetrahedra (dropped) and " << reoriented
+              << " inverted ones (reoriented); --stats has tets_degenerate and tets_reoriented\n";
+}
+
 }  // namespace
 
 int render(const RenderOptions& options)
@@ -242,6 +253,7 @@ int render(const RenderOptions& options)
     }
 
     progress.reset();  // the line is cleared before the summary
+    noteMeshRepairs(frame0.stats);
 
     // 4. Stats, atomically; frame 0's figures at the top level as without --orbit.
     const FrameStats& steady = frame0.stats;

@@ -6,6 +6,10 @@
 #include "host/runtime/file_io.h"
 
 #include <algorithm>
+#include <sstream>
+#include <map>
+#include <limits>
+#include <array>
 #include <cctype>
 #include <cerrno>
 #include <climits>
@@ -329,6 +333,72 @@ Plc readPlc(const fs::path& path)
     if (ext == ".poly" || ext == ".smesh")
         return readPoly(path, ext == ".smesh");
     throw InputError(path.string() + ": unknown surface format \"" + ext + "\" (.poly, .smesh, .off, .stl)");
+}
+
+std::vector<std::uint32_t> mergeIdenticalPoints(const std::vector<glm::dvec3>& points, std::vector<glm::dvec3>& merged)
+{
+    std::map<std::array<double, 3>, std::uint32_t> first;
+    std::vector<std::uint32_t> remap(points.size());
+    merged.clear();
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        const glm::dvec3& p = points[i];
+        const auto [it, added] = first.try_emplace({p.x, p.y, p.z}, static_cast<std::uint32_t>(merged.size()));
+        if (added)
+            merged.push_back(p);
+        remap[i] = it->second;
+    }
+    return remap;
+}
+
+void checkSurface(const Plc& plc, const std::filesystem::path& path, bool closedManifold)
+{
+    std::vector<glm::dvec3> points;
+    const std::vector<std::uint32_t> remap = mergeIdenticalPoints(plc.points, points);
+    glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+    for (const glm::dvec3& p : points) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+    }
+    const double extent = glm::length(hi - lo);
+    const auto pointOf = [&](int number, std::size_t facet) {
+        const long index = static_cast<long>(number) - plc.firstNumber;
+        if (index < 0 || index >= static_cast<long>(plc.points.size()))
+            throw InputError(path.string() + ": facet " + std::to_string(facet) + " uses point " + std::to_string(number) +
+                             ", which does not exist");
+        return remap[static_cast<std::size_t>(index)];
+    };
+    std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;  // undirected edge -> polygons bordering it
+    for (std::size_t f = 0; f < plc.facets.size(); ++f)
+        for (const std::vector<int>& polygon : plc.facets[f].polygons) {
+            if (polygon.size() < 3)
+                continue;  // a segment or point constraint inside a .poly facet
+            // Newell's normal: twice the polygon's vector area, zero for a collinear or repeated polygon.
+            glm::dvec3 area(0.0);
+            for (std::size_t k = 0; k < polygon.size(); ++k) {
+                const std::uint32_t a = pointOf(polygon[k], f), b = pointOf(polygon[(k + 1) % polygon.size()], f);
+                area += glm::cross(points[a], points[b]);
+                if (a != b)
+                    ++uses[{std::min(a, b), std::max(a, b)}];
+            }
+            if (!(glm::length(area) > 1e-12 * extent * extent)) {
+                std::string numbers;
+                for (int n : polygon)
+                    numbers += " " + std::to_string(n);
+                throw InputError(path.string() + ": facet " + std::to_string(f) + " (points" + numbers +
+                                 ") has zero area: TetGen needs a surface without degenerate facets");
+            }
+        }
+    if (!closedManifold)
+        return;
+    for (const auto& [edge, n] : uses)
+        if (n != 2) {
+            const glm::dvec3 &a = points[edge.first], &b = points[edge.second];
+            std::ostringstream s;
+            s << path.string() << ": the edge (" << a.x << ", " << a.y << ", " << a.z << ") - (" << b.x << ", " << b.y
+              << ", " << b.z << ") borders " << n << (n == 1 ? " facet: the surface is open (a hole)" : " facets: the surface is not a manifold")
+              << "; TetGen needs a closed surface in which every edge borders two facets";
+            throw InputError(s.str());
+        }
 }
 
 }  // namespace clvr

@@ -6,6 +6,7 @@
 
 #include <glm/glm.hpp>
 
+#include <cstdint>
 #include <filesystem>
 #include <vector>
 
@@ -39,5 +40,16 @@ struct Plc {
 // beside it). Lines are read as TetGen does: '#' starts a comment, blank lines are skipped, numbers are
 // separated by spaces, tabs or commas. InputError "<path>:<line>: ..." for anything it cannot read.
 Plc readPlc(const std::filesystem::path& path);
+
+// Points with identical coordinates merged, the first occurrence kept: `merged` gets the distinct points
+// in order of first occurrence and the result maps each input point to its index there (an STL file
+// repeats every corner; TetGen merges them too).
+std::vector<std::uint32_t> mergeIdenticalPoints(const std::vector<glm::dvec3>& points, std::vector<glm::dvec3>& merged);
+
+// What TetGen needs of a surface, checked before it runs (docs/meshes.md): every polygon has a nonzero
+// area, and — with `closedManifold`, for the pure surface formats .off and .stl — every edge (points
+// merged as above) borders exactly two polygons. InputError naming `path` and the first offending
+// facet or edge. (.poly and .smesh may hold internal or dangling facets, which TetGen accepts.)
+void checkSurface(const Plc& plc, const std::filesystem::path& path, bool closedManifold);
 
 }  // namespace clvr

@@ -196,6 +196,7 @@ TetMesh meshSurface(const fs::path& surface, const MesherOptions& options)
     }
     if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z))
         throw InputError(surface.string() + ": the surface is flat (its bounding box has zero extent), not closed");
+    checkSurface(plc, surface, ext == ".off" || ext == ".stl");
 
     // A surface that intersects itself crashes TetGen's mesher (a segfault inside tetrahedralize, not an
     // error code). TetGen's own check ("d": detect intersecting facets, no meshing) reports such facets

@@ -343,17 +343,8 @@ void closeClipMesh(ClipMesh& mesh)
     for (const glm::dvec3& p : mesh.points)
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
             throw InputError(mesh.source + ": the clip mesh has a point that is not finite");
-    // Merge points with identical coordinates (first occurrence wins).
-    std::map<std::array<double, 3>, std::uint32_t> first;
-    std::vector<std::uint32_t> remap(mesh.points.size());
     std::vector<glm::dvec3> points;
-    for (std::size_t i = 0; i < mesh.points.size(); ++i) {
-        const glm::dvec3& p = mesh.points[i];
-        const auto [it, added] = first.try_emplace({p.x, p.y, p.z}, static_cast<std::uint32_t>(points.size()));
-        if (added)
-            points.push_back(p);
-        remap[i] = it->second;
-    }
+    const std::vector<std::uint32_t> remap = mergeIdenticalPoints(mesh.points, points);
     std::vector<std::array<std::uint32_t, 3>> triangles;
     for (const auto& t : mesh.triangles) {
         const std::array<std::uint32_t, 3> r = {remap[t[0]], remap[t[1]], remap[t[2]]};
