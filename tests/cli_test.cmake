@@ -227,6 +227,31 @@ if(NOT bricked_stats MATCHES "\"bricks\": *(1[0-9]|[2-9][0-9])[^0-9]")
 endif()
 expect_error(2 ${out} "default scene: options.brick_budget: 100 bytes is less than the smallest brick"
   ${CLVR} render -o ${out} ${SMALL} ${ISO} --set options.brick_budget=100)
+# Faults injected mid-run (CLVR_INJECT_FAULT, docs/robustness.md): a launch in the middle of an iso3d frame
+# (the 7th: clears and slices come before it) and of an orbit's last frame (the 5th: frame 0 renders
+# twice) fail with exit 3 and one line, and leave no image (the orbit's first frames are removed again);
+# a kernel build failure exits 3 with the compiler's log under the line; a malformed value is bad input.
+expect_error(3 ${out} "launching \"[^\"]+\" failed: CL_OUT_OF_RESOURCES \\(injected by CLVR_INJECT_FAULT=launch:7\\)"
+  ${CMAKE_COMMAND} -E env CLVR_INJECT_FAULT=launch:7 ${CLVR} render -o ${out} ${SMALL} ${ISO} --stats ${WORK}/fault.json)
+if(EXISTS ${WORK}/fault.json)
+  message(FATAL_ERROR "a failed launch left its --stats file")
+endif()
+file(MAKE_DIRECTORY "${WORK}/fault-frames")
+expect_error(3 "${WORK}/fault-frames/f0.png" "injected by CLVR_INJECT_FAULT=launch:5"
+  ${CMAKE_COMMAND} -E env CLVR_INJECT_FAULT=launch:5 ${CLVR} render -o "${WORK}/fault-frames/f%d.png" ${SMALL} --orbit 4)
+file(GLOB written "${WORK}/fault-frames/*")
+if(written)
+  message(FATAL_ERROR "an --orbit whose last frame failed left files: ${written}")
+endif()
+file(REMOVE ${out})
+execute_process(COMMAND ${CMAKE_COMMAND} -E env CLVR_INJECT_FAULT=build ${CLVR} render -o ${out} ${SMALL}
+  RESULT_VARIABLE rc OUTPUT_VARIABLE stdout ERROR_VARIABLE stderr TIMEOUT 300)
+if(NOT rc EQUAL 3 OR NOT stderr MATCHES "clvr: error: building kernels/[a-z0-9_]+\\.cl for [^\n]+ failed: CL_BUILD_PROGRAM_FAILURE\n"
+   OR NOT stderr MATCHES "CLVR_INJECT_FAULT=build" OR EXISTS ${out})
+  message(FATAL_ERROR "a failing kernel build: exit ${rc}, want 3, the error line and the log, no image\n  stderr: ${stderr}")
+endif()
+expect_error(2 ${out} "CLVR_INJECT_FAULT \"launch:0\": want"
+  ${CMAKE_COMMAND} -E env CLVR_INJECT_FAULT=launch:0 ${CLVR} render -o ${out} ${SMALL})
 # A malformed limit is bad input.
 expect_error(2 ${out} "CLVR_DEVICE_MEMORY_LIMIT"
   ${CMAKE_COMMAND} -E env CLVR_DEVICE_MEMORY_LIMIT=lots ${CLVR} render -o ${out} ${SMALL})

@@ -197,6 +197,30 @@ std::vector<std::string> outputPaths(const RenderOptions& options)
 }
 
 
+// The images a command has written, removed again unless keep() is called: a command that fails leaves
+// all its frames or none (an --orbit that fails at frame 3 takes frames 0..2 with it).
+class WrittenFiles {
+public:
+    WrittenFiles() = default;
+    WrittenFiles(const WrittenFiles&) = delete;
+    WrittenFiles& operator=(const WrittenFiles&) = delete;
+    ~WrittenFiles()
+    {
+        if (kept_)
+            return;
+        for (const std::string& path : paths_) {
+            std::error_code ignored;
+            fs::remove(path, ignored);
+        }
+    }
+    void add(const std::string& path) { paths_.push_back(path); }
+    void keep() { kept_ = true; }
+
+private:
+    std::vector<std::string> paths_;
+    bool kept_ = false;
+};
+
 // One stderr note when checkMesh changed the mesh (docs/meshes.md): the counts are in --stats too.
 void noteMeshRepairs(const FrameStats& stats)
 {
@@ -239,7 +263,9 @@ int render(const RenderOptions& options)
     firstFrameMs += frame0.wallMs;
     if (!options.singleFrame)
         frame0 = session.render();
+    WrittenFiles written;
     writeImage(outputs[0], frame0.image);
+    written.add(outputs[0]);
     nlohmann::json frames = nlohmann::json::array();
     frames.push_back({{"index", 0}, {"output", outputs[0]}, {"frame_ms", frame0.stats.frameMs},
                       {"setup_ms", session.setupMs()}});
@@ -248,6 +274,7 @@ int render(const RenderOptions& options)
         session.setCamera(orbitCamera(camera0, k, frameCount));
         const Frame frame = session.render();
         writeImage(outputs[static_cast<std::size_t>(k)], frame.image);
+        written.add(outputs[static_cast<std::size_t>(k)]);
         frames.push_back({{"index", k}, {"output", outputs[static_cast<std::size_t>(k)]},
                           {"frame_ms", frame.stats.frameMs}, {"setup_ms", session.setupMs()}});
     }
@@ -267,6 +294,7 @@ int render(const RenderOptions& options)
         }
         writeFileAtomically(options.statsPath, stats.dump(2) + "\n");
     }
+    written.keep();
 
     std::ostringstream line;
     line << "wrote " << options.output;

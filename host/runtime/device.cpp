@@ -109,6 +109,30 @@ const Found& pick(const std::vector<Found>& found, const std::string& spec)
     throw DeviceError(source + " \"" + rule + "\" matches no OpenCL device (see clvr info)");
 }
 
+// $CLVR_INJECT_FAULT, a testing aid (docs/robustness.md): "build" makes every program build fail in the
+// compiler (an #error appended to the source), "launch:N" makes the N-th kernel launch fail as a driver's
+// CL_OUT_OF_RESOURCES would. Unset or empty: no fault.
+FaultInjection faultFromEnvironment()
+{
+    const char* env = std::getenv("CLVR_INJECT_FAULT");
+    if (!env || !*env)
+        return {};
+    const std::string text(env);
+    FaultInjection fault;
+    if (text == "build") {
+        fault.build = true;
+        return fault;
+    }
+    const std::string prefix = "launch:";
+    if (text.rfind(prefix, 0) == 0 && text.size() > prefix.size() && text.size() <= prefix.size() + 9 &&
+        std::all_of(text.begin() + prefix.size(), text.end(), [](unsigned char c) { return std::isdigit(c); })) {
+        fault.launch = std::stoull(text.substr(prefix.size()));
+        if (fault.launch > 0)
+            return fault;
+    }
+    throw InputError("CLVR_INJECT_FAULT \"" + text + "\": want \"build\" or \"launch:N\" with N >= 1");
+}
+
 // $CLVR_DEVICE_MEMORY_LIMIT: bytes with an optional K, M or G suffix (powers of 1024); 0 when unset.
 cl_ulong memoryLimitFromEnvironment()
 {
@@ -169,6 +193,7 @@ Device::Device(const std::string& spec)
         listing_.globalMemBytes = std::min(listing_.globalMemBytes, limit);
         listing_.maxAllocBytes = std::min(listing_.maxAllocBytes, limit);
     }
+    fault_ = faultFromEnvironment();
     device_ = chosen.device;
     context_ = cl::Context(device_);
     queue_ = cl::CommandQueue(context_, device_, CL_QUEUE_PROFILING_ENABLE);
@@ -186,7 +211,8 @@ cl::Program Device::program(std::string_view label, std::string_view source, std
     if (auto it = programs_.find(key); it != programs_.end())
         return it->second;
 
-    cl::Program program(context_, std::string(source));
+    cl::Program program(context_, fault_.build ? std::string(source) + "\n#error CLVR_INJECT_FAULT=build\n"
+                                                : std::string(source));
     const auto start = std::chrono::steady_clock::now();
     cl_int status = CL_SUCCESS;
     try {
@@ -241,6 +267,9 @@ cl::Kernel Device::kernel(std::string_view file, std::string_view kernelName, st
 
 void Device::enqueue(std::string name, const cl::Kernel& kernel, const cl::NDRange& global, const cl::NDRange& local)
 {
+    if (fault_.launch && ++launches_ == fault_.launch)
+        throw DeviceError("launching \"" + name + "\" failed: CL_OUT_OF_RESOURCES (injected by CLVR_INJECT_FAULT=launch:" +
+                          std::to_string(fault_.launch) + ")");
     cl::Event event;
     try {
         queue_.enqueueNDRangeKernel(kernel, cl::NullRange, global, local, nullptr, &event);

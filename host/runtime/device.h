@@ -43,6 +43,12 @@ struct PassTime {
     double ms = 0.0;   // device time from the profiling events
 };
 
+// Faults a test can inject through $CLVR_INJECT_FAULT (device.cpp): a failing build, a failing N-th launch.
+struct FaultInjection {
+    bool build = false;
+    std::uint64_t launch = 0;  // 1-based; 0: none
+};
+
 class Device {
 public:
     // Opens the device chooseDevice(spec) names, with a profiling in-order queue. $CLVR_DEVICE_MEMORY_LIMIT
@@ -123,6 +129,8 @@ private:
     std::vector<std::string> warnings_;
     double compileMs_ = 0.0;
     std::optional<std::uint64_t> loopIterationCap_;
+    FaultInjection fault_;
+    std::uint64_t launches_ = 0;
 };
 
 }  // namespace clvr
