@@ -276,6 +276,15 @@ TEST(Scene, TransferFunctionWithOnePoint)
                        "two control points");
 }
 
+// Bounded work (issue 15): kernels walk the control points a segment crosses, so their count is bounded.
+TEST(Scene, TransferFunctionWithTooManyPoints)
+{
+    std::string points = "transfer_function.points=[";
+    for (int i = 0; i <= 4096; ++i)
+        points += (i ? ", [" : "[") + std::to_string(i) + ", 1,1,1, 1]";
+    EXPECT_SCENE_ERROR(errorOf(kMinimal, {points + "]"}), "transfer_function", "4097 control points, at most 4096");
+}
+
 TEST(Scene, TransferFunctionUnsorted)
 {
     EXPECT_SCENE_ERROR(errorOf(kMinimal, {"transfer_function.points=[[1, 0,0,0, 0], [0, 1,1,1, 1]]"}),

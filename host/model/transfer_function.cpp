@@ -13,6 +13,11 @@ TransferFunction::TransferFunction(std::vector<ControlPoint> points) : points_(s
 {
     if (points_.size() < 2)
         throw InputError("transfer_function: needs at least two control points, got " + std::to_string(points_.size()));
+    // Kernels walk the control points a ray segment crosses (harc splits every segment at them): the
+    // bound keeps a hostile scene from making each sample cost millions of steps.
+    if (points_.size() > kMaxControlPoints)
+        throw InputError("transfer_function: " + std::to_string(points_.size()) + " control points, at most " +
+                         std::to_string(kMaxControlPoints));
     for (std::size_t i = 0; i < points_.size(); ++i) {
         const ControlPoint& p = points_[i];
         const std::string where = "transfer_function: point " + std::to_string(i);

@@ -5,6 +5,7 @@
 
 #include <glm/glm.hpp>
 
+#include <cstddef>
 #include <vector>
 
 namespace clvr {
@@ -15,11 +16,13 @@ struct ControlPoint {
     double tau = 0.0;       // extinction per world unit
 };
 
+inline constexpr std::size_t kMaxControlPoints = 4096;
+
 class TransferFunction {
 public:
     TransferFunction() = default;
-    // Throws InputError for fewer than two points, unsorted (or repeated) s, NaN or infinite values,
-    // colors outside [0,1] or negative tau.
+    // Throws InputError for fewer than two or more than kMaxControlPoints points, unsorted (or repeated)
+    // s, NaN or infinite values, colors outside [0,1] or negative tau.
     explicit TransferFunction(std::vector<ControlPoint> points);
 
     const std::vector<ControlPoint>& points() const { return points_; }
