@@ -47,7 +47,7 @@ for t in "${targets[@]}"; do
     result=ok
     if ((rc != 0)); then
         result="FAILED (exit $rc): $(grep -m1 -E '^==[0-9]+==ERROR|^SUMMARY|ERROR: libFuzzer|runtime error' "$dir/log" || true)"
-        result+=" artifact: $(ls "$dir"/{crash,leak,timeout,oom,slow-unit}-* 2>/dev/null | head -1) log: $dir/log"
+        result+=" artifact: $(ls "$dir"/{crash,leak,timeout,oom,slow-unit}-* 2>/dev/null | head -1 || true) log: $dir/log"
         failed+=("$t")
     fi
     printf '%-18s %12s %8s %6s %6s %6s  %s\n' "$t" "$(stat number_of_executed_units)" \
