@@ -332,6 +332,21 @@ TEST(MeshIo, MalformedTetgen)
     expectError([&] { clvr::readTetgen(dir / "t.ele"); }, "no node attributes", "t.node");
 }
 
+// The smallest long long as a point or neighbor number of a 1-based file was subtracted from before it
+// was compared (signed overflow, found by fuzz_tetgen; fuzz/regressions/tetgen): now out of range.
+TEST(MeshIo, TetgenSmallestNumberIsOutOfRange)
+{
+    TempDir dir;
+    writeFile(dir / "a.node", "5 3 1 0\n1 0 0 0 0\n2 1 0 0 1\n3 0 1 0 2\n4 0 0 1 3\n5 1 1 1 4\n");
+    writeFile(dir / "a.ele", "2 4 0\n1 1 2 3 -9223372036854775808\n2 2 3 5 4\n");
+    expectError([&] { clvr::readTetgen(dir / "a.ele"); },
+                "tetrahedron 0 has point index -9223372036854775808, out of range (points are numbered 1 to 5)",
+                "a.ele line 2");
+    writeFile(dir / "a.ele", "2 4 0\n1 1 2 3 4\n2 2 3 5 4\n");
+    writeFile(dir / "a.neigh", "2 4\n1 -9223372036854775808 -1 -1 -1\n2 -1 -1 1 -1\n");
+    expectError([&] { clvr::readTetgen(dir / "a.ele"); }, "neighbor -9223372036854775808 out of range", "a.neigh line 2");
+}
+
 TEST(MeshIo, MalformedVtk)
 {
     TempDir dir;

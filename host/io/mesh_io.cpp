@@ -761,12 +761,12 @@ TetMesh readTetgen(const fs::path& path, const std::string& scalar)
             throw InputError(ele.where() + ": a tetrahedron line needs a number and " + std::to_string(per) + " points");
         glm::uvec4 c;
         for (int k = 0; k < 4; ++k) {
-            const long long id = ele.integer(tok[1 + k], "point index") - firstNumber;
-            if (id < 0 || static_cast<std::uint64_t>(id) >= n)
+            const long long number = ele.integer(tok[1 + k], "point index");  // compared before subtracting: no overflow
+            if (number < firstNumber || static_cast<std::uint64_t>(number - firstNumber) >= n)
                 throw InputError(ele.where() + ": tetrahedron " + std::to_string(t) + " has point index " +
-                                 std::to_string(id + firstNumber) + ", out of range (points are numbered " +
+                                 std::to_string(number) + ", out of range (points are numbered " +
                                  std::to_string(firstNumber) + " to " + std::to_string(firstNumber + static_cast<long long>(n) - 1) + ")");
-            c[k] = static_cast<std::uint32_t>(id);
+            c[k] = static_cast<std::uint32_t>(number - firstNumber);
         }
         mesh.tets[t] = c;
     }
@@ -798,7 +798,7 @@ TetMesh readTetgen(const fs::path& path, const std::string& scalar)
                 mesh.neighbors[t][k] = -1;
                 continue;
             }
-            if (id - firstNumber < 0 || static_cast<std::uint64_t>(id - firstNumber) >= nt)
+            if (id < firstNumber || static_cast<std::uint64_t>(id - firstNumber) >= nt)
                 throw InputError(neigh.where() + ": neighbor " + std::to_string(id) + " out of range (tetrahedra are numbered " +
                                  std::to_string(firstNumber) + " to " + std::to_string(firstNumber + static_cast<long long>(nt) - 1) +
                                  ", -1 for none)");

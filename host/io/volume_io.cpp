@@ -310,7 +310,12 @@ struct NrrdHeader {
     std::optional<std::string> origin;
     long long byteSkip = 0;
     long long lineSkip = 0;
-    std::vector<fs::path> dataFiles;  // empty: data attached after the header
+    std::vector<fs::path> dataFiles;  // one name or LIST; empty: data attached, or a format (below)
+    // "data file: <format> <min> <max> <step>": file n is the format expanded for min + n * step, when it
+    // is read. Expanding all 2^20 names a 60-byte header may ask for took seconds before anything was checked.
+    std::string dataFileFormat;
+    long long formatFirst = 0, formatStep = 1;
+    std::uint64_t formatCount = 0;
     std::uint64_t dataOffset = 0;     // attached: first byte after the blank line
 };
 
@@ -590,14 +595,32 @@ NrrdHeader readNrrdHeader(const fs::path& path)
             const std::uint64_t count = static_cast<std::uint64_t>((*hi - *lo) / *step) + 1;
             if (count > (1u << 20))
                 throw InputError(source + ": data file " + shown(*dataFileValue) + " names too many files");
-            for (std::uint64_t n = 0; n < count; ++n)
-                h.dataFiles.push_back(relative(expandDataFileFormat(source, words[0], *lo + static_cast<long long>(n) * *step)));
+            expandDataFileFormat(source, words[0], *lo);  // the format is checked here, expanded when read
+            h.dataFileFormat = words[0];
+            h.formatFirst = *lo;
+            h.formatStep = *step;
+            h.formatCount = count;
         } else {
             throw InputError(source + ": data file " + shown(*dataFileValue) +
                              " is not one name, \"<format> <min> <max> <step> [<subdim>]\" or \"LIST\"");
         }
     }
     return h;
+}
+
+std::uint64_t dataFileCount(const NrrdHeader& h)
+{
+    return h.dataFiles.size() + h.formatCount;
+}
+
+// Data file f of a detached header (f < dataFileCount(h)).
+fs::path dataFile(const NrrdHeader& h, std::uint64_t f)
+{
+    if (h.formatCount == 0)
+        return h.dataFiles[f];
+    const fs::path name = expandDataFileFormat(h.path.string(), h.dataFileFormat,
+                                               h.formatFirst + static_cast<long long>(f) * h.formatStep);
+    return name.is_absolute() ? name : h.path.parent_path() / name;
 }
 
 // Parses "(a,b,c)" with exactly three components.
@@ -831,12 +854,12 @@ Volume readNrrd(const fs::path& path)
 
     const std::size_t elem = scalarSize(*h.type);
     const std::string sizes = dimsText(*h.sizes) + " x " + std::to_string(elem) + " bytes";
-    if (h.dataFiles.empty()) {
+    if (dataFileCount(h) == 0) {
         const std::string sizeText = "header says " + sizes + " = " + std::to_string(count * elem) + " bytes";
         readNrrdData(h, path, h.dataOffset, count, v.values, v.dims, sizeText);
     } else {
         // Several files share the samples equally, in order (slices of the slowest axis, usually).
-        const std::uint64_t files = h.dataFiles.size();
+        const std::uint64_t files = dataFileCount(h);
         if (count % files != 0)
             throw InputError(source + ": " + std::to_string(count) + " grid points do not split evenly into " +
                              std::to_string(files) + " data files");
@@ -850,7 +873,7 @@ Volume readNrrd(const fs::path& path)
         bool plausible = *h.encoding != NrrdEncoding::Ascii;
         for (std::uint64_t f = 0; f < files && plausible; ++f) {
             std::error_code ec;
-            const std::uint64_t fileBytes = fs::file_size(h.dataFiles[f], ec);
+            const std::uint64_t fileBytes = fs::file_size(dataFile(h, f), ec);
             plausible = !ec && (*h.encoding == NrrdEncoding::Raw ? fileBytes >= per * elem
                                                                   : gzipCanHold(fileBytes, per * elem));
         }
@@ -859,7 +882,7 @@ Volume readNrrd(const fs::path& path)
             v.values.reserve(static_cast<std::size_t>(count));
         }
         for (std::uint64_t f = 0; f < files; ++f)
-            readNrrdData(h, h.dataFiles[f], 0, per, v.values, v.dims, sizeText);
+            readNrrdData(h, dataFile(h, f), 0, per, v.values, v.dims, sizeText);
     }
     v.validate();
     return v;
