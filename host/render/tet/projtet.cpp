@@ -225,6 +225,7 @@ private:
     raster::Framebuffer fb_;
     raster::FragmentProgram program_;
     cl::Kernel finish_;
+    std::vector<raster::Vertex> vertices_;  // the frame's triangles, 3 vertices each
     std::uint64_t residentBytes_ = 0;
 };
 
@@ -280,8 +281,8 @@ Image4f ProjtetRenderer::render(FrameStats& stats)
         inFront[p] = camera_.parallel || c.w > nearZ;
         ndc[p] = glm::dvec2(glm::vec2(static_cast<float>(c.x / c.w), static_cast<float>(c.y / c.w)));
     }
-    std::vector<raster::Vertex> vertices;
-    vertices.reserve(sorted.order.size() * 12);
+    std::vector<raster::Vertex>& vertices = vertices_;  // kept: its pages are touched once, not every frame
+    vertices.clear();
     std::uint64_t class1 = 0, class2 = 0, degenerate = 0, nearCells = 0;
     for (const std::uint32_t t : sorted.order) {
         const glm::uvec4 tet = tets_[t];
