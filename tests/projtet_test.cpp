@@ -304,7 +304,9 @@ TEST(ProjtetMeshes, BluntfinMatchesExactReference)
                     static_cast<unsigned long long>(stats.extra["cells_class2"].get<std::uint64_t>()));
         const Scene centroidScene = makeScene(camera, tf, 64, json{{"order", "centroid"}});
         const Image4f centroid = makeProjtetRenderer(test::device(), centroidScene, mesh, topology)->render(stats);
-        printError(what + ", centroid order", centroid, expected);
+        const test::ImageError c = printError(what + ", centroid order", centroid, expected);
+        const test::ImageError e = test::imageError(image, expected);
+        EXPECT_GT(worst(c.maxAbs), 10.0 * worst(e.maxAbs)) << what;  // measured: 1.9e-5 vs 7.4e-3 (perspective)
     }
 }
 

@@ -171,6 +171,8 @@ ProjectedTet classifyProjection(const std::array<glm::dvec2, 4>& p)
         r.thickVertex = i;
         r.triangles = {{{i, o[0], o[1]}, {i, o[1], o[2]}, {i, o[2], o[0]}, {0, 0, 0}}};
         r.triangleCount = 3;
+        r.outer = {o[0], o[1], o[2], 0};
+        r.outerCount = 3;
         return r;
     }
     // Class 2: the diagonals (a, b) and (c, d) of a convex quadrilateral cross at the thick vertex.
@@ -185,6 +187,8 @@ ProjectedTet classifyProjection(const std::array<glm::dvec2, 4>& p)
         r.thick = p[a] + (o3 / (o3 - o4)) * (p[b] - p[a]);
         r.triangles = {{{4, a, c}, {4, c, b}, {4, b, d}, {4, d, a}}};
         r.triangleCount = 4;
+        r.outer = {a, c, b, d};
+        r.outerCount = 4;
         return r;
     }
     return r;  // no area: nothing to draw
@@ -193,6 +197,11 @@ ProjectedTet classifyProjection(const std::array<glm::dvec2, 4>& p)
 // ---- the renderer -----------------------------------------------------------------------------------
 
 namespace {
+
+// Conservative coverage: each silhouette grows by this much (pixels; snapping moves corners 1/512 at
+// most), its corners by at most kMaxMiterPixels.
+constexpr double kGrowPixels = 1.0 / 16.0;
+constexpr double kMaxMiterPixels = 1.0;
 
 std::string fragmentSource()
 {
@@ -281,6 +290,7 @@ Image4f ProjtetRenderer::render(FrameStats& stats)
         inFront[p] = camera_.parallel || c.w > nearZ;
         ndc[p] = glm::dvec2(glm::vec2(static_cast<float>(c.x / c.w), static_cast<float>(c.y / c.w)));
     }
+    const glm::dvec2 pixelScale(0.5 * image_.width, 0.5 * image_.height);  // NDC to pixels
     std::vector<raster::Vertex>& vertices = vertices_;  // kept: its pages are touched once, not every frame
     vertices.clear();
     std::uint64_t class1 = 0, class2 = 0, degenerate = 0, nearCells = 0;
@@ -317,10 +327,37 @@ Image4f ProjtetRenderer::render(FrameStats& stats)
             continue;
         }
         (pt.kind == ProjectedTet::Kind::Class1 ? class1 : class2)++;
+        // Conservative coverage: the silhouette's corners moved outwards by kGrowPixels (miter, capped),
+        // so that no pixel centre the cell's own ray meets is lost to the raster stage's 1/256-pixel
+        // snapping at a silhouette edge; the fragment's exact ray-cell intersection makes the extra
+        // fragments empty (discarded), so nothing is counted twice.
+        std::array<glm::dvec2, 4> corner = q;
+        double signedArea = 0.0;
+        for (int k = 0; k < pt.outerCount; ++k) {
+            const glm::dvec2 a = q[pt.outer[k]] * pixelScale, b = q[pt.outer[(k + 1) % pt.outerCount]] * pixelScale;
+            signedArea += a.x * b.y - a.y * b.x;
+        }
+        const double sigma = signedArea >= 0.0 ? 1.0 : -1.0;
+        auto outward = [&](int from, int to) {
+            const glm::dvec2 e = (q[to] - q[from]) * pixelScale;
+            const double len = glm::length(e);
+            return len > 0.0 ? sigma * glm::dvec2(e.y, -e.x) / len : glm::dvec2(0.0);
+        };
+        for (int k = 0; k < pt.outerCount; ++k) {
+            const int v = pt.outer[k];
+            const int prev = pt.outer[(k + pt.outerCount - 1) % pt.outerCount], next = pt.outer[(k + 1) % pt.outerCount];
+            const glm::dvec2 n0 = outward(prev, v), n1 = outward(v, next);
+            glm::dvec2 offset = kGrowPixels * (n0 + n1) / std::max(1.0 + glm::dot(n0, n1), 1e-3);
+            const double length = glm::length(offset);
+            if (length > kMaxMiterPixels)
+                offset *= kMaxMiterPixels / length;
+            corner[v] = q[v] + offset / pixelScale;
+        }
         const glm::vec4 thick(static_cast<float>(pt.thick.x), static_cast<float>(pt.thick.y), 0.0f, 1.0f);
         for (int k = 0; k < pt.triangleCount; ++k)
-            for (const int corner : pt.triangles[k])
-                vertex(corner == 4 ? thick : glm::vec4(static_cast<float>(q[corner].x), static_cast<float>(q[corner].y), 0.0f, 1.0f));
+            for (const int c : pt.triangles[k])
+                vertex(c == 4 ? thick
+                              : glm::vec4(static_cast<float>(corner[c].x), static_cast<float>(corner[c].y), 0.0f, 1.0f));
     }
     const double projectMs = msSince(t0);
 

@@ -75,6 +75,10 @@ struct ProjectedTet {
     // Triangles as corner indices: 0..3 the vertices, 4 the thick vertex (Class2).
     std::array<std::array<int, 3>, 4> triangles{};
     int triangleCount = 0;
+    // The silhouette's corners in cyclic order (3 for Class1, 4 for Class2): the renderer moves them
+    // outwards by a fraction of a pixel (conservative coverage, docs/projtet.md).
+    std::array<int, 4> outer{};
+    int outerCount = 0;
 };
 ProjectedTet classifyProjection(const std::array<glm::dvec2, 4>& p);
 
