@@ -1,6 +1,7 @@
 /* kernels/projtet_params.h — the uniforms of kernels/projtet.cl's fragment program, shared by host
- * (host/render/tet/projtet.cpp) and device; sizes and offsets probed by tests/layout_test.cpp. float4s
- * only: they travel as raster::FragmentProgram::uniforms (host/render/fragment_uniforms.h). */
+ * (host/render/tet/projtet.cpp) and device. float4s only: they travel as raster::FragmentProgram::uniforms
+ * (host/render/fragment_uniforms.h), so host and device agree by construction; the host static_asserts
+ * the size (not in tests/layout_test.cpp's probe, which covers by-value kernel arguments). */
 #ifndef CLVR_PROJTET_PARAMS_H
 #define CLVR_PROJTET_PARAMS_H
 

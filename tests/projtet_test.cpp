@@ -187,6 +187,24 @@ TEST(Projtet, NonConvexBoxesMatchExactReference)
         }
 }
 
+// The camera inside the mesh: cells with a point at or behind the near plane are drawn as their front
+// faces in clip space (clipped by the raster stage); only the ray part in front of the eye counts.
+TEST(Projtet, CameraInsideTheMesh)
+{
+    const TetMesh mesh = boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, 4}}, {0.6, 0.25, -0.4}, 0.35);
+    const TransferFunction tf = test::rampTransferFunction();
+    const Camera camera = perspective({0.55, 0.45, 0.8}, {0.5, 0.5, 0.0}, 60.0);
+    const Scene scene = makeScene(camera, tf, 64);
+    FrameStats stats;
+    const Image4f image = renderProjtet(scene, mesh, &stats);
+    const Image4d expected = tetReferenceIntegral(mesh, tf, camera, scene.image);
+    printError("camera inside", image, expected);
+    std::printf("camera inside: %llu cells at the near plane\n",
+                static_cast<unsigned long long>(stats.extra["cells_near_plane"].get<std::uint64_t>()));
+    EXPECT_GT(stats.extra["cells_near_plane"].get<std::uint64_t>(), 0u);
+    EXPECT_TRUE(test::imagesNear(image, expected, {.maxAbs = 2e-3, .meanAbs = 2e-4}));
+}
+
 TEST(Projtet, AgreesWithHarc)
 {
     const TetMesh mesh = boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, 3}}, {0.5, -0.3, 0.45}, 0.2);

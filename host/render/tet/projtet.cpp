@@ -271,7 +271,9 @@ Image4f ProjtetRenderer::render(FrameStats& stats)
 
     // Projection: every point to normalized device coordinates (double, then float as the raster stage
     // gets them, so neighbouring cells share their silhouette edges bit for bit). A cell with a point at
-    // or behind the near plane is drawn as its front faces in clip space instead (the raster stage clips).
+    // or behind the near plane is drawn as its back faces in clip space instead (the raster stage clips):
+    // every ray that meets such a cell in front of the eye leaves it through a back face in front of the
+    // eye, also when the eye is inside the cell (which has no front face).
     t0 = std::chrono::steady_clock::now();
     const glm::dvec3 forward = camera_.forward();
     double depthMax = 0.0;
@@ -314,7 +316,7 @@ Image4f ProjtetRenderer::render(FrameStats& stats)
                 glm::dvec3 normal = glm::cross(b - a, c - a);
                 if (glm::dot(normal, points_[tet[f]] - a) > 0.0)
                     normal = -normal;  // out of the cell
-                if (glm::dot(normal, camera_.position - a) > 0.0)
+                if (glm::dot(normal, camera_.position - a) <= 0.0)  // faces away: a ray's exit, beyond the eye
                     for (const int k : corner)
                         vertex(clip[k]);
             }
