@@ -10,6 +10,7 @@
 #include "clvr_common.h"
 #include "harc_params.h"
 #include "ray.h"
+#include "segment_integral.h"
 
 /* Per tetrahedron, 5 float4 = 80 bytes (Table 1 of seeds/001 uses 96), host/render/tet/harc.h:
  *   [0..2] barycentric planes (h_i, k_i), i = 0, 1, 2: b_i(x) = dot(h_i, x) + k_i is 1 at vertex i and
@@ -24,107 +25,6 @@
 #define HARC_INTEGRATION_PARTIAL 0
 #define HARC_INTEGRATION_AVERAGE 1
 #define HARC_INTEGRATION_FULL 2
-
-/* ψ of Eq. 4 from the γ-table of host/optics/psi_table.h (bilinear; same arithmetic as PsiTable::lookup). */
-float harc_psi(global const float* psi, const int n, float tau_l_front, float tau_l_back)
-{
-    const float f = fmin(tau_l_front, 1e30f), b = fmin(tau_l_back, 1e30f);
-    const float n1 = (float)(n - 1);
-    const float x = f / (1.0f + f) * n1, y = b / (1.0f + b) * n1;
-    const int i = min((int)x, n - 2), j = min((int)y, n - 2);
-    const float fx = x - (float)i, fy = y - (float)j;
-    global const float* r0 = psi + j * n + i;
-    global const float* r1 = r0 + n;
-    const float a = r0[0] + fx * (r0[1] - r0[0]);
-    const float c = r1[0] + fx * (r1[1] - r1[0]);
-    return a + fy * (c - a);
-}
-
-/* One linear piece of length l with (C, τ) = cf at the front and cb at the back (Eq. 2, I_0 = 0):
- * composited under what is in front: color += T I, T *= ζ. */
-void harc_piece(global const float* psi, const int psi_n, const float4 cf, const float4 cb, const float l,
-                float3* color, float* transmittance)
-{
-    const float tf = cf.w * l, tb = cb.w * l;
-    const float zeta = exp(-0.5f * (tf + tb));          /* Eq. 3 */
-    const float p = harc_psi(psi, psi_n, tf, tb);        /* Eq. 4 */
-    const float3 c = cb.xyz * (p - zeta) + cf.xyz * (1.0f - p);  /* Eq. 2 */
-    *color += *transmittance * c;
-    *transmittance *= zeta;
-}
-
-/* Transfer function (kernels/transfer_function.h's layout: s, then values, then slopes) at x, given
- * k = the number of control points <= x (0 .. n). */
-float4 harc_tf_at(global const float* tf, const int n, const int k, const float x)
-{
-    global const float* value = tf + ((n + 3) & ~3);
-    global const float* slope = value + 4 * n;
-    if (k == 0)
-        return vload4(0, value);
-    if (k == n)
-        return vload4(n - 1, value);
-    return vload4(k - 1, value) + (x - tf[k - 1]) * vload4(k - 1, slope);
-}
-
-/* The number of control points s_i <= x (upper bound), by bisection. */
-int harc_upper(global const float* tf, const int n, const float x)
-{
-    int lo = 0, hi = n;
-    while (lo < hi) {
-        const int mid = (lo + hi) >> 1;
-        if (tf[mid] <= x)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo;
-}
-
-/* The segment from s_f (front, ray parameter 0) to s_b (back, length l) inside one tetrahedron,
- * split at every control point strictly between s_f and s_b (Figure 5's s_iso / next_s_iso: the
- * first control point past the current s in the direction of travel; searching with a strict
- * inequality from the current s returns next_s_iso exactly where Figure 6 has to step past
- * s_f == s_iso). Returns the number of pieces. */
-int harc_segment(global const float* tf, const int n, global const float* psi, const int psi_n, const float s_f,
-                 const float s_b, const float l, float3* color, float* transmittance)
-{
-    const int k_f = harc_upper(tf, n, s_f);
-    float4 c_front = harc_tf_at(tf, n, k_f, s_f);
-    if (!(s_b != s_f)) {  /* s constant along the ray: one piece with constant C and τ */
-        harc_piece(psi, psi_n, c_front, c_front, l, color, transmittance);
-        return 1;
-    }
-    const float inv_ds = 1.0f / (s_b - s_f);
-    global const float* value = tf + ((n + 3) & ~3);
-    float lambda_front = 0.0f;
-    int pieces = 0;
-    if (s_b > s_f) {
-        for (int k = k_f; k < n && tf[k] < s_b; ++k) {  /* tf[k] > s_f: the next iso-surface ahead */
-            const float lambda = l * ((tf[k] - s_f) * inv_ds);
-            const float4 c_iso = vload4(k, value);
-            harc_piece(psi, psi_n, c_front, c_iso, lambda - lambda_front, color, transmittance);
-            c_front = c_iso;
-            lambda_front = lambda;
-            ++pieces;
-        }
-    } else {
-        /* Points equal to s_f are at the front end, not ahead: start below them. */
-        int k = k_f - 1;
-        while (k >= 0 && tf[k] >= s_f)
-            --k;
-        for (; k >= 0 && tf[k] > s_b; --k) {
-            const float lambda = l * ((tf[k] - s_f) * inv_ds);
-            const float4 c_iso = vload4(k, value);
-            harc_piece(psi, psi_n, c_front, c_iso, lambda - lambda_front, color, transmittance);
-            c_front = c_iso;
-            lambda_front = lambda;
-            ++pieces;
-        }
-    }
-    const float4 c_back = harc_tf_at(tf, n, harc_upper(tf, n, s_b), s_b);
-    harc_piece(psi, psi_n, c_front, c_back, l - lambda_front, color, transmittance);
-    return pieces + 1;
-}
 
 /* The plain average-of-endpoints segment (the comparison of issue 3 part 6): constant C and τ, the
  * means of their values at s_f and s_b: C (1 - exp(-τ l)). */

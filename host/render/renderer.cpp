@@ -5,6 +5,7 @@
 #include "host/runtime/errors.h"
 #include "host/render/grid/blend.h"
 #include "host/render/tet/harc.h"
+#include "host/render/tet/projtet.h"
 #include "host/render/tet/tetiso.h"
 #include "host/render/tet/tetslice.h"
 #include "host/render/grid/iso3d.h"
@@ -65,7 +66,8 @@ const std::vector<TechniqueInfo>& techniques()
 {
     static const std::vector<TechniqueInfo> all = {slice3dTechnique(), stack2dTechnique(), iso3dTechnique(),
                                                    planesTechnique(),  blendTechnique(),   sphericalTechnique(),
-                                                   harcTechnique(),    tetsliceTechnique(), tetisoTechnique()};
+                                                   harcTechnique(),    tetsliceTechnique(), tetisoTechnique(),
+                                                   projtetTechnique()};
     return all;
 }
 

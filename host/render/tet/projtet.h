@@ -1,0 +1,90 @@
+// host/render/tet/projtet.h — cell projection of tetrahedral meshes in visibility order: each cell's
+// projected silhouette split into 3 or 4 triangles around its thick vertex (Shirley & Tuchman 1990),
+// the cells sorted back to front on the host (MPVONC over the face adjacency, Williams 1992, or the
+// centre-distance sort), all drawn in that order through the raster stage (raster/rasterizer.h) with
+// kernels/projtet.cl's fragment program: the exact ray segment of the fragment's own ray through its
+// cell, integrated with harc's partial pre-integration (kernels/segment_integral.h), blended
+// ONE, ONE_MINUS_SRC_ALPHA. docs/projtet.md.
+#pragma once
+
+#include "host/model/camera.h"
+#include "host/model/mesh.h"
+#include "host/render/renderer.h"
+
+#include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace clvr {
+
+struct ProjtetOptions {
+    // "mpvonc": topological sort of the adjacency's in-front-of relation; "centroid": the cells'
+    // centres sorted by distance from the eye (depth along the view for parallel cameras).
+    enum class Order { Mpvonc, Centroid };
+    Order order = Order::Mpvonc;
+};
+
+// Its registry entry (host/render/renderer.h).
+TechniqueInfo projtetTechnique();
+
+// Reads the scene's "options" for projtet: "order" ("mpvonc" | "centroid"). InputError naming the key
+// for unknown keys, wrong types and values.
+ProjtetOptions parseProjtetOptions(const nlohmann::json& options);
+
+// The view-independent part of the visibility order: per interior face its two cells and its plane
+// (outward normal of `a`, offset: dot(normal, x) = offset on the face), and the cells' centres.
+class VisibilitySorter {
+public:
+    VisibilitySorter(const TetMesh& mesh, const TetTopology& topology);
+
+    struct Result {
+        std::vector<std::uint32_t> order;  // every cell once, back to front
+        std::uint64_t cyclesBroken = 0;    // cells emitted before all cells behind them (cycles)
+    };
+    // Back to front for `camera`. Mpvonc: Kahn's topological sort of "a is behind b" across each
+    // interior face (the side of the face's plane the eye is on; the view direction for parallel
+    // cameras), the ready cell farthest from the eye first (exact for convex meshes; for non-convex
+    // ones, where cells that share no face can still overlap, the distance priority is a heuristic,
+    // docs/projtet.md). When no cell is ready (a cycle), the farthest cell left is emitted and counted.
+    // Centroid: the centres' distances, farthest first.
+    Result sort(const Camera& camera, ProjtetOptions::Order order) const;
+
+private:
+    struct InnerFace {
+        std::uint32_t a, b;
+        glm::dvec3 normal;  // out of a
+        double offset;
+    };
+    std::vector<InnerFace> faces_;
+    std::vector<std::array<std::int32_t, 4>> faceOf_;  // per cell, its inner faces' indices (-1: none)
+    std::vector<glm::dvec3> centres_;
+};
+
+// Shirley-Tuchman classes of a projected tetrahedron (2D points, any orientation): Class1 one vertex
+// inside the triangle of the other three (the thick vertex: 3 triangles), Class2 the two diagonals of a
+// convex quadrilateral cross (the thick vertex is their crossing: 4 triangles), Degenerate: no area.
+struct ProjectedTet {
+    enum class Kind { Class1, Class2, Degenerate };
+    Kind kind = Kind::Degenerate;
+    glm::dvec2 thick{0.0};  // the thick vertex
+    int thickVertex = -1;   // Class1: which vertex; Class2: -1
+    // Triangles as corner indices: 0..3 the vertices, 4 the thick vertex (Class2).
+    std::array<std::array<int, 3>, 4> triangles{};
+    int triangleCount = 0;
+    // The silhouette's corners in cyclic order (3 for Class1, 4 for Class2): the renderer moves them
+    // outwards by a fraction of a pixel (conservative coverage, docs/projtet.md).
+    std::array<int, 4> outer{};
+    int outerCount = 0;
+};
+ProjectedTet classifyProjection(const std::array<glm::dvec2, 4>& p);
+
+// Renderer for "projtet" on a mesh that checkMesh() has normalized. InputError for bad options, an
+// empty mesh or 2^24 cells or more (cell ids travel as two 12-bit halves in a float attribute).
+std::unique_ptr<Renderer> makeProjtetRenderer(Device& device, const Scene& scene, const TetMesh& mesh,
+                                              const TetTopology& topology);
+
+}  // namespace clvr

@@ -1,0 +1,60 @@
+// kernels/projtet.cl — cell projection in visibility order (Shirley & Tuchman 1990; Williams 1992),
+// the fragment program of its one draw, appended after kernels/raster.cl (host/render/tet/projtet.h).
+// The projected triangles of a tetrahedron only give coverage (its silhouette, once); each fragment then
+// intersects its own ray with the tetrahedron's four planes, so (s_f, s_b, l) are exact for perspective
+// and parallel cameras alike, and integrates the segment with harc's partial pre-integration
+// (kernels/segment_integral.h: ψ table, split at the transfer function's control points). Blending
+// ONE, ONE_MINUS_SRC_ALPHA back to front composites the segments.
+#include "projtet_params.h"
+
+#ifdef CLVR_PROJTET_FRAGMENT
+#include "segment_integral.h"
+
+/* Per tetrahedron, kernels/harc.cl's 5 float4 (host/render/tet/harc.h packHarcTets): three barycentric
+ * planes (h_i, k_i), the fourth 1 minus their sum, the gradient and scalar term; the adjacency is unused. */
+#define PROJTET_TET_FLOAT4S 5
+
+/* attr[0] = (tet id low 12 bits, tet id high 12 bits, 0, 0), the same at every corner: interpolated
+ * constants within a few ulps of integers below 2^12. buffer[0] the tetrahedra, buffer[1] the transfer
+ * function (transfer_function.h layout), buffer[2] the ψ table. uniforms: ClProjtetUniforms.
+ * color = the segment's premultiplied (I, 1 - T), composited under nothing (I_0 = 0, T_0 = 1). */
+int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* color)
+{
+    constant ClProjtetUniforms* u = (constant ClProjtetUniforms*)r->uniforms;
+    const ClCamera cam = u->camera;
+    const float4 counts = u->counts;
+    const uint t = (uint)rint(f->attr[0].x) + ((uint)rint(f->attr[0].y) << 12);
+    global const float* tet = r->buffer[0] + (size_t)t * (4 * PROJTET_TET_FLOAT4S);
+    const float4 p0 = vload4(0, tet), p1 = vload4(1, tet), p2 = vload4(2, tet), grad = vload4(3, tet);
+    const float4 p3 = (float4)(-(p0.xyz + p1.xyz + p2.xyz), 1.0f - (p0.w + p1.w + p2.w));
+
+    /* The ray through the pixel centre, |d| = 1, as harc's (kernels/ray.h). */
+    float3 e, d;
+    clvr_ray_unit(clvr_ray_offset(clvr_ray_ndc(f->window, counts.xy), cam), cam, &e, &d);
+
+    /* Inside: b_i(e + λ d) = b_i(e) + λ dot(h_i, d) >= 0 for all four planes. */
+    float lambda_in = 0.0f, lambda_out = INFINITY;
+    const float4 planes[4] = {p0, p1, p2, p3};
+    for (int i = 0; i < 4; ++i) {
+        const float hd = dot(planes[i].xyz, d);
+        const float b = dot(planes[i].xyz, e) + planes[i].w;
+        if (hd > 0.0f)
+            lambda_in = fmax(lambda_in, -b / hd);
+        else if (hd < 0.0f)
+            lambda_out = fmin(lambda_out, b / -hd);
+        else if (b < 0.0f)
+            return 0;  /* parallel to face i, outside it */
+    }
+    const float l = lambda_out - lambda_in;
+    if (!(l > 0.0f))
+        return 0;  /* the pixel centre's ray misses (grazes) the cell: no light, no opacity */
+    const float s_f = dot(grad.xyz, e + lambda_in * d) + grad.w;   /* Eq. 6 */
+    const float s_b = dot(grad.xyz, e + lambda_out * d) + grad.w;
+    float3 c = (float3)(0.0f);
+    float transmittance = 1.0f;
+    harc_segment(r->buffer[1], (int)counts.z, r->buffer[2], (int)counts.w, s_f, s_b, l, &c, &transmittance);
+    *color = (float4)(c, 1.0f - transmittance);
+    return 1;
+}
+
+#endif
