@@ -2,9 +2,11 @@
 # tools/setup.sh — one command from a fresh Debian 12 machine (as root) to a result:
 #   bash tools/setup.sh          install what is missing, build, render the default scene to out/default.png
 #   bash tools/setup.sh test     install what is missing, build, run every test (ctest) on PoCL, the
-#                                kernel and image suites again on Mesa's rusticl (docs/devices.md), then
-#                                the host code's tests again under AddressSanitizer + UndefinedBehaviorSanitizer
-# Environment: JOBS (parallel build jobs, default: number of cores), CLVR_SKIP_ASAN=1 skips the sanitizer pass.
+#                                kernel and image suites again on Mesa's rusticl (docs/devices.md), each
+#                                input reader under libFuzzer for 3 s (docs/robustness.md), then the host
+#                                code's tests again under AddressSanitizer + UndefinedBehaviorSanitizer
+# Environment: JOBS (parallel build jobs, default: number of cores), CLVR_SKIP_FUZZ=1 and CLVR_SKIP_ASAN=1
+# skip the fuzzing and sanitizer passes.
 set -euo pipefail
 mode="${1:-render}"
 case "$mode" in render | test) ;; *)
@@ -50,6 +52,13 @@ echo "clvr setup: running every test (build/)"
 ctest --test-dir build --output-on-failure -j "$jobs" --timeout 900 -LE portable
 echo "clvr setup: the kernel and image suites on a second OpenCL implementation (Mesa rusticl, llvmpipe)"
 ctest --test-dir build --output-on-failure -j "$jobs" --timeout 900 -L portable
+
+if [ "${CLVR_SKIP_FUZZ:-0}" != 1 ]; then
+    echo "clvr setup: every input reader under libFuzzer for a few seconds each (build-fuzz/, clang)"
+    cmake -S . -B build-fuzz -DCLVR_FUZZ=ON -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ >/dev/null
+    cmake --build build-fuzz -j "$jobs"
+    ctest --test-dir build-fuzz --output-on-failure -j "$jobs" --timeout 300 -L fuzz
+fi
 
 if [ "${CLVR_SKIP_ASAN:-0}" != 1 ]; then
     echo "clvr setup: host code under ASan + UBSan (build-asan/)"

@@ -382,8 +382,10 @@ void checkSurface(const Plc& plc, const std::filesystem::path& path, bool closed
             }
             if (!(glm::length(area) > 1e-12 * extent * extent)) {
                 std::string numbers;
-                for (int n : polygon)
-                    numbers += " " + std::to_string(n);
+                for (int n : polygon) {
+                    numbers += ' ';
+                    numbers += std::to_string(n);
+                }
                 throw InputError(path.string() + ": facet " + std::to_string(f) + " (points" + numbers +
                                  ") has zero area: TetGen needs a surface without degenerate facets");
             }
