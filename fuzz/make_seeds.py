@@ -359,6 +359,30 @@ seed("surface", "cube.smesh", b"\3" + text("""
 
 
 # --- PLOT3D: scalar byte, grid, marker, solution (big-endian, 2x2x2)
+# --- clip surfaces: the first byte picks .off, .stl (ASCII or binary), .obj (fuzz/clip_surface.cpp)
+TET_POINTS = [(0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1)]
+TET_FACES = [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)]
+seed("clip_surface", "tetrahedron.off", b"\0" + text("""
+OFF
+4 4 0
+0 0 0
+1 0 0
+0 1 0
+0 0 1
+3 0 2 1
+3 0 1 3
+3 0 3 2
+3 1 2 3
+"""))
+seed("clip_surface", "tetrahedron.stl", b"\1" + ("solid t\n" + "".join(
+    "facet normal 0 0 0\nouter loop\n" + "".join("vertex %g %g %g\n" % TET_POINTS[i] for i in f) + "endloop\nendfacet\n"
+    for f in TET_FACES) + "endsolid t\n").encode())
+seed("clip_surface", "tetrahedron-binary.stl", b"\1" + b"\0" * 80 + struct.pack("<I", 4) + b"".join(
+    struct.pack("<3f", 0, 0, 0) + b"".join(struct.pack("<3f", *TET_POINTS[i]) for i in f) + b"\0\0" for f in TET_FACES))
+seed("clip_surface", "tetrahedron.obj", b"\2" + ("# a tetrahedron\n" + "".join("v %g %g %g\n" % p for p in TET_POINTS) +
+    "".join("f %d/1/1 %d %d\n" % tuple(i + 1 for i in f) for f in TET_FACES)).encode())
+
+
 def plot3d(scalar):
     n = 8
     xyz = struct.pack(">3i", 2, 2, 2) + struct.pack(">%df" % n, *[i & 1 for i in range(n)]) + \

@@ -184,9 +184,11 @@ ClipMeshSpec parseClipMeshSpec(const json& spec, const std::string& key)
         std::string list;
         for (const char* k : known)
             list += (list.empty() ? "" : ", ") + std::string(k);
-        for (const auto& [k, v] : spec.items())
+        for (const auto& item : spec.items()) {
+            const std::string& k = item.key();  // not a structured binding: clang 14 cannot capture one
             if (std::none_of(known.begin(), known.end(), [&](const char* n) { return k == n; }))
                 badKey(key + "." + k, "unknown key (known: " + list + ")");
+        }
     };
     if (spec.contains("file")) {
         check({"file", "scale", "translate"});
