@@ -340,6 +340,15 @@ expect_error(2 ${out} "--threads: want a whole number of threads" ${CLVR} render
 expect_error(2 ${out} "CLVR_THREADS: want a whole number of threads"
   ${CMAKE_COMMAND} -E env CLVR_THREADS=-3 ${CLVR} render -o ${out} ${TINY})
 
+# An image with nothing in it (a transfer function transparent everywhere) is written, with one note.
+expect_run(0 "clvr: note: the image is empty \\(alpha 0 in every pixel\\)" ${CLVR} render -o ${WORK}/empty.png ${SMALL}
+  --set "transfer_function.points=[[0,1,1,1,0],[1,1,1,1,0]]" --single-frame)
+expect_png(${WORK}/empty.png 64 64)
+execute_process(COMMAND ${CLVR} render -o ${WORK}/full.png ${SMALL} --single-frame ERROR_VARIABLE fullErr OUTPUT_QUIET)
+if(fullErr MATCHES "note")
+  message(FATAL_ERROR "the default scene is not empty, but: ${fullErr}")
+endif()
+
 # Meshes as they come (docs/meshes.md): an inverted tetrahedron is reoriented and a flat one dropped,
 # each counted in --stats and told in one stderr note; the image is still written.
 file(WRITE "${WORK}/fixed.node" "6 3 1 0\n0 0 0 0 0\n1 1 0 0 1\n2 0 1 0 2\n3 0 0 1 3\n4 1 1 1 4\n5 2 2 0 5\n")

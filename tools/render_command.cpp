@@ -232,6 +232,20 @@ void noteMeshRepairs(const FrameStats& stats)
               << " inverted ones (reoriented); --stats has tets_degenerate and tets_reoriented\n";
 }
 
+// One stderr note when frame 0 is empty (alpha 0 everywhere): a silent all-background image is the most
+// common surprise (the data outside the view, a transfer function transparent over the data's range,
+// Cartesian data given to spherical), and the image alone cannot say which.
+void noteEmptyImage(const Image4f& image, const std::string& technique)
+{
+    const auto& pixels = image.pixels();
+    if (pixels.empty() || std::any_of(pixels.begin(), pixels.end(), [](const glm::vec4& p) { return p.a > 0.0f; }))
+        return;
+    std::cerr << "clvr: note: the image is empty (alpha 0 in every pixel): is the data in view, and is the transfer "
+                 "function opaque anywhere in the data's range?"
+              << (technique == "spherical" ? " spherical reads the volume's axes as (phi, theta, r), docs/spherical.md" : "")
+              << '\n';
+}
+
 }  // namespace
 
 int render(const RenderOptions& options)
@@ -281,6 +295,7 @@ int render(const RenderOptions& options)
 
     progress.reset();  // the line is cleared before the summary
     noteMeshRepairs(frame0.stats);
+    noteEmptyImage(frame0.image, session.scene().technique);
 
     // 4. Stats, atomically; frame 0's figures at the top level as without --orbit.
     const FrameStats& steady = frame0.stats;
