@@ -75,7 +75,14 @@ if [ "${CLVR_SKIP_ASAN:-0}" != 1 ]; then
     export LSAN_OPTIONS="suppressions=$PWD/tests/lsan.supp:print_suppressions=0:intercept_tls_get_addr=0"
     export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
     export POCL_CACHE_DIR="$PWD/build/pocl-cache"
-    # TetsliceMeshes.* (tetslice on bluntfin, the post and the torus at up to 1,024 slices) run in the
-    # release pass only: under ASan they take a minute for host code the Tetslice.* box-grid tests run too.
-    ctest --test-dir build-asan --output-on-failure -j "$jobs" --timeout 900 -E '^TetsliceMeshes\.' -LE portable
+    # Only PoCL's ICD: Mesa's (installed for the rusticl pass) leaks 128 bytes per process from a library it
+    # unloads, which LeakSanitizer can neither name nor suppress; the second device is the release pass's.
+    mkdir -p build-asan/icd
+    cp /etc/OpenCL/vendors/pocl.icd build-asan/icd/
+    export OCL_ICD_VENDORS="$PWD/build-asan/icd"
+    # The image-convergence tests on real meshes (*Meshes.*) and the error-versus-sample-count curves
+    # (ErrorFalls*, Converges*) run in the release pass only: under ASan they spend minutes in kernels for
+    # host code that the box-grid and single-image tests run too.
+    ctest --test-dir build-asan --output-on-failure -j "$jobs" --timeout 900 -LE portable \
+        -E '^(TetsliceMeshes|ProjtetMeshes|HarcMeshes)\.|ErrorFalls|Converges'
 fi
