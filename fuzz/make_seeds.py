@@ -286,18 +286,11 @@ seed("off_tet", "counts_only.off", text("""
 """))
 
 # --- surfaces: the first byte picks .off, .stl, .poly, .smesh (fuzz/surface.cpp)
-seed("surface", "tetrahedron.off", b"\0" + text("""
-OFF
-4 4 6
-0 0 0
-1 0 0
-0 1 0
-0 0 1
-3 0 2 1
-3 0 1 3
-3 0 3 2
-3 1 2 3
-"""))
+TET_POINTS = [(0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1)]
+TET_FACES = [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)]
+TET_OFF = ("OFF\n4 4 6\n" + "".join("%d %d %d\n" % p for p in TET_POINTS) +
+           "".join("3 %d %d %d\n" % f for f in TET_FACES)).encode()
+seed("surface", "tetrahedron.off", b"\0" + TET_OFF)
 seed("surface", "triangle.stl", b"\1" + text("""
 solid t
   facet normal 0 0 1
@@ -360,20 +353,7 @@ seed("surface", "cube.smesh", b"\3" + text("""
 
 # --- PLOT3D: scalar byte, grid, marker, solution (big-endian, 2x2x2)
 # --- clip surfaces: the first byte picks .off, .stl (ASCII or binary), .obj (fuzz/clip_surface.cpp)
-TET_POINTS = [(0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1)]
-TET_FACES = [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)]
-seed("clip_surface", "tetrahedron.off", b"\0" + text("""
-OFF
-4 4 0
-0 0 0
-1 0 0
-0 1 0
-0 0 1
-3 0 2 1
-3 0 1 3
-3 0 3 2
-3 1 2 3
-"""))
+seed("clip_surface", "tetrahedron.off", b"\0" + TET_OFF)
 seed("clip_surface", "tetrahedron.stl", b"\1" + ("solid t\n" + "".join(
     "facet normal 0 0 0\nouter loop\n" + "".join("vertex %g %g %g\n" % TET_POINTS[i] for i in f) + "endloop\nendfacet\n"
     for f in TET_FACES) + "endsolid t\n").encode())
