@@ -16,16 +16,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// The scene's camera, or one that fits its data's bounds (as clvr render always did).
-Camera sceneCamera(const Scene& scene, const SceneData& data)
-{
-    if (scene.camera)
-        return *scene.camera;
-    if (scene.mesh)
-        return fitCamera(data.mesh.boundsMin(), data.mesh.boundsMax());
-    return fitCamera(data.volume.boundsMin(), data.volume.boundsMax());
-}
-
 // Rodrigues' rotation of v by `angle` radians about the unit axis k.
 glm::dvec3 rotate(const glm::dvec3& v, const glm::dvec3& k, double angle)
 {
@@ -34,6 +24,15 @@ glm::dvec3 rotate(const glm::dvec3& v, const glm::dvec3& k, double angle)
 }
 
 }  // namespace
+
+Camera sceneCamera(const Scene& scene, const SceneData& data)
+{
+    if (scene.camera)
+        return *scene.camera;
+    if (scene.mesh)
+        return fitCamera(data.mesh.boundsMin(), data.mesh.boundsMax());
+    return fitCamera(data.volume.boundsMin(), data.volume.boundsMax());
+}
 
 SceneData loadSceneData(const Scene& scene)
 {

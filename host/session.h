@@ -28,6 +28,10 @@ struct SceneData {
 // Loads what scene.volume or scene.mesh names (paths resolved at parse time). InputError naming the file.
 SceneData loadSceneData(const Scene& scene);
 
+// The scene's camera, or one that fits its data's bounds (as clvr render always did). A part of a larger
+// data set (Volume::part, TetMesh::part) must be given the whole data's camera.
+Camera sceneCamera(const Scene& scene, const SceneData& data);
+
 // One rendered frame: the image and what the frame did. stats.frameMs is the renderer's own time, or
 // the wall time where the renderer reports none; stats.passes the device time of each named launch.
 struct Frame {

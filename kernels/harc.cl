@@ -69,7 +69,10 @@ float4 harc_full_lookup(global const float4* table, const int ns, const int nl, 
  * relative to the mesh's shifted origin. Ray e + λ d, |d| = 1 (kernels/ray.h's clvr_ray_unit, as
  * host/model/camera.cpp's Camera::ray). stats[p] = (steps, 1 if the step bound stopped the ray, pieces).
  * integration: HARC_INTEGRATION_*; full_table, full_ns, full_nl, full_params: harc_full_lookup's
- * table (a one-element dummy unless integration is full). Out: (I + T background, 1 - T). */
+ * table (a one-element dummy unless integration is full). With clip_box (a sort-last part, host/cluster/
+ * partition.h) only the ray's part inside [box_lo, box_hi] is integrated: each segment is cut to it, the
+ * scalar interpolated at the cut (the field is linear in the cell), and the walk stops past the box.
+ * Out: (I + T background, 1 - T). */
 kernel void harc_render(global float4* out, global uint* stats, global const float4* tets,
                         global const uint* offsets, global const int2* entries, global const float* tf,
                         global const float* psi, global const float4* full_table, const ClHarcParams params)
@@ -85,11 +88,31 @@ kernel void harc_render(global float4* out, global uint* stats, global const flo
     const float2 offset = clvr_ray_offset(clvr_ray_ndc(clvr_ray_pixel_centre(x, y), size), params.camera);
     clvr_ray_unit(offset, params.camera, &e, &d);
 
+    /* The ray's parameter range inside the part's box (slab test); everywhere without one. */
+    float clip_lo = -INFINITY, clip_hi = INFINITY;
+    if (params.clip_box) {
+        const float3 inv_d = 1.0f / d;
+        const float3 t0 = (params.box_lo.xyz - e) * inv_d, t1 = (params.box_hi.xyz - e) * inv_d;
+        const float3 t_near = fmin(t0, t1), t_far = fmax(t0, t1);
+        for (int a = 0; a < 3; ++a) {
+            const float da = a == 0 ? d.x : (a == 1 ? d.y : d.z);
+            const float ea = a == 0 ? e.x : (a == 1 ? e.y : e.z);
+            const float lo = a == 0 ? params.box_lo.x : (a == 1 ? params.box_lo.y : params.box_lo.z);
+            const float hi = a == 0 ? params.box_hi.x : (a == 1 ? params.box_hi.y : params.box_hi.z);
+            if (da == 0.0f) {
+                if (ea < lo || ea > hi)
+                    clip_hi = -INFINITY;
+                continue;
+            }
+            clip_lo = fmax(clip_lo, a == 0 ? t_near.x : (a == 1 ? t_near.y : t_near.z));
+            clip_hi = fmin(clip_hi, a == 0 ? t_far.x : (a == 1 ? t_far.y : t_far.z));
+        }
+    }
     float3 color = (float3)(0.0f);
     float transmittance = 1.0f;
     uint steps = 0, bounded = 0, pieces = 0;
     float lambda_done = -INFINITY;  /* where the ray last left the mesh */
-    const uint end = offsets[p + 1];
+    const uint end = clip_lo <= clip_hi ? offsets[p + 1] : offsets[p];  /* a ray that misses the box: nothing */
     for (uint k = offsets[p]; k < end && !bounded; ++k) {
         const int2 entry = entries[k];
         float lambda = as_float(entry.x);
@@ -129,22 +152,28 @@ kernel void harc_render(global float4* out, global uint* stats, global const flo
                 break;
             }
             const float lambda_exit = lambda + step;
-            const float s_f = dot(grad.xyz, pos) + grad.w;                       /* Eq. 6 */
-            const float s_b = dot(grad.xyz, e + lambda_exit * d) + grad.w;
-            if (integration == HARC_INTEGRATION_FULL) {
-                /* The whole segment at once: no split at control points (the table has them inside). */
-                const float4 c =
-                    harc_full_lookup(full_table, params.full_ns, params.full_nl, params.full_params, s_f, s_b, step);
-                color += transmittance * c.xyz;
-                transmittance *= 1.0f - c.w;
-                ++pieces;
-            } else if (integration == HARC_INTEGRATION_AVERAGE) {
-                harc_segment_average(tf, tf_count, s_f, s_b, step, &color, &transmittance);
-                ++pieces;
-            } else {
-                pieces += (uint)harc_segment(tf, tf_count, psi, psi_n, s_f, s_b, step, &color, &transmittance);
+            /* The segment [lambda, lambda_exit], cut to the part's box (unchanged without one). */
+            const float seg_f = fmax(lambda, clip_lo), seg_b = fmin(lambda_exit, clip_hi);
+            if (seg_f < seg_b || (seg_f == lambda && seg_b == lambda_exit)) {
+                const float length = seg_f == lambda && seg_b == lambda_exit ? step : seg_b - seg_f;
+                const float s_f = dot(grad.xyz, e + seg_f * d) + grad.w;                       /* Eq. 6 */
+                const float s_b = dot(grad.xyz, e + seg_b * d) + grad.w;
+                if (integration == HARC_INTEGRATION_FULL) {
+                    /* The whole segment at once: no split at control points (the table has them inside). */
+                    const float4 c = harc_full_lookup(full_table, params.full_ns, params.full_nl, params.full_params,
+                                                      s_f, s_b, length);
+                    color += transmittance * c.xyz;
+                    transmittance *= 1.0f - c.w;
+                    ++pieces;
+                } else if (integration == HARC_INTEGRATION_AVERAGE) {
+                    harc_segment_average(tf, tf_count, s_f, s_b, length, &color, &transmittance);
+                    ++pieces;
+                } else {
+                    pieces += (uint)harc_segment(tf, tf_count, psi, psi_n, s_f, s_b, length, &color, &transmittance);
+                }
             }
-            if (1.0f - transmittance >= ert_alpha) {  /* early ray termination (off: ert_alpha = 2) */
+            if (1.0f - transmittance >= ert_alpha || lambda_exit >= clip_hi) {  /* early ray termination (off:
+                                                                                 * ert_alpha = 2), or past the box */
                 k = end;
                 break;
             }

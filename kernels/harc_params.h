@@ -19,7 +19,10 @@ typedef struct {
     cl_int integration;     /* HARC_INTEGRATION_* */
     cl_float ert_alpha;     /* stop once the opacity reaches this (2: off) */
     cl_int full_ns, full_nl; /* full pre-integration table: samples per s axis and along l */
-    cl_int pad0, pad1, pad2;
-} ClHarcParams;             /* 160 bytes */
+    cl_int clip_box;        /* 1: integrate only inside [box_lo, box_hi] (a sort-last part), 0: everywhere */
+    cl_int pad1, pad2;
+    cl_float4 box_lo;       /* the part's box, relative to the shifted origin, w = 0 */
+    cl_float4 box_hi;
+} ClHarcParams;             /* 192 bytes */
 
 #endif

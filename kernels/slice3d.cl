@@ -44,21 +44,37 @@ float3 slice3d_point(const float3 go, const float3 gd, const float depth0, const
     return go + (depth0 + (float)k * delta_s) * gd;
 }
 
-/* Brick (x, y, z) of the cell clvr_trilinear uses at g (its lower corner, clamped to n - 2). */
-int4 slice3d_brick(const float3 g, const int4 dims)
+/* 1 when full-grid coordinates g are this volume's to sample (own_lo <= g < own_hi per axis; for the
+ * whole grid own_hi is the next float above n - 1, so this is clvr_grid_inside's g <= n - 1). */
+int slice3d_owned(const float3 g, const float3 own_lo, const float3 own_hi)
 {
-    return (int4)(min((int)g.x, dims.x - 2), min((int)g.y, dims.y - 2), min((int)g.z, dims.z - 2), 0) >>
+    return g.x >= own_lo.x && g.y >= own_lo.y && g.z >= own_lo.z && g.x < own_hi.x && g.y < own_hi.y &&
+           g.z < own_hi.z;
+}
+
+/* The volume's own grid coordinates of owned full-grid coordinates g: g - offset, exact in float (g >=
+ * offset >= 0 and g < 2^24, so the difference is a multiple of g's ulp no larger than g). */
+float3 slice3d_local(const float3 g, const int4 offset)
+{
+    return g - convert_float3(offset.xyz);
+}
+
+/* Brick (x, y, z) of the cell clvr_trilinear uses at the volume's own coordinates gl (its lower corner,
+ * clamped to n - 2). */
+int4 slice3d_brick(const float3 gl, const int4 dims)
+{
+    return (int4)(min((int)gl.x, dims.x - 2), min((int)gl.y, dims.y - 2), min((int)gl.z, dims.z - 2), 0) >>
            SLICE3D_BRICK_SHIFT;
 }
 
-/* 1 if slice k's sample is inside the grid and its brick within Chebyshev distance r of brick b. */
+/* 1 if slice k's sample is this volume's and its brick within Chebyshev distance r of brick b. */
 int slice3d_in_cube(const float3 go, const float3 gd, const float depth0, const float delta_s, const int k,
-                    const int4 dims, const int4 b, const int r)
+                    const ClSlice3dParams* p, const int4 b, const int r)
 {
     const float3 g = slice3d_point(go, gd, depth0, delta_s, k);
-    if (!clvr_grid_inside(g, dims))
+    if (!slice3d_owned(g, p->own_lo.xyz, p->own_hi.xyz))
         return 0;
-    const uint4 c = abs_diff(slice3d_brick(g, dims), b);
+    const uint4 c = abs_diff(slice3d_brick(slice3d_local(g, p->part_offset), p->dims), b);
     return max(c.x, max(c.y, c.z)) <= (uint)r;
 }
 
@@ -68,11 +84,14 @@ int slice3d_in_cube(const float3 go, const float3 gd, const float depth0, const 
  * = 1 / gd) gives a candidate, checked with the main loop's own arithmetic (and one slice back if it
  * fails); by monotonicity every slice between k and it is then in the cube too. Falls back to k. */
 int slice3d_empty_run(const float3 go, const float3 gd, const float3 inv_gd, const float depth0,
-                      const float delta_s, const int k, const int step, const int k_end, const int4 dims,
+                      const float delta_s, const int k, const int step, const int k_end, const ClSlice3dParams* p,
                       const int4 b, const int r)
 {
-    const float3 lo = convert_float3(max(b.xyz - r, 0) << SLICE3D_BRICK_SHIFT);
-    const float3 hi = fmin(convert_float3((b.xyz + r + 1) << SLICE3D_BRICK_SHIFT), convert_float3(dims.xyz - 1));
+    /* the cube's box in full-grid coordinates */
+    const int4 dims = p->dims;
+    const float3 offset = convert_float3(p->part_offset.xyz);
+    const float3 lo = offset + convert_float3(max(b.xyz - r, 0) << SLICE3D_BRICK_SHIFT);
+    const float3 hi = offset + fmin(convert_float3((b.xyz + r + 1) << SLICE3D_BRICK_SHIFT), convert_float3(dims.xyz - 1));
     /* eye depth where the ray crosses each face it walks towards */
     const float3 face = (float)step * gd > 0.0f ? hi : lo;
     const float3 t = (face - go) * inv_gd;
@@ -88,7 +107,7 @@ int slice3d_empty_run(const float3 go, const float3 gd, const float3 inv_gd, con
     else
         cand = (int)clamp(ceil(kf), (float)k_end, (float)k);
     for (int tries = 0; tries < 2 && cand != k; ++tries, cand -= step)
-        if (slice3d_in_cube(go, gd, depth0, delta_s, cand, dims, b, r))
+        if (slice3d_in_cube(go, gd, depth0, delta_s, cand, p, b, r))
             return cand;
     return k;
 }
@@ -100,7 +119,7 @@ int slice3d_space(global const uchar* space, const int4 bdims, const int4 b)
 }
 
 /* One work-item per pixel: slices k = 0 .. slice_count-1 at eye depth depth0 + k * delta_s. Only the
- * slices whose ray point lies in the grid bounds are sampled (the rest are empty, DESIGN.md); their
+ * slices whose ray point lies in the grid bounds (the part's own box, for a part) are sampled (the rest are empty, DESIGN.md); their
  * number goes to samples[pixel]. With skip != 0, runs of slices in empty bricks are stepped over
  * (their number goes to skipped[pixel]; they are counted in samples[pixel] too). Back to front:
  * c = C alpha + (1 - alpha) c (the paper's blending); front to back: c += T alpha C, T *= 1 - alpha,
@@ -139,20 +158,22 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
     const float3 ud = (float3)(dot(clip_row0.xyz, d), dot(clip_row1.xyz, d), dot(clip_row2.xyz, d));
 #endif
 
-    /* Depth interval of the ray inside the grid bounds (slab test), widened by one slice each way;
-     * each sample is still checked, so this only limits the loop. */
+    /* Depth interval of the ray inside the owned box (slab test), widened by one slice each way; each
+     * sample is still checked, so this only limits the loop. */
+    const float3 own_lo = p.own_lo.xyz, own_hi = p.own_hi.xyz;
+    const int4 offset = p.part_offset;
     float zin = -INFINITY, zout = INFINITY;
-    const float3 last = convert_float3(dims.xyz - 1);
     for (int a = 0; a < 3; ++a) {
         const float g0 = a == 0 ? go.x : (a == 1 ? go.y : go.z);
         const float gs = a == 0 ? gd.x : (a == 1 ? gd.y : gd.z);
-        const float hi = a == 0 ? last.x : (a == 1 ? last.y : last.z);
+        const float lo = a == 0 ? own_lo.x : (a == 1 ? own_lo.y : own_lo.z);
+        const float hi = a == 0 ? own_hi.x : (a == 1 ? own_hi.y : own_hi.z);
         if (gs == 0.0f) {
-            if (g0 < 0.0f || g0 > hi)
+            if (g0 < lo || g0 >= hi)
                 zout = -INFINITY;
             continue;
         }
-        const float t0 = (0.0f - g0) / gs, t1 = (hi - g0) / gs;
+        const float t0 = (lo - g0) / gs, t1 = (hi - g0) / gs;
         zin = fmax(zin, fmin(t0, t1));
         zout = fmin(zout, fmax(t0, t1));
     }
@@ -170,13 +191,14 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
         float transmittance = 1.0f;
         for (int k = k_lo; k <= k_hi; ++k) {
             const float3 g = slice3d_point(go, gd, depth0, delta_s, k);
-            if (!clvr_grid_inside(g, dims))
+            if (!slice3d_owned(g, own_lo, own_hi))
                 continue;
+            const float3 gl = slice3d_local(g, offset);
             if (skip) {
-                const int4 b = slice3d_brick(g, dims);
+                const int4 b = slice3d_brick(gl, dims);
                 const int space_b = slice3d_space(space, bdims, b);
                 if (space_b != 0) {
-                    const int run_end = slice3d_empty_run(go, gd, inv_gd, depth0, delta_s, k, 1, k_hi, dims, b,
+                    const int run_end = slice3d_empty_run(go, gd, inv_gd, depth0, delta_s, k, 1, k_hi, &p, b,
                                                           space_b - 1);
                     stepped_over += (uint)(run_end - k + 1);
                     k = run_end;
@@ -188,7 +210,7 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
             if (!clvr_clip_keep(clip_texels, p.clip_tex, uo + (depth0 + (float)k * delta_s) * ud, p.clip_inverse))
                 continue;
 #endif
-            const float4 ct = clvr_tf_eval(tf, tf_count, SLICE3D_TRILINEAR(volume, dims, g));
+            const float4 ct = clvr_tf_eval(tf, tf_count, SLICE3D_TRILINEAR(volume, dims, gl));
             const float alpha = 1.0f - exp2(ct.w * neg_delta_log2e);
             c += (transmittance * alpha) * ct.xyz;
             transmittance *= 1.0f - alpha;
@@ -199,13 +221,14 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
     } else {
         for (int k = k_hi; k >= k_lo; --k) {
             const float3 g = slice3d_point(go, gd, depth0, delta_s, k);
-            if (!clvr_grid_inside(g, dims))
+            if (!slice3d_owned(g, own_lo, own_hi))
                 continue;
+            const float3 gl = slice3d_local(g, offset);
             if (skip) {
-                const int4 b = slice3d_brick(g, dims);
+                const int4 b = slice3d_brick(gl, dims);
                 const int space_b = slice3d_space(space, bdims, b);
                 if (space_b != 0) {
-                    const int run_end = slice3d_empty_run(go, gd, inv_gd, depth0, delta_s, k, -1, k_lo, dims, b,
+                    const int run_end = slice3d_empty_run(go, gd, inv_gd, depth0, delta_s, k, -1, k_lo, &p, b,
                                                           space_b - 1);
                     stepped_over += (uint)(k - run_end + 1);
                     k = run_end;
@@ -217,7 +240,7 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
             if (!clvr_clip_keep(clip_texels, p.clip_tex, uo + (depth0 + (float)k * delta_s) * ud, p.clip_inverse))
                 continue;
 #endif
-            const float4 ct = clvr_tf_eval(tf, tf_count, SLICE3D_TRILINEAR(volume, dims, g));
+            const float4 ct = clvr_tf_eval(tf, tf_count, SLICE3D_TRILINEAR(volume, dims, gl));
             const float alpha = 1.0f - exp2(ct.w * neg_delta_log2e);
             c = ct.xyz * alpha + (1.0f - alpha) * c;
             alpha_acc = alpha + (1.0f - alpha) * alpha_acc;

@@ -30,7 +30,15 @@ typedef struct {
     cl_int pad0, pad1;
     ClTexture clip_tex;      /* clip texture (SLICE3D_CLIP_TEXTURE builds only) */
     cl_float4 clip_row[3];   /* rows of the affine world -> clip-texture coordinates map */
-} ClSlice3dParams;           /* 304 bytes */
+    /* The part of the grid this volume is (sort-last, host/model/volume.h's GridPart; the whole grid
+     * otherwise): grid_origin and the sample positions are the full grid's; a sample at full-grid
+     * coordinates g is this volume's when own_lo <= g < own_hi per axis (own_hi is the next float above
+     * the last point where the part ends with the grid), and is read at g - part_offset, dims being
+     * the part's own. */
+    cl_int4 part_offset;     /* w = 0 */
+    cl_float4 own_lo;        /* w = 0 */
+    cl_float4 own_hi;        /* w = 0 */
+} ClSlice3dParams;           /* 352 bytes */
 
 typedef struct {
     cl_float4 background;    /* image background, w = 0 */

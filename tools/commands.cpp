@@ -85,7 +85,8 @@ int listTechniques(const std::string& name)
 
 // The thread budget (host/runtime/parallel.h): --threads, else $CLVR_THREADS, else one per hardware thread (and
 // PoCL left to its own default). Set before the first OpenCL call, so that PoCL's CPU device reads it.
-void applyThreadBudget(const std::string& threadsOption)
+// Returns whether either set it.
+bool applyThreadBudget(const std::string& threadsOption)
 {
     const char* env = std::getenv("CLVR_THREADS");
     if (!threadsOption.empty())
@@ -93,11 +94,24 @@ void applyThreadBudget(const std::string& threadsOption)
     else if (env && *env)
         setThreadBudget(parseThreadCount(env, "CLVR_THREADS"));
     else
-        return;
+        return false;
     passThreadBudgetToPocl();
+    return true;
 }
 
+bool quiet = false;
+
 }  // namespace
+
+void quietErrors()
+{
+    quiet = true;
+}
+
+bool errorsQuiet()
+{
+    return quiet;
+}
 
 // `clvr mesh` (tools/mesh_command.cpp).
 CLI::App* addMeshCommand(CLI::App& app);
@@ -137,6 +151,10 @@ int run(int argc, char** argv)
                        "render N frames, frame k with the camera rotated by k*360/N degrees about view-up through "
                        "the focal point; -o is then a printf pattern with one integer conversion, e.g. f%03d.png")
         ->check(CLI::Range(1, 100000));
+    render->add_option("--distribution", renderOptions.distribution,
+                       "under mpirun: sort-last (the data split over the ranks, images composited by IceT), "
+                       "sort-first or frames (--orbit frames shared out); default: the scene's, else sort-last, "
+                       "frames with --orbit (docs/cluster.md)");
     render->add_flag("--single-frame", renderOptions.singleFrame,
                      "render once (by default a first frame and a steady frame are rendered; frame_ms is the steady one)");
     std::string threads;
@@ -206,7 +224,7 @@ int run(int argc, char** argv)
     } catch (const CLI::ParseError& e) {
         throw InputError("command line: " + oneLine(e.what()) + " (see clvr --help)");
     }
-    applyThreadBudget(threads);
+    renderOptions.threadsGiven = applyThreadBudget(threads);
     if (*render)
         return tools::render(renderOptions);
     if (*infoCommand)

@@ -24,6 +24,8 @@ struct RenderOptions {
     std::string statsPath;               // --stats: JSON with times and counts; empty: none
     int orbit = 0;                       // --orbit N: N frames about view-up, `output` a %d pattern; 0: one image
     bool singleFrame = false;            // --single-frame: render once (no separate steady frame)
+    std::string distribution;            // --distribution (MPI jobs): sort-last, sort-first, frames; empty: the scene's
+    bool threadsGiven = false;           // --threads or $CLVR_THREADS set the thread budget
 };
 
 // Renders one image (or --orbit N frames) through clvr::Session: checks every output path, loads the
@@ -31,5 +33,14 @@ struct RenderOptions {
 // --single-frame, a steady frame; then each further orbit frame once; writes the images (and the stats)
 // atomically and prints one line to stdout. Returns 0; throws InputError / DeviceError / BuildError.
 int render(const RenderOptions& options);
+
+// main() prints an error line unless quietErrors() was called: ranks other than 0 of an MPI job, which
+// fail with the same agreed error as rank 0 (host/cluster/world.h), leave the line to rank 0.
+void quietErrors();
+bool errorsQuiet();
+
+// `mpirun -np N clvr render` (docs/cluster.md): render() calls it when an MPI launcher started the
+// process and clvr was built with CLVR_MPI. Same outputs and errors; every rank returns the same status.
+int renderCluster(const RenderOptions& options);
 
 }  // namespace clvr::tools

@@ -2,6 +2,10 @@
 // image, or with --orbit N a camera path of N frames, plus stats. Every check that can fail on bad input runs before the device is opened; outputs are written to a
 // temporary file and renamed into place, so a failure never leaves a partial file (DESIGN.md).
 #include "tools/commands.h"
+#include "tools/render_output.h"
+#if CLVR_HAVE_MPI
+#include "host/cluster/world.h"
+#endif
 
 #include "host/runtime/device.h"
 #include "host/runtime/errors.h"
@@ -20,6 +24,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -32,15 +37,19 @@
 #include <thread>
 
 namespace clvr::tools {
-namespace {
 
 namespace fs = std::filesystem;
+
+namespace {
+
 using Clock = std::chrono::steady_clock;
 
 double msSince(Clock::time_point t0)
 {
     return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
+
+}  // namespace
 
 std::string lowerExtension(const fs::path& p)
 {
@@ -76,6 +85,8 @@ void writeFileAtomically(const std::string& path, const std::string& text)
         throw InputError(path + ": cannot rename the temporary file into place: " + ec.message());
     }
 }
+
+namespace {
 
 // "\rclvr: rendering slice3d 512x512 ... 2.3 s" on stderr every 0.5 s once a render has taken a
 // second, only when stderr is a terminal; setLabel() changes the text (frame k of N); the line is
@@ -133,6 +144,8 @@ private:
     std::atomic<bool> printed_{false};
     std::jthread thread_;  // last: stopped and joined before the label goes
 };
+
+}  // namespace
 
 // The --orbit output pattern: printf-style with exactly one integer conversion (%d, %i or %u, with flags,
 // width and precision, e.g. %03d), "%%" for a literal percent sign. InputError otherwise.
@@ -197,30 +210,6 @@ std::vector<std::string> outputPaths(const RenderOptions& options)
 }
 
 
-// The images a command has written, removed again unless keep() is called: a command that fails leaves
-// all its frames or none (an --orbit that fails at frame 3 takes frames 0..2 with it).
-class WrittenFiles {
-public:
-    WrittenFiles() = default;
-    WrittenFiles(const WrittenFiles&) = delete;
-    WrittenFiles& operator=(const WrittenFiles&) = delete;
-    ~WrittenFiles()
-    {
-        if (kept_)
-            return;
-        for (const std::string& path : paths_) {
-            std::error_code ignored;
-            fs::remove(path, ignored);
-        }
-    }
-    void add(const std::string& path) { paths_.push_back(path); }
-    void keep() { kept_ = true; }
-
-private:
-    std::vector<std::string> paths_;
-    bool kept_ = false;
-};
-
 // One stderr note when checkMesh changed the mesh (docs/meshes.md): the counts are in --stats too.
 void noteMeshRepairs(const FrameStats& stats)
 {
@@ -246,10 +235,18 @@ void noteEmptyImage(const Image4f& image, const std::string& technique)
               << '\n';
 }
 
-}  // namespace
-
 int render(const RenderOptions& options)
 {
+#if CLVR_HAVE_MPI
+    if (cluster::launchedByMpi())
+        return renderCluster(options);
+#else
+    if (const char* size = std::getenv("OMPI_COMM_WORLD_SIZE"); size && std::string(size) != "1")
+        throw InputError("this clvr was built without MPI (CLVR_MPI=OFF): under mpirun every rank would render the "
+                         "whole image; rebuild with libopenmpi-dev and paraview-dev installed (docs/cluster.md)");
+#endif
+    if (!options.distribution.empty())  // one process renders everything; the value must still be one
+        checkDistribution(options.distribution, "--distribution");
     // 1. Outputs: a known format and a writable folder for every file, before anything expensive happens.
     if (options.orbit < 0)
         throw InputError("--orbit: the frame count must be at least 1, got " + std::to_string(options.orbit));

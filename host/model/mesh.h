@@ -7,10 +7,19 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 namespace clvr {
+
+// A mesh cut from a larger one (sort-last cluster rendering, host/cluster/partition.h): its cells are
+// those meeting the box [lo, hi], and a renderer integrates each ray only inside that box, in the
+// coordinates of the full mesh's box [fullLo, fullHi] (so that every part computes as the whole would).
+struct MeshPart {
+    glm::dvec3 lo{0.0}, hi{0.0};
+    glm::dvec3 fullLo{0.0}, fullHi{0.0};
+};
 
 struct TetMesh {
     std::vector<glm::dvec3> points;
@@ -26,6 +35,7 @@ struct TetMesh {
     // -1 on the boundary; empty when there was none. checkMesh keeps it in step with reoriented cells
     // and forgets it when cells are dropped; buildTopology checks it and then uses it.
     std::vector<std::array<std::int32_t, 4>> neighbors;
+    std::optional<MeshPart> part;  // set only on a part of a larger mesh (sort-last); see MeshPart
 
     glm::dvec3 boundsMin() const;
     glm::dvec3 boundsMax() const;

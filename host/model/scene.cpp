@@ -442,7 +442,7 @@ Scene parseSceneJson(json root, const std::string& label, const std::filesystem:
         applyOverride(root, o, label);
 
     check.knownKeys(root, "", {"technique", "volume", "mesh", "camera", "image", "transfer_function", "options",
-                               "iso", "lights", "material"});
+                               "iso", "lights", "material", "distribution"});
     Scene scene;
     scene.baseDir = baseDir;
     if (root.contains("technique")) {
@@ -468,6 +468,14 @@ Scene parseSceneJson(json root, const std::string& label, const std::filesystem:
         check.object(root["options"], "options");
         scene.options = root["options"];
     }
+    if (root.contains("distribution")) {
+        scene.distribution = check.string(root["distribution"], "distribution");
+        try {
+            checkDistribution(scene.distribution, "distribution");
+        } catch (const InputError& e) {
+            check.fail(e.what());  // with the scene's label
+        }
+    }
     if (root.contains("iso"))
         scene.iso = parseIso(check, root["iso"]);
     if (root.contains("lights"))
@@ -491,6 +499,12 @@ const char* shadingName(IsoSpec::Shading shading)
     case IsoSpec::Shading::None: return "none";
     }
     throw InternalError("shadingName: unknown IsoSpec::Shading " + std::to_string(static_cast<int>(shading)));
+}
+
+void checkDistribution(const std::string& name, const std::string& where)
+{
+    if (name != "sort-last" && name != "sort-first" && name != "frames")
+        throw InputError(where + ": unknown distribution \"" + name + "\" (known: sort-last, sort-first, frames)");
 }
 
 Scene parseScene(const std::string& text, const std::string& label, const std::filesystem::path& baseDir,

@@ -72,7 +72,13 @@ struct Scene {
     nlohmann::json options = nlohmann::json::object();  // technique options, checked by the technique
     std::optional<IsoSpec> iso;  // absent: no "iso" (direct volume rendering)
     Lighting lighting;           // "lights" (none: unshaded) and "material"
+    // "distribution": how `mpirun -np N clvr render` shares the work (docs/cluster.md): "sort-last",
+    // "sort-first" or "frames"; empty: sort-last for one image, frames for --orbit. One process ignores it.
+    std::string distribution;
 };
+
+// InputError ("WHERE: unknown distribution ...") unless `name` is sort-last, sort-first or frames.
+void checkDistribution(const std::string& name, const std::string& where);
 
 // Parses scene JSON text; `label` (the file name) prefixes every error. `unsets` are `--unset` paths
 // ("camera", "options.slices") removed from the JSON first; a path that is not in the scene is an

@@ -66,6 +66,11 @@ void Volume::validate() const
     for (std::size_t i = 0; i < values.size(); ++i)
         if (!std::isfinite(values[i]))
             throw InputError(source + ": value " + std::to_string(i) + " is NaN or infinite");
+    if (part)  // made by code (host/cluster/partition.h), never read from a file
+        for (int a = 0; a < 3; ++a)
+            if (part->offset[a] < 0 || part->offset[a] + dims[a] > part->fullDims[a])
+                throw InternalError(source + ": part of a larger grid does not lie inside it on axis " +
+                                    std::to_string(a));
 }
 
 }  // namespace clvr

@@ -16,12 +16,26 @@ namespace clvr {
 // machine's physical memory: a volume that large would be killed by the OOM killer, not reported.
 void checkHostMemoryForVoxels(const std::string& source, std::uint64_t voxels);
 
+// Where a volume sits in the larger grid it was cut from (sort-last cluster rendering, host/cluster/):
+// its grid point (0, 0, 0) is point `offset` of that grid, whose dims and origin these are (same
+// spacing). Such a volume "owns" the grid coordinates [offset, offset + dims - 1) per axis, closed at
+// the full grid's last point, so that parts cut with one shared layer of points own every sample once.
+struct GridPart {
+    glm::ivec3 offset{0};
+    glm::ivec3 fullDims{0};
+    glm::dvec3 fullOrigin{0.0};
+
+    glm::dvec3 fullBoundsMin() const { return fullOrigin; }
+    glm::dvec3 fullBoundsMax(const glm::dvec3& spacing) const { return fullOrigin + glm::dvec3(fullDims - 1) * spacing; }
+};
+
 struct Volume {
     glm::ivec3 dims{0};
     glm::dvec3 spacing{1.0};
     glm::dvec3 origin{0.0};
     std::vector<float> values;  // data units, as stored (int16 CT numbers stay CT numbers)
     std::string source;         // file or generator it came from, for messages
+    std::optional<GridPart> part;  // set only on a part of a larger grid (sort-last); see GridPart
 
     std::size_t voxelCount() const { return static_cast<std::size_t>(dims.x) * dims.y * dims.z; }
     glm::dvec3 boundsMin() const { return origin; }

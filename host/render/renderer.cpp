@@ -17,6 +17,16 @@
 namespace clvr {
 namespace {
 
+[[noreturn]] void sortLastUnsupported(const TechniqueInfo& t)
+{
+    std::string able;
+    for (const TechniqueInfo& other : techniques())
+        if (other.sortLast)
+            able += (able.empty() ? "" : ", ") + other.name;
+    throw InputError("technique " + t.name + " does not render a part of a data set (sort-last renders " + able +
+                     "); use --distribution frames (sort-first is not built yet)");
+}
+
 std::string joined(const std::vector<std::string>& names)
 {
     std::string out;
@@ -103,6 +113,8 @@ std::unique_ptr<Renderer> makeRenderer(Device& device, const Scene& scene, const
         throw InputError("technique " + t->name + " needs a tetrahedral \"mesh\", and the scene has none");
     if (volume.values.empty())
         throw InputError("technique " + t->name + " needs a regular-grid \"volume\", and the scene has none");
+    if (volume.part && !t->sortLast)
+        sortLastUnsupported(*t);
     return t->makeForVolume(device, scene, volume);
 }
 
@@ -115,6 +127,8 @@ std::unique_ptr<Renderer> makeMeshRenderer(Device& device, const Scene& scene, c
     if (t->data != DataKind::Mesh)
         throw InputError("technique \"" + t->name + "\" renders regular-grid volumes, and the scene has a \"mesh\" " +
                          "(mesh techniques: " + joined(namesOf(DataKind::Mesh)) + ")");
+    if (mesh.part && !t->sortLast)
+        sortLastUnsupported(*t);
     return t->makeForMesh(device, scene, mesh);
 }
 

@@ -62,6 +62,9 @@ struct TechniqueInfo {
     DataKind data = DataKind::Volume;
     std::string description;  // one line
     std::vector<OptionInfo> options;
+    // Renders a part of a larger data set (Volume::part, TetMesh::part) so that the parts' images
+    // composited in visibility order give the whole one: sort-last cluster rendering (docs/cluster.md).
+    bool sortLast = false;
     // The factory for the technique's data kind (the other one is empty).
     std::function<std::unique_ptr<Renderer>(Device&, const Scene&, const Volume&)> makeForVolume;
     std::function<std::unique_ptr<Renderer>(Device&, const Scene&, const TetMesh&)> makeForMesh;

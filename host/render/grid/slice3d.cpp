@@ -45,7 +45,9 @@ private:
     Camera camera_;
     ImageSpec image_;
     glm::ivec3 dims_;
-    glm::dvec3 origin_, spacing_, lo_, hi_;
+    glm::dvec3 origin_, spacing_, lo_, hi_;  // the full grid's origin and box (a part's are inside them)
+    glm::ivec3 partOffset_{0};               // the volume's point 0 in the full grid (sort-last part)
+    glm::vec3 ownLo_{0.0f}, ownHi_{0.0f};    // full-grid coordinates the volume samples (ClSlice3dParams)
     TransferFunctionUpload tf_;
     SlicePlan plan_;
     cl::Buffer volume_;
@@ -81,10 +83,24 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
 {
     checkGridVolume(volume, "slice3d");
     dims_ = volume.dims;
-    origin_ = volume.origin;
     spacing_ = volume.spacing;
-    lo_ = volume.boundsMin();
-    hi_ = volume.boundsMax();
+    // A part of a larger grid (sort-last) takes the full grid's slices and sample positions and keeps
+    // the samples it owns (host/model/volume.h's GridPart): the parts' images composite to the full one.
+    const GridPart whole{glm::ivec3(0), volume.dims, volume.origin};
+    const GridPart& part = volume.part ? *volume.part : whole;
+    if (volume.part && options_.path != Slice3dOptions::Path::Fused)
+        throw InputError("slice3d: the raster path (options.path \"raster\", clip meshes) does not render a part "
+                         "of a volume; use --distribution frames (sort-first is not built yet)");
+    origin_ = part.fullOrigin;
+    lo_ = part.fullBoundsMin();
+    hi_ = part.fullBoundsMax(spacing_);
+    partOffset_ = part.offset;
+    for (int a = 0; a < 3; ++a) {
+        const int last = part.offset[a] + dims_[a] - 1;
+        ownLo_[a] = static_cast<float>(part.offset[a]);
+        ownHi_[a] = last == part.fullDims[a] - 1 ? std::nextafter(static_cast<float>(last), INFINITY)
+                                                 : static_cast<float>(last);
+    }
     camera_ = frameCamera(scene, lo_, hi_);
     plan_ = planSlices(camera_, lo_, hi_, options_);
     if (options_.clip) {
@@ -253,6 +269,9 @@ Image4f Slice3dRenderer::renderFused(FrameStats& stats)
     params.slice_count = plan_.count;
     params.front_to_back = frontToBack ? 1 : 0;
     params.ert_alpha = ert;
+    params.part_offset = cl_int4{{partOffset_.x, partOffset_.y, partOffset_.z, 0}};
+    params.own_lo = cl_float4{{ownLo_.x, ownLo_.y, ownLo_.z, 0.0f}};
+    params.own_hi = cl_float4{{ownHi_.x, ownHi_.y, ownHi_.z, 0.0f}};
     int a = 0;
     fused_.setArg(a++, out_);
     fused_.setArg(a++, samples_);
@@ -474,6 +493,7 @@ TechniqueInfo slice3dTechnique()
     t.name = "slice3d";
     t.data = DataKind::Volume;
     t.description = "3D-texture slicing: view-aligned slices composited (docs/slice3d.md)";
+    t.sortLast = true;  // the fused path; the raster path refuses a part
     t.options = {
         slicesInfo(),
         sliceSpacingInfo(),

@@ -56,6 +56,7 @@ private:
     TetMesh mesh_;          // copies: the renderer outlives the caller's mesh
     TetTopology topology_;
     glm::dvec3 shift_{0.0};
+    std::optional<MeshPart> part_;  // the box to integrate in, for a part of a larger mesh
     TransferFunctionUpload tf_;
     std::uint64_t maxSteps_ = 0;
     cl::Buffer tets_, psi_, out_, stats_;
@@ -83,10 +84,17 @@ HarcRenderer::HarcRenderer(Device& device, const Scene& scene, const TetMesh& me
         throw InputError(mesh.source + ": harc takes fewer than 2^29 tetrahedra (tet * 4 + face in 31 bits)");
     if (topology.neighbor.size() != mesh.tets.size())  // makeMeshRenderer builds it from this mesh
         throw InternalError(mesh.source + ": topology does not match the mesh");
+    // A part of a larger mesh (sort-last) computes in the full mesh's frame and integrates only inside
+    // its box (host/model/mesh.h's MeshPart), so that the parts' images composite to the full one.
     glm::dvec3 lo, hi;
     meshBounds(mesh, lo, hi);
+    if (mesh.part) {
+        lo = mesh.part->fullLo;
+        hi = mesh.part->fullHi;
+    }
     shift_ = 0.5 * (lo + hi);
     camera_ = frameCamera(scene, lo, hi);
+    part_ = mesh.part;
 
     counts_ = MeshCounts::of(mesh);
     maxSteps_ = options_.maxSteps
@@ -184,6 +192,11 @@ Image4f HarcRenderer::render(FrameStats& stats)
     params.ert_alpha = ert;
     params.full_ns = ns;
     params.full_nl = nl;
+    if (part_) {
+        params.clip_box = 1;
+        params.box_lo = toCl4(part_->lo - shift_);
+        params.box_hi = toCl4(part_->hi - shift_);
+    }
     int a = 0;
     kernel_.setArg(a++, out_);
     kernel_.setArg(a++, stats_);
@@ -259,6 +272,7 @@ TechniqueInfo harcTechnique()
     t.name = "harc";
     t.data = DataKind::Mesh;
     t.description = "tetrahedral ray casting with partial pre-integration, seeds/001 (docs/harc.md)";
+    t.sortLast = true;
     t.options = {
         {"integration", "partial", "", "\"partial\" (Eq. 2-4), \"average\" (mean color per segment) or \"full\" (3D table)"},
         {"full_table", nullptr, "[64, 64], with integration full only", "[NS, NL]: the full table's samples of s_f, s_b and of l"},

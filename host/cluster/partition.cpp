@@ -1,0 +1,238 @@
+// host/cluster/partition.cpp — k-d partitions of grids and meshes, their visibility order, and the
+// "over" composite of the parts' images (host/cluster/partition.h).
+#include "host/cluster/partition.h"
+
+#include "host/runtime/errors.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <unordered_map>
+
+namespace clvr {
+namespace {
+
+// The axis of the longest extent (the first of equals).
+int longestAxis(const glm::dvec3& extent)
+{
+    int axis = 0;
+    for (int a = 1; a < 3; ++a)
+        if (extent[a] > extent[axis])
+            axis = a;
+    return axis;
+}
+
+// Builds the grid tree over cells [c0, c1) per axis for `ranks` parts numbered from `firstPart`.
+int splitGrid(GridPartition& out, const glm::ivec3& c0, const glm::ivec3& c1, const glm::dvec3& origin,
+              const glm::dvec3& spacing, int ranks, int firstPart)
+{
+    const int node = static_cast<int>(out.tree.nodes.size());
+    out.tree.nodes.emplace_back();
+    if (ranks == 1) {
+        out.tree.nodes[node].part = firstPart;
+        out.lo[firstPart] = c0;
+        out.hi[firstPart] = c1;  // points [c0, c1]: the cells' upper layer is shared with the neighbour
+        return node;
+    }
+    const glm::ivec3 cells = c1 - c0;
+    // The longest axis that still has a cell for each side.
+    glm::dvec3 extent = glm::dvec3(cells) * spacing;
+    for (int a = 0; a < 3; ++a)
+        if (cells[a] < 2)
+            extent[a] = -1.0;
+    const int axis = longestAxis(extent);
+    if (extent[axis] < 0.0)
+        throw InputError("the volume has too few cells to split into parts for every rank (a part needs at least one "
+                         "cell per axis); use fewer ranks or --distribution frames");
+    const int below = ranks / 2;
+    const double share = static_cast<double>(below) / ranks;
+    const int cut = std::clamp(c0[axis] + static_cast<int>(std::lround(cells[axis] * share)), c0[axis] + 1,
+                               c1[axis] - 1);
+    glm::ivec3 mid1 = c1, mid0 = c0;
+    mid1[axis] = cut;
+    mid0[axis] = cut;
+    const int b = splitGrid(out, c0, mid1, origin, spacing, below, firstPart);
+    const int a = splitGrid(out, mid0, c1, origin, spacing, ranks - below, firstPart + below);
+    KdTree::Node& n = out.tree.nodes[node];
+    n.axis = axis;
+    n.split = origin[axis] + cut * spacing[axis];
+    n.below = b;
+    n.above = a;
+    return node;
+}
+
+// Builds the mesh tree over the centroids [first, last) (sorted in place) inside the box [lo, hi].
+int splitMesh(MeshPartition& out, std::vector<glm::dvec3>& centroids, std::size_t first, std::size_t last,
+              const glm::dvec3& lo, const glm::dvec3& hi, int ranks, int firstPart)
+{
+    const int node = static_cast<int>(out.tree.nodes.size());
+    out.tree.nodes.emplace_back();
+    if (ranks == 1) {
+        out.tree.nodes[node].part = firstPart;
+        out.lo[firstPart] = lo;
+        out.hi[firstPart] = hi;
+        return node;
+    }
+    const int axis = longestAxis(hi - lo);
+    const int below = ranks / 2;
+    // The centroid quantile of the ranks' share, inside the box (never on its faces, so both sides
+    // keep a volume).
+    const std::size_t count = last - first;
+    const std::size_t k = first + std::min(count - 1, count * static_cast<std::size_t>(below) / ranks);
+    double split = 0.5 * (lo[axis] + hi[axis]);
+    if (count > 0) {
+        std::nth_element(centroids.begin() + static_cast<std::ptrdiff_t>(first), centroids.begin() + static_cast<std::ptrdiff_t>(k),
+                         centroids.begin() + static_cast<std::ptrdiff_t>(last),
+                         [axis](const glm::dvec3& p, const glm::dvec3& q) { return p[axis] < q[axis]; });
+        split = centroids[k][axis];
+    }
+    const double margin = 1e-6 * (hi[axis] - lo[axis]);
+    if (!(split > lo[axis] + margin && split < hi[axis] - margin))
+        split = 0.5 * (lo[axis] + hi[axis]);
+    glm::dvec3 mid1 = hi, mid0 = lo;
+    mid1[axis] = split;
+    mid0[axis] = split;
+    // The centroids on each side, for the next levels.
+    const auto middle = std::partition(centroids.begin() + static_cast<std::ptrdiff_t>(first),
+                                       centroids.begin() + static_cast<std::ptrdiff_t>(last),
+                                       [&](const glm::dvec3& p) { return p[axis] < split; });
+    const std::size_t m = static_cast<std::size_t>(middle - centroids.begin());
+    const int b = splitMesh(out, centroids, first, m, lo, mid1, below, firstPart);
+    const int a = splitMesh(out, centroids, m, last, mid0, hi, ranks - below, firstPart + below);
+    KdTree::Node& n = out.tree.nodes[node];
+    n.axis = axis;
+    n.split = split;
+    n.below = b;
+    n.above = a;
+    return node;
+}
+
+void checkRanks(int n)
+{
+    if (n < 1)
+        throw InputError("a partition needs at least one part, got " + std::to_string(n));
+}
+
+}  // namespace
+
+std::vector<int> KdTree::frontToBack(const Camera& camera) const
+{
+    std::vector<int> order;
+    if (nodes.empty())
+        return order;
+    const glm::dvec3 forward = camera.forward();
+    std::vector<int> stack{0};
+    while (!stack.empty()) {
+        const Node& n = nodes[static_cast<std::size_t>(stack.back())];
+        stack.pop_back();
+        if (n.axis < 0) {
+            order.push_back(n.part);
+            continue;
+        }
+        // Which side a ray starts on: the eye's side (perspective), or the side the direction leaves
+        // (parallel: every ray has direction `forward`). A ray never crosses the plane back.
+        const bool belowFirst = camera.parallel ? forward[n.axis] >= 0.0 : camera.position[n.axis] < n.split;
+        stack.push_back(belowFirst ? n.above : n.below);  // popped second
+        stack.push_back(belowFirst ? n.below : n.above);
+    }
+    return order;
+}
+
+GridPartition partitionGrid(const glm::ivec3& dims, const glm::dvec3& origin, const glm::dvec3& spacing, int n)
+{
+    checkRanks(n);
+    GridPartition out;
+    out.lo.resize(static_cast<std::size_t>(n));
+    out.hi.resize(static_cast<std::size_t>(n));
+    splitGrid(out, glm::ivec3(0), dims - 1, origin, spacing, n, 0);
+    return out;
+}
+
+Volume cutGridPart(const Volume& volume, const GridPartition& partition, int p)
+{
+    const glm::ivec3 lo = partition.lo.at(static_cast<std::size_t>(p)), hi = partition.hi.at(static_cast<std::size_t>(p));
+    Volume part;
+    part.dims = hi - lo + 1;
+    part.spacing = volume.spacing;
+    part.origin = volume.origin + glm::dvec3(lo) * volume.spacing;
+    part.source = volume.source;
+    part.part = GridPart{lo, volume.dims, volume.origin};
+    part.values.resize(part.voxelCount());
+    std::size_t i = 0;
+    for (int k = lo.z; k <= hi.z; ++k)
+        for (int j = lo.y; j <= hi.y; ++j) {
+            const std::size_t row = (static_cast<std::size_t>(k) * volume.dims.y + j) * volume.dims.x + lo.x;
+            std::copy_n(volume.values.begin() + static_cast<std::ptrdiff_t>(row), part.dims.x,
+                        part.values.begin() + static_cast<std::ptrdiff_t>(i));
+            i += static_cast<std::size_t>(part.dims.x);
+        }
+    return part;
+}
+
+MeshPartition partitionMesh(const TetMesh& mesh, int n)
+{
+    checkRanks(n);
+    if (mesh.tets.empty())
+        throw InputError(mesh.source + ": the mesh has no tetrahedra to split into parts");
+    std::vector<glm::dvec3> centroids;
+    centroids.reserve(mesh.tets.size());
+    for (const glm::uvec4& t : mesh.tets)
+        centroids.push_back(0.25 * (mesh.points[t.x] + mesh.points[t.y] + mesh.points[t.z] + mesh.points[t.w]));
+    MeshPartition out;
+    out.lo.resize(static_cast<std::size_t>(n));
+    out.hi.resize(static_cast<std::size_t>(n));
+    splitMesh(out, centroids, 0, centroids.size(), mesh.boundsMin(), mesh.boundsMax(), n, 0);
+    return out;
+}
+
+TetMesh cutMeshPart(const TetMesh& mesh, const MeshPartition& partition, int p)
+{
+    const glm::dvec3 lo = partition.lo.at(static_cast<std::size_t>(p)), hi = partition.hi.at(static_cast<std::size_t>(p));
+    TetMesh part;
+    part.source = mesh.source;
+    part.part = MeshPart{lo, hi, mesh.boundsMin(), mesh.boundsMax()};
+    std::unordered_map<std::uint32_t, std::uint32_t> renumber;
+    const auto point = [&](std::uint32_t v) {
+        const auto [it, added] = renumber.try_emplace(v, static_cast<std::uint32_t>(part.points.size()));
+        if (added) {
+            part.points.push_back(mesh.points[v]);
+            part.scalars.push_back(mesh.scalars[v]);
+        }
+        return it->second;
+    };
+    for (const glm::uvec4& t : mesh.tets) {
+        const glm::dvec3 a = mesh.points[t.x], b = mesh.points[t.y], c = mesh.points[t.z], d = mesh.points[t.w];
+        const glm::dvec3 tlo = glm::min(glm::min(a, b), glm::min(c, d)), thi = glm::max(glm::max(a, b), glm::max(c, d));
+        if (glm::any(glm::lessThan(thi, lo)) || glm::any(glm::greaterThan(tlo, hi)))
+            continue;
+        part.tets.push_back(glm::uvec4(point(t.x), point(t.y), point(t.z), point(t.w)));
+    }
+    part.tetsRead = part.tets.size();
+    return part;
+}
+
+Image4f compositeOver(const std::vector<const Image4f*>& frontToBack)
+{
+    if (frontToBack.empty())
+        throw InternalError("compositeOver: no images");
+    Image4f out(frontToBack[0]->width(), frontToBack[0]->height());
+    for (const Image4f* image : frontToBack) {
+        if (image->width() != out.width() || image->height() != out.height())
+            throw InternalError("compositeOver: images of different sizes");
+        for (std::size_t i = 0; i < out.pixelCount(); ++i) {
+            glm::vec4& o = out.pixels()[i];
+            o += (1.0f - o.a) * image->pixels()[i];
+        }
+    }
+    return out;
+}
+
+void addBackground(Image4f& image, const glm::dvec3& background)
+{
+    const glm::vec3 bg(background);
+    for (glm::vec4& p : image.pixels())
+        p = glm::vec4(glm::vec3(p) + (1.0f - p.a) * bg, p.a);
+}
+
+}  // namespace clvr

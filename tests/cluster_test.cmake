@@ -1,0 +1,107 @@
+# tests/cluster_test.cmake — `mpirun -np N clvr render` end to end (cmake -P; docs/cluster.md): the N-rank
+# image equals the one-process image within 1/255 per channel (PNG) and 2e-5 (EXR, float) for N = 1..8,
+# sort-last on a volume (slice3d) and a non-convex TetGen mesh whose k-d boxes cut through cells (harc),
+# perspective, parallel and an eye inside the volume; frames mode gives the one-process orbit frames;
+# a failure on one rank (missing scene file, kernel build failure, failed launch, technique that cannot
+# render a part) gives one error line, the same non-zero status from mpirun, within seconds, no output.
+# Inputs: CLVR, MPIEXEC, OIIOTOOL, SRC, WORK. Images are 64x64 or 96x96 to stay fast.
+file(REMOVE_RECURSE "${WORK}")
+file(MAKE_DIRECTORY "${WORK}")
+set(ENV{OMPI_ALLOW_RUN_AS_ROOT} 1)  # ../shared/CLUSTER-NOTES.md: CI runs as root
+set(ENV{OMPI_ALLOW_RUN_AS_ROOT_CONFIRM} 1)
+set(MPI ${MPIEXEC} --oversubscribe)
+set(VOLUME ${SRC}/data/scenes/default.json --set image={"width":96,"height":96,"background":[0.1,0.2,0.3]}
+    --set options.slices=160)
+set(MESH ${SRC}/data/scenes/l-block.json --set image={"width":96,"height":96,"background":[0.05,0.05,0.08]}
+    --set mesh.max_volume=0.01)
+
+function(run_ok)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 300)
+  if(NOT rc STREQUAL "0")
+    message(FATAL_ERROR "${ARGN}\n  exit ${rc}\n  stdout: ${out}\n  stderr: ${err}")
+  endif()
+endfunction()
+
+# expect_same(A B TOLERANCE): every channel of every pixel within TOLERANCE (oiiotool --diff).
+function(expect_same a b tolerance)
+  execute_process(COMMAND ${OIIOTOOL} --fail ${tolerance} --failpercent 0 ${a} ${b} --diff
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc STREQUAL "0")
+    message(FATAL_ERROR "${b} differs from ${a} by more than ${tolerance}:\n${out}${err}")
+  endif()
+  string(REGEX MATCH "Max error += [^ ]*" worst "${out}")
+  if(NOT worst)
+    set(worst "identical")
+  endif()
+  message(STATUS "${b}: ${worst} (tolerance ${tolerance})")
+endfunction()
+
+# sort_last(NAME RANKS scene args...): one process and N ranks, PNG and EXR, compared.
+function(sort_last name ranks)
+  run_ok(${CLVR} render ${ARGN} -o ${WORK}/${name}-1p.png)
+  run_ok(${CLVR} render ${ARGN} -o ${WORK}/${name}-1p.exr)
+  foreach(n ${ranks})
+    run_ok(${MPI} -np ${n} ${CLVR} render ${ARGN} -o ${WORK}/${name}-${n}.png)
+    run_ok(${MPI} -np ${n} ${CLVR} render ${ARGN} -o ${WORK}/${name}-${n}.exr)
+    expect_same(${WORK}/${name}-1p.png ${WORK}/${name}-${n}.png 0.0040)  # at most one 8-bit step
+    expect_same(${WORK}/${name}-1p.exr ${WORK}/${name}-${n}.exr 2e-5)
+  endforeach()
+endfunction()
+
+sort_last(volume "1;2;3;5;8" ${VOLUME})
+sort_last(volume-parallel "2;4" ${VOLUME} --set camera.projection=\"parallel\" --set camera.parallel_scale=1.3)
+sort_last(volume-inside "3;6" ${VOLUME} --set camera.position=[0.2,0.3,0.6] --set camera.view_angle=80)
+sort_last(mesh "1;2;4;7" ${MESH})
+sort_last(mesh-parallel "3" ${MESH} --set camera.projection=\"parallel\" --set camera.parallel_scale=1.4)
+
+# Frames: an orbit of 5 frames on 3 ranks, each frame as one process renders it.
+run_ok(${CLVR} render ${VOLUME} --orbit 5 -o ${WORK}/orbit-1p-%d.png)
+run_ok(${MPI} -np 3 ${CLVR} render ${VOLUME} --orbit 5 -o ${WORK}/orbit-%d.png --stats ${WORK}/orbit.json)
+foreach(k RANGE 4)
+  expect_same(${WORK}/orbit-1p-${k}.png ${WORK}/orbit-${k}.png 0)
+endforeach()
+file(READ ${WORK}/orbit.json stats)
+string(JSON ranks GET "${stats}" ranks)
+string(JSON rank4 GET "${stats}" frames 4 rank)
+if(NOT ranks EQUAL 3 OR NOT rank4 EQUAL 1)
+  message(FATAL_ERROR "orbit stats: ranks ${ranks}, frame 4 on rank ${rank4}; want 3 and 1\n${stats}")
+endif()
+
+# expect_job_error(RC PATTERN mpirun-args...): mpirun's status RC, exactly one "clvr: error:" line (rank 0
+# speaks for all) matching PATTERN, within 60 s, and no image.
+function(expect_job_error expected_rc pattern)
+  file(REMOVE ${WORK}/fail.png)
+  string(TIMESTAMP t0 "%s")
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 120)
+  string(TIMESTAMP t1 "%s")
+  math(EXPR seconds "${t1} - ${t0}")
+  set(context "${ARGN}\n  exit ${rc} after ${seconds} s\n  stdout: ${out}\n  stderr: ${err}")
+  if(NOT rc STREQUAL "${expected_rc}")
+    message(FATAL_ERROR "${context}\n  want exit ${expected_rc}")
+  endif()
+  string(REGEX MATCHALL "clvr: error:" lines "${err}")  # (an error line may hold a ';', a CMake list separator)
+  list(LENGTH lines count)
+  if(NOT count EQUAL 1)
+    message(FATAL_ERROR "${context}\n  want exactly one 'clvr: error:' line, got ${count}")
+  endif()
+  if(NOT err MATCHES "clvr: error: [^\n]*${pattern}")
+    message(FATAL_ERROR "${context}\n  the error does not match '${pattern}'")
+  endif()
+  if(seconds GREATER 60 OR EXISTS ${WORK}/fail.png)
+    message(FATAL_ERROR "${context}\n  took over 60 s or left ${WORK}/fail.png")
+  endif()
+endfunction()
+
+set(SMALL --set image.width=64 --set image.height=64 -o ${WORK}/fail.png)
+expect_job_error(2 "rank 1: .*missing.json: no such scene file"
+  ${MPI} -np 1 ${CLVR} render ${SRC}/data/scenes/default.json ${SMALL}
+       : -np 1 ${CLVR} render ${WORK}/missing.json ${SMALL})
+expect_job_error(3 "rank 2: building kernels/"
+  ${MPI} -np 2 ${CLVR} render ${SRC}/data/scenes/default.json ${SMALL}
+       : -np 1 -x CLVR_INJECT_FAULT=build ${CLVR} render ${SRC}/data/scenes/default.json ${SMALL})
+expect_job_error(3 "CL_OUT_OF_RESOURCES .injected"
+  ${MPI} -np 3 -x CLVR_INJECT_FAULT=launch:1 ${CLVR} render ${SRC}/data/scenes/default.json ${SMALL})
+expect_job_error(2 "iso3d does not render a part"
+  ${MPI} -np 2 ${CLVR} render ${SRC}/data/scenes/engine-iso.json ${SMALL})
+expect_job_error(2 "unknown distribution \"tiles\""
+  ${MPI} -np 2 ${CLVR} render ${SRC}/data/scenes/default.json ${SMALL} --distribution tiles)

@@ -1,0 +1,277 @@
+// tests/partition_test.cpp — sort-last on one process (host/cluster/partition.h): the k-d tree's
+// visibility order against rays cast through the boxes, grid and mesh parts that cover the data, and the
+// parts' images, rendered on their own and composited "over" in that order, against the one-part image
+// (slice3d fused, harc) for 1..8 parts, perspective, parallel and an eye inside the bounds.
+#include "host/cluster/partition.h"
+
+#include "host/io/generators.h"
+#include "host/render/renderer.h"
+#include "host/runtime/errors.h"
+#include "tests/support/mesh_fixtures.h"
+#include "tests/support/test_util.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace clvr {
+namespace {
+
+// The parts a ray e + t d (t >= 0 for perspective, all t for parallel) passes through, in the order
+// it enters them (slab tests in double).
+std::vector<int> partsAlongRay(const std::vector<glm::dvec3>& lo, const std::vector<glm::dvec3>& hi,
+                               const glm::dvec3& e, const glm::dvec3& d, bool fromEye)
+{
+    std::vector<std::pair<double, int>> hits;
+    for (std::size_t p = 0; p < lo.size(); ++p) {
+        double t0 = fromEye ? 0.0 : -INFINITY, t1 = INFINITY;
+        for (int a = 0; a < 3; ++a) {
+            const double u = (lo[p][a] - e[a]) / d[a], v = (hi[p][a] - e[a]) / d[a];
+            t0 = std::max(t0, std::min(u, v));
+            t1 = std::min(t1, std::max(u, v));
+        }
+        if (t1 - t0 > 1e-9)  // a real stretch inside, not a touch of an edge
+            hits.emplace_back(t0, static_cast<int>(p));
+    }
+    std::sort(hits.begin(), hits.end());
+    std::vector<int> out;
+    for (const auto& h : hits)
+        out.push_back(h.second);
+    return out;
+}
+
+// Every ray through the camera's image visits the parts in an order consistent with frontToBack.
+void expectOrderHoldsAlongRays(const KdTree& tree, const std::vector<glm::dvec3>& lo,
+                               const std::vector<glm::dvec3>& hi, const Camera& camera)
+{
+    const std::vector<int> order = tree.frontToBack(camera);
+    ASSERT_EQ(order.size(), lo.size());
+    std::vector<int> rank(order.size());
+    for (std::size_t i = 0; i < order.size(); ++i)
+        rank[static_cast<std::size_t>(order[i])] = static_cast<int>(i);
+    int checked = 0;
+    for (int y = 0; y < 24; ++y)
+        for (int x = 0; x < 24; ++x) {
+            const Ray ray = camera.ray(x, y, 24, 24);
+            const std::vector<int> along = partsAlongRay(lo, hi, ray.origin, ray.direction, !camera.parallel);
+            for (std::size_t i = 1; i < along.size(); ++i, ++checked)
+                ASSERT_LT(rank[static_cast<std::size_t>(along[i - 1])], rank[static_cast<std::size_t>(along[i])])
+                    << "pixel " << x << "," << y << ": part " << along[i - 1] << " is in front of part " << along[i];
+        }
+    EXPECT_GT(checked, 0) << "no ray crossed two parts: the test checks nothing";
+}
+
+std::vector<Camera> sortLastCameras()
+{
+    Camera inside = test::obliquePerspectiveCamera(70.0);
+    inside.position = {0.15, -0.1, 0.3};  // inside [-1, 1]^3
+    inside.focalPoint = {-0.6, 0.4, -0.9};
+    return {test::obliquePerspectiveCamera(40.0), test::obliqueParallelCamera(1.8), inside};
+}
+
+TEST(Partition, KdOrderIsTheVisibilityOrderOfTheBoxesForEveryEye)
+{
+    const glm::ivec3 dims(33, 29, 41);
+    const glm::dvec3 origin(-1.0), spacing = 2.0 / glm::dvec3(dims - 1);
+    for (int n = 2; n <= 8; ++n) {
+        const GridPartition grid = partitionGrid(dims, origin, spacing, n);
+        std::vector<glm::dvec3> lo, hi;
+        for (int p = 0; p < n; ++p) {
+            lo.push_back(origin + glm::dvec3(grid.lo[static_cast<std::size_t>(p)]) * spacing);
+            hi.push_back(origin + glm::dvec3(grid.hi[static_cast<std::size_t>(p)]) * spacing);
+        }
+        for (const Camera& camera : sortLastCameras()) {
+            SCOPED_TRACE("n = " + std::to_string(n));
+            expectOrderHoldsAlongRays(grid.tree, lo, hi, camera);
+        }
+    }
+}
+
+TEST(Partition, GridPartsShareOneLayerAndCoverEveryCellOnce)
+{
+    const glm::ivec3 dims(17, 9, 12);
+    for (int n = 1; n <= 8; ++n) {
+        const GridPartition g = partitionGrid(dims, glm::dvec3(0.0), glm::dvec3(1.0), n);
+        std::vector<int> cover(static_cast<std::size_t>((dims.x - 1) * (dims.y - 1) * (dims.z - 1)), 0);
+        std::size_t smallest = SIZE_MAX, largest = 0;
+        for (int p = 0; p < n; ++p) {
+            const glm::ivec3 lo = g.lo[static_cast<std::size_t>(p)], hi = g.hi[static_cast<std::size_t>(p)];
+            ASSERT_TRUE(glm::all(glm::lessThan(lo, hi))) << "part " << p << " has no cell";
+            const std::size_t cells = static_cast<std::size_t>((hi - lo).x) * (hi - lo).y * (hi - lo).z;
+            smallest = std::min(smallest, cells);
+            largest = std::max(largest, cells);
+            for (int k = lo.z; k < hi.z; ++k)
+                for (int j = lo.y; j < hi.y; ++j)
+                    for (int i = lo.x; i < hi.x; ++i)
+                        ++cover[static_cast<std::size_t>((k * (dims.y - 1) + j) * (dims.x - 1) + i)];
+        }
+        EXPECT_TRUE(std::all_of(cover.begin(), cover.end(), [](int c) { return c == 1; })) << n << " parts";
+        EXPECT_LE(static_cast<double>(largest), 2.5 * static_cast<double>(smallest)) << n << " parts: unbalanced";
+    }
+    EXPECT_THROW(partitionGrid(glm::ivec3(3, 2, 2), glm::dvec3(0.0), glm::dvec3(1.0), 3), InputError);
+}
+
+TEST(Partition, GridPartHoldsItsPointsAndKnowsWhereItSits)
+{
+    Volume v = generateVolume("marschner-lobb", glm::ivec3(9, 7, 8));
+    const GridPartition g = partitionGrid(v.dims, v.origin, v.spacing, 4);
+    for (int p = 0; p < 4; ++p) {
+        const Volume part = cutGridPart(v, g, p);
+        ASSERT_TRUE(part.part.has_value());
+        EXPECT_EQ(part.part->offset, g.lo[static_cast<std::size_t>(p)]);
+        EXPECT_EQ(part.part->fullDims, v.dims);
+        const glm::ivec3 o = part.part->offset;
+        for (int k = 0; k < part.dims.z; ++k)
+            for (int j = 0; j < part.dims.y; ++j)
+                for (int i = 0; i < part.dims.x; ++i)
+                    ASSERT_EQ(part.at(i, j, k), v.at(i + o.x, j + o.y, k + o.z));
+        EXPECT_NO_THROW(part.validate());
+    }
+}
+
+// Renders `scene` whole and as n parts (each part on its own, background 0, composited over in the
+// tree's order, then the background added), and returns the largest channel difference.
+double sortLastDifference(const Scene& scene, const std::function<Image4f(const Scene&, int, int)>& renderPart,
+                          const KdTree& tree, int n)
+{
+    const Image4f whole = renderPart(scene, -1, n);
+    Scene partScene = scene;
+    partScene.image.background = glm::dvec3(0.0);
+    std::vector<Image4f> images;
+    for (int p = 0; p < n; ++p)
+        images.push_back(renderPart(partScene, p, n));
+    std::vector<const Image4f*> ordered;
+    for (int p : tree.frontToBack(*scene.camera))
+        ordered.push_back(&images[static_cast<std::size_t>(p)]);
+    Image4f composite = compositeOver(ordered);
+    addBackground(composite, scene.image.background);
+    double worst = 0.0;
+    for (std::size_t i = 0; i < whole.pixelCount(); ++i)
+        for (int c = 0; c < 4; ++c) {
+            const double d = std::abs(double(composite.pixels()[i][c]) - double(whole.pixels()[i][c]));
+            worst = std::isnan(d) ? INFINITY : std::max(worst, d);
+        }
+    return worst;
+}
+
+// Float tolerance of the sort-last composite against the whole image: the same samples (slice3d) or the
+// same segments cut at the boxes (harc), blended in another association. 8-bit: far below 1/255.
+constexpr double kSortLastFloatTolerance = 2e-5;
+
+TEST(SortLast, Slice3dPartsCompositeToTheWholeImage)
+{
+    const Volume v = generateVolume("marschner-lobb", glm::ivec3(41, 37, 45));
+    Scene scene;
+    scene.technique = "slice3d";
+    scene.image = ImageSpec{64, 64, {0.1, 0.2, 0.3}};
+    scene.transferFunction = test::designTransferFunction();
+    scene.options = {{"slices", 160}};
+    for (const Camera& camera : sortLastCameras()) {
+        scene.camera = camera;
+        for (int n : {1, 2, 3, 5, 8}) {
+            const GridPartition g = partitionGrid(v.dims, v.origin, v.spacing, n);
+            const auto render = [&](const Scene& s, int p, int) {
+                FrameStats stats;
+                return p < 0 ? test::renderScene(s, v) : test::renderScene(s, cutGridPart(v, g, p), &stats);
+            };
+            const double d = sortLastDifference(scene, render, g.tree, n);
+            std::printf("slice3d, %s camera, %d parts: max |composite - whole| = %.2g\n",
+                        camera.parallel ? "parallel" : "perspective", n, d);
+            EXPECT_LE(d, kSortLastFloatTolerance) << n << " parts";
+        }
+    }
+}
+
+TEST(SortLast, Slice3dPartTakesEachSampleOnce)
+{
+    // The samples the parts take add up to the whole image's (every sample owned by one part).
+    const Volume v = generateVolume("marschner-lobb", glm::ivec3(21, 19, 23));
+    Scene scene;
+    scene.technique = "slice3d";
+    scene.image = ImageSpec{48, 48, {0.0, 0.0, 0.0}};
+    scene.transferFunction = test::designTransferFunction();
+    scene.camera = test::obliquePerspectiveCamera(40.0);
+    scene.options = {{"slices", 97}, {"empty_space_skipping", false}};
+    FrameStats whole;
+    test::renderScene(scene, v, &whole);
+    const GridPartition g = partitionGrid(v.dims, v.origin, v.spacing, 6);
+    std::uint64_t sum = 0;
+    for (int p = 0; p < 6; ++p) {
+        FrameStats stats;
+        test::renderScene(scene, cutGridPart(v, g, p), &stats);
+        sum += stats.samples;
+    }
+    EXPECT_EQ(sum, whole.samples);
+    EXPECT_GT(whole.samples, 0u);
+}
+
+TEST(SortLast, HarcPartsCompositeToTheWholeImage)
+{
+    // Two boxes (a non-convex L of cells) with a linear field: the k-d boxes cut through cells.
+    TetMesh mesh = test::boxMesh({{{-1.0, -1.0, -1.0}, {1.0, 0.0, 1.0}, 5}, {{-1.0, 0.0, -1.0}, {0.0, 1.0, 1.0}, 3}},
+                                 {0.3, 0.2, -0.25}, 0.5);
+    checkMesh(mesh);
+    Scene scene = test::meshScene("harc", Camera{}, test::rampTransferFunction(), 48);
+    // harc starts its rays at boundary faces, so the eye stays outside the mesh (docs/harc.md); close to
+    // it, looking across the cuts.
+    Camera near = test::perspective({1.9, 0.8, 1.6}, {-0.2, 0.1, -0.3}, 60.0);
+    for (const Camera& camera : {sortLastCameras()[0], sortLastCameras()[1], near}) {
+        scene.camera = camera;
+        for (int n : {1, 2, 3, 4, 7}) {
+            const MeshPartition m = partitionMesh(mesh, n);
+            const auto render = [&](const Scene& s, int p, int) {
+                const TetMesh part = p < 0 ? mesh : cutMeshPart(mesh, m, p);
+                FrameStats stats;
+                return makeMeshRenderer(test::device(), s, part)->render(stats);
+            };
+            const double d = sortLastDifference(scene, render, m.tree, n);
+            std::printf("harc, %s camera, %d parts: max |composite - whole| = %.2g\n",
+                        camera.parallel ? "parallel" : "perspective", n, d);
+            EXPECT_LE(d, kSortLastFloatTolerance) << n << " parts";
+        }
+    }
+}
+
+TEST(SortLast, MeshPartsKeepEveryCellThatMeetsTheirBox)
+{
+    TetMesh mesh = test::boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, 4}}, {1.0, 0.0, 0.0}, 0.0);
+    checkMesh(mesh);
+    const MeshPartition m = partitionMesh(mesh, 4);
+    std::size_t kept = 0;
+    for (int p = 0; p < 4; ++p) {
+        const TetMesh part = cutMeshPart(mesh, m, p);
+        kept += part.tets.size();
+        // Every centroid inside the box has its cell in the part.
+        std::size_t inside = 0;
+        for (const glm::uvec4& t : mesh.tets) {
+            const glm::dvec3 c = 0.25 * (mesh.points[t.x] + mesh.points[t.y] + mesh.points[t.z] + mesh.points[t.w]);
+            inside += glm::all(glm::greaterThanEqual(c, m.lo[static_cast<std::size_t>(p)])) &&
+                      glm::all(glm::lessThanEqual(c, m.hi[static_cast<std::size_t>(p)]));
+        }
+        EXPECT_GE(part.tets.size(), inside);
+        EXPECT_EQ(part.points.size(), part.scalars.size());
+    }
+    EXPECT_GE(kept, mesh.tets.size());  // cells on a cut belong to both sides
+}
+
+TEST(SortLast, TechniquesThatCannotRenderAPartSaySo)
+{
+    const Volume v = generateVolume("sphere", glm::ivec3(9, 9, 9));
+    const GridPartition g = partitionGrid(v.dims, v.origin, v.spacing, 2);
+    Scene scene;
+    scene.technique = "iso3d";
+    scene.image = ImageSpec{16, 16, {0.0, 0.0, 0.0}};
+    scene.transferFunction = test::designTransferFunction();
+    try {
+        makeRenderer(test::device(), scene, cutGridPart(v, g, 0));
+        FAIL() << "iso3d took a part";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("--distribution frames"), std::string::npos) << e.what();
+    }
+    scene.technique = "slice3d";
+    scene.options = {{"path", "raster"}};
+    EXPECT_THROW(makeRenderer(test::device(), scene, cutGridPart(v, g, 0)), InputError);
+}
+
+}  // namespace
+}  // namespace clvr

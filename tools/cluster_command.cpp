@@ -1,0 +1,261 @@
+// tools/cluster_command.cpp — `mpirun -np N clvr render` (docs/cluster.md): one image (or --orbit frames)
+// from N ranks, the same files and errors as one process.
+//   sort-last: every rank loads the data, keeps its k-d part (host/cluster/partition.h) and renders it
+//              with the scene's technique into premultiplied RGBA on a black background; IceT composites
+//              the parts in the view's visibility order (host/cluster/compositor.h); rank 0 adds the
+//              background and writes.
+//   frames:    frame k of --orbit N on rank k mod N; each rank writes its own frames.
+// Every step that can fail runs inside World::agree, so a failure on any rank becomes the same error on
+// every rank (rank 0 prints it, every rank exits with its status) and nobody waits in a collective.
+#include "tools/commands.h"
+
+#include "host/cluster/compositor.h"
+#include "host/cluster/partition.h"
+#include "host/cluster/world.h"
+#include "host/io/image_io.h"
+#include "host/model/scene.h"
+#include "host/render/scaffold.h"
+#include "host/runtime/device.h"
+#include "host/runtime/errors.h"
+#include "host/runtime/parallel.h"
+#include "host/session.h"
+#include "tools/render_output.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <thread>
+
+namespace clvr::tools {
+namespace {
+
+using cluster::World;
+
+// The rank's OpenCL device: --device or $CLVR_DEVICE when given, else the GPUs shared out by node-local
+// rank, else the usual default (the first CPU device).
+std::string rankDevice(const RenderOptions& options, const World& world)
+{
+    if (!options.deviceSpec.empty())
+        return options.deviceSpec;
+    if (const char* env = std::getenv("CLVR_DEVICE"); env && *env)
+        return env;
+    std::vector<DeviceListing> gpus;
+    for (const DeviceListing& d : listDevices())
+        if (d.type == "GPU")
+            gpus.push_back(d);
+    if (gpus.empty())
+        return "";
+    return std::to_string(gpus[static_cast<std::size_t>(world.nodeRank()) % gpus.size()].index);
+}
+
+// The job's distribution: --distribution, else the scene's, else sort-last (frames with --orbit).
+std::string distributionOf(const RenderOptions& options, const Scene& scene)
+{
+    if (!options.distribution.empty()) {
+        checkDistribution(options.distribution, "--distribution");
+        return options.distribution;
+    }
+    if (!scene.distribution.empty())
+        return scene.distribution;
+    return options.orbit > 0 ? "frames" : "sort-last";
+}
+
+double msSince(std::chrono::steady_clock::time_point t0)
+{
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+struct Job {
+    Scene scene;
+    std::string sceneLabel;
+    std::vector<std::string> outputs;
+    std::string distribution;
+};
+
+// Frames: each rank renders and writes the orbit frames k with k mod size == rank.
+int renderFrames(const RenderOptions& options, World& world, Job& job)
+{
+    const int count = static_cast<int>(job.outputs.size());
+    WrittenFiles written;
+    std::vector<double> frameMs(static_cast<std::size_t>(count), 0.0);
+    std::unique_ptr<Session> session;
+    world.agree([&] {
+        if (world.rank() >= count)
+            return;  // nothing to do: more ranks than frames
+        session = std::make_unique<Session>(job.scene, job.sceneLabel, rankDevice(options, world));
+        const Camera camera0 = session->camera();
+        for (int k = world.rank(); k < count; k += world.size()) {
+            if (k != 0)
+                session->setCamera(orbitCamera(camera0, k, count));
+            Frame frame = session->render();
+            if (!options.singleFrame && k == world.rank())
+                frame = session->render();  // the first frame builds kernels; time a steady one
+            writeImage(job.outputs[static_cast<std::size_t>(k)], frame.image);
+            written.add(job.outputs[static_cast<std::size_t>(k)]);
+            frameMs[static_cast<std::size_t>(k)] = frame.stats.frameMs;
+        }
+    });
+    std::vector<double> all = frameMs;
+    for (int k = 0; k < count; ++k)
+        all[static_cast<std::size_t>(k)] = world.maxOver(frameMs[static_cast<std::size_t>(k)]);
+    world.agree([&] {
+        if (world.rank() == 0 && !options.statsPath.empty()) {
+            nlohmann::json frames = nlohmann::json::array();
+            for (int k = 0; k < count; ++k)
+                frames.push_back({{"index", k}, {"rank", k % world.size()}, {"output", job.outputs[static_cast<std::size_t>(k)]},
+                                  {"frame_ms", all[static_cast<std::size_t>(k)]}});
+            nlohmann::json stats = {{"scene", job.sceneLabel}, {"technique", job.scene.technique},
+                                    {"distribution", "frames"}, {"ranks", world.size()}, {"frames", frames}};
+            writeFileAtomically(options.statsPath, stats.dump(2) + "\n");
+        }
+    });
+    written.keep();
+    if (world.rank() == 0)
+        std::cout << "wrote " << options.output << ": " << count << " frame" << (count == 1 ? "" : "s") << " on "
+                  << world.size() << " ranks (" << job.scene.technique << ", frames)" << std::endl;
+    return 0;
+}
+
+// Sort-last: each rank renders its part; IceT composites; rank 0 writes.
+int renderSortLast(const RenderOptions& options, World& world, Job& job)
+{
+    const int count = static_cast<int>(job.outputs.size());
+    std::unique_ptr<Device> device;
+    std::unique_ptr<Session> session;
+    KdTree tree;
+    std::string partText;
+    double setupMs = 0.0;
+    world.agree([&] {
+        const auto t0 = std::chrono::steady_clock::now();
+        SceneData data = loadSceneData(job.scene);
+        job.scene.camera = sceneCamera(job.scene, data);  // the whole data's camera, on every rank
+        // Cut out this rank's part (the rest of the data is freed here).
+        if (job.scene.mesh) {
+            const MeshPartition partition = partitionMesh(data.mesh, world.size());
+            data.mesh = cutMeshPart(data.mesh, partition, world.rank());
+            tree = partition.tree;
+            partText = std::to_string(data.mesh.tets.size()) + " tets";
+        } else {
+            const GridPartition partition = partitionGrid(data.volume.dims, data.volume.origin, data.volume.spacing,
+                                                          world.size());
+            data.volume = cutGridPart(data.volume, partition, world.rank());
+            tree = partition.tree;
+            const glm::ivec3 n = data.volume.dims;
+            partText = std::to_string(n.x) + "x" + std::to_string(n.y) + "x" + std::to_string(n.z) + " points";
+        }
+        Scene partScene = job.scene;
+        partScene.image.background = glm::dvec3(0.0);  // premultiplied parts; the background goes on last
+        device = std::make_unique<Device>(rankDevice(options, world));
+        session = std::make_unique<Session>(*device, partScene, std::move(data), job.sceneLabel);
+        setupMs = msSince(t0);
+    });
+    cluster::Compositor compositor(world, job.scene.image.width, job.scene.image.height);
+
+    WrittenFiles written;
+    nlohmann::json frames = nlohmann::json::array();
+    nlohmann::json frame0Stats;
+    double frame0Ms = 0.0, composite0Ms = 0.0;
+    const Camera camera0 = *job.scene.camera;
+    for (int k = 0; k < count; ++k) {
+        const Camera camera = orbitCamera(camera0, k, count);
+        Frame frame;
+        world.agree([&] {
+            if (k != 0)
+                session->setCamera(camera);
+            frame = session->render();
+            if (k == 0 && !options.singleFrame)
+                frame = session->render();  // the first frame builds kernels; time a steady one
+        });
+        const auto t0 = std::chrono::steady_clock::now();
+        Image4f image;
+        world.agree([&] { image = compositor.composite(frame.image, tree.frontToBack(camera)); });
+        const double compositeMs = msSince(t0);
+        const double renderMs = world.maxOver(frame.stats.frameMs);
+        const std::vector<double> perRank = world.gather(frame.stats.frameMs);
+        world.agree([&] {
+            if (world.rank() != 0)
+                return;
+            addBackground(image, job.scene.image.background);
+            const std::string& path = job.outputs[static_cast<std::size_t>(k)];
+            writeImage(path, image);
+            written.add(path);
+            frames.push_back({{"index", k}, {"output", path}, {"render_ms", renderMs}, {"composite_ms", compositeMs},
+                              {"frame_ms", renderMs + compositeMs}, {"render_ms_per_rank", perRank}});
+            if (k == 0) {
+                frame0Stats = session->stats(frame);
+                frame0Ms = renderMs + compositeMs;
+                composite0Ms = compositeMs;
+                noteEmptyImage(image, job.scene.technique);
+            }
+        });
+    }
+    world.agree([&] {
+        if (world.rank() != 0 || options.statsPath.empty())
+            return;
+        nlohmann::json stats = frame0Stats;  // rank 0's own part, plus the job's figures
+        stats["scene"] = job.sceneLabel;
+        stats["distribution"] = "sort-last";
+        stats["ranks"] = world.size();
+        stats["rank0_part"] = partText;
+        stats["setup_ms"] = setupMs;
+        stats["frame_ms"] = frame0Ms;
+        stats["composite_ms"] = composite0Ms;
+        stats["frames"] = frames;
+        if (options.orbit > 0)
+            stats["orbit"] = options.orbit;
+        writeFileAtomically(options.statsPath, stats.dump(2) + "\n");
+    });
+    written.keep();
+    if (world.rank() == 0) {
+        std::ostringstream line;
+        line << "wrote " << options.output;
+        if (options.orbit > 0)
+            line << ": " << count << " frames";
+        line << " (" << job.scene.image.width << "x" << job.scene.image.height << ", " << job.scene.technique
+             << ", sort-last on " << world.size() << " ranks, " << std::fixed << std::setprecision(1) << frame0Ms
+             << " ms/frame)";
+        std::cout << line.str() << std::endl;
+    }
+    return 0;
+}
+
+}  // namespace
+
+int renderCluster(const RenderOptions& options)
+{
+    World world(nullptr, nullptr);
+    // Host threads: the budget shared by the ranks on a node unless --threads or $CLVR_THREADS said.
+    if (!options.threadsGiven) {
+        setThreadBudget(std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / world.nodeSize()));
+        passThreadBudgetToPocl();
+    }
+    try {
+        Job job;
+        world.agree([&] {
+            if (options.orbit < 0)
+                throw InputError("--orbit: the frame count must be at least 1, got " + std::to_string(options.orbit));
+            job.outputs = outputPaths(options);
+            if (!options.statsPath.empty())
+                checkWritable(options.statsPath, "--stats");
+            const bool useDefault = options.scene.empty() || options.scene == "default";
+            job.sceneLabel = useDefault ? "default scene" : options.scene;
+            job.scene = useDefault ? defaultScene(options.overrides, options.unsets)
+                                   : loadScene(options.scene, options.overrides, options.unsets);
+            job.distribution = distributionOf(options, job.scene);
+            if (job.distribution == "sort-first")
+                throw InputError("--distribution sort-first is not built yet (docs/cluster.md); use sort-last or frames");
+        });
+        return job.distribution == "frames" ? renderFrames(options, world, job) : renderSortLast(options, world, job);
+    } catch (...) {
+        if (world.rank() != 0)
+            quietErrors();  // the same error on every rank: rank 0 prints it
+        throw;
+    }
+}
+
+}  // namespace clvr::tools
