@@ -65,7 +65,8 @@ float4 harc_full_lookup(global const float4* table, const int ns, const int nl, 
 }
 
 /* One work-item per pixel. entries[offsets[p] .. offsets[p+1]) are the boundary front-face crossings
- * of pixel p's ray, sorted by ray parameter: (λ as float bits, tet * 4 + face). params.camera is
+ * of pixel p's ray, sorted by ray parameter: (λ as float bits, tet * 4 + face), after (0, -1 - tet) when a
+ * perspective eye lies inside tet. params.camera is
  * relative to the mesh's shifted origin. Ray e + λ d, |d| = 1 (kernels/ray.h's clvr_ray_unit, as
  * host/model/camera.cpp's Camera::ray). stats[p] = (steps, 1 if the step bound stopped the ray, pieces).
  * integration: HARC_INTEGRATION_*; full_table, full_ns, full_nl, full_params: harc_full_lookup's
@@ -120,8 +121,9 @@ kernel void harc_render(global float4* out, global uint* stats, global const flo
         if (lambda < lambda_done - 1e-5f * (1.0f + fabs(lambda_done)))
             continue;
         lambda = fmax(lambda, lambda_done);
-        int t = entry.y >> 2;
-        int entry_face = entry.y & 3;
+        /* tet * 4 + entry face; -1 - tet for a perspective eye inside tet (no entry face) */
+        int t = entry.y >= 0 ? entry.y >> 2 : -1 - entry.y;
+        int entry_face = entry.y >= 0 ? entry.y & 3 : -1;
         for (;;) {
             if (steps >= max_steps) {
                 bounded = 1;

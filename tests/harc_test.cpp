@@ -7,6 +7,7 @@
 
 #include "host/runtime/errors.h"
 #include "host/optics/psi_table.h"
+#include "host/reference/tet_reference.h"
 #include "tests/support/mesh_fixtures.h"
 #include "tests/support/test_util.h"
 
@@ -319,6 +320,26 @@ TEST(Harc, ConvexBoxGridMatchesExactIntegral)
         EXPECT_GT(stats.extra["steps"].get<std::uint64_t>(), 1000u);
         EXPECT_EQ(stats.extra["tet_layout_bytes"].get<std::uint64_t>(), 80u);
     }
+}
+
+TEST(Harc, EyeInsideTheMeshStartsEveryRayInItsCell)
+{
+    // A perspective eye inside a non-convex mesh (two boxes): the rays start in the eye's cell, not at the
+    // first boundary face ahead; before this they lost everything between the eye and that face.
+    const std::vector<Box> boxes = {{{0.0, 0.0, 0.0}, {2.0, 1.0, 1.0}, 4}, {{0.0, 1.0, 0.0}, {1.0, 2.0, 1.0}, 3}};
+    const glm::dvec3 gradient(0.3, 0.35, -0.4);
+    TetMesh mesh = boxMesh(boxes, gradient, 0.4);
+    checkMesh(mesh);
+    const TransferFunction tf = rampTf();
+    Camera camera = perspective({0.55, 0.45, 0.6}, {1.6, 1.3, 0.3}, 95.0);
+    const Scene scene = makeScene(camera, tf, 48);
+    FrameStats stats;
+    const Image4f image = renderHarc(scene, mesh, &stats);
+    EXPECT_GE(stats.extra["eye_tet"].get<std::int64_t>(), 0);
+    const Image4d expected = tetReferenceIntegral(mesh, tf, camera, scene.image);
+    printError("eye inside", image, expected);
+    EXPECT_TRUE(test::imagesNear(image, expected, {.maxAbs = 2e-3, .meanAbs = 2e-4}));
+    EXPECT_EQ(locatePoint(mesh, glm::dvec3(1.5, 1.5, 0.5)), -1);  // in the L's gap
 }
 
 TEST(Harc, NonConvexRayContinuesBehindTheGap)

@@ -69,19 +69,6 @@ Spread spread(std::vector<double> v)
 
 // A file of the repository (data/scenes/bench/..., tools/peer_vtk.py): looked up from the current
 // folder, then from the executable's folder and its parents (a build folder inside the repository).
-fs::path repoFile(const fs::path& relative)
-{
-    if (fs::exists(relative))
-        return relative;
-    std::error_code ec;
-    fs::path dir = fs::read_symlink("/proc/self/exe", ec).parent_path();
-    for (int up = 0; !ec && up < 4 && !dir.empty(); ++up, dir = dir.parent_path())
-        if (fs::exists(dir / relative))
-            return dir / relative;
-    throw InputError(relative.string() + ": not found in the current folder or above the clvr executable "
-                     "(run clvr bench from the repository root, or name the scene files)");
-}
-
 // Per-channel absolute difference over R, G, B (VTK's PNG has no alpha).
 struct ImageDiff {
     double mean = 0.0, max = 0.0;
@@ -412,10 +399,25 @@ nlohmann::json rasterBench(Device& device)
 
 }  // namespace
 
+std::filesystem::path repoFile(const std::filesystem::path& relative)
+{
+    if (fs::exists(relative))
+        return relative;
+    std::error_code ec;
+    fs::path dir = fs::read_symlink("/proc/self/exe", ec).parent_path();
+    for (int up = 0; !ec && up < 4 && !dir.empty(); ++up, dir = dir.parent_path())
+        if (fs::exists(dir / relative))
+            return dir / relative;
+    throw InputError(relative.string() + ": not found in the current folder or above the clvr executable "
+                     "(run clvr bench from the repository root, or name the scene files)");
+}
+
 int bench(const BenchOptions& options)
 {
     if (options.suite == "raster" && options.scenes.empty())
         return benchRaster(options);
+    if (options.suite == "cluster")
+        return benchCluster(options);
     std::vector<fs::path> scenes(options.scenes.begin(), options.scenes.end());
     if (scenes.empty())
         for (const std::string& name : benchSuiteScenes(options.suite))

@@ -4,6 +4,7 @@
 // docs/benchmarks.md says what each figure means and how it is measured.
 #pragma once
 
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,14 @@ struct BenchOptions {
 // The scene files (under data/scenes/bench/) a suite runs: "slice3d" -> slice3d-{ml256,engine}.json,
 // "harc" -> harc-bluntfin-{10,255}.json and harc-tetgen-1m.json, "all" -> both. InputError otherwise.
 std::vector<std::string> benchSuiteScenes(const std::string& suite);
+
+// `relative` (a repository file such as data/scenes/bench/x.json) from the current folder, else from the
+// folders above the clvr executable. InputError when neither has it.
+std::filesystem::path repoFile(const std::filesystem::path& relative);
+
+// --suite cluster (tools/bench_cluster.cpp): the scenes under mpirun on 1, 2 and 4 ranks, sort-last;
+// render, composite and frame times per rank count, and each image against one rank's.
+int benchCluster(const BenchOptions& options);
 
 // Runs the benchmark; returns the exit status (0). Throws InputError / DeviceError like `render`.
 int bench(const BenchOptions& options);

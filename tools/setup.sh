@@ -4,7 +4,8 @@
 #   bash tools/setup.sh test     install what is missing, build, run every test (ctest) on PoCL, the
 #                                kernel and image suites again on Mesa's rusticl (docs/devices.md), each
 #                                input reader under libFuzzer for 3 s (docs/robustness.md), then the host
-#                                code's tests again under AddressSanitizer + UndefinedBehaviorSanitizer
+#                                code's tests again under AddressSanitizer + UndefinedBehaviorSanitizer;
+#                                the cluster test runs mpirun -np 1..8 clvr render (docs/cluster.md)
 # Environment: JOBS (parallel build jobs, default: number of cores), CLVR_SKIP_FUZZ=1 and CLVR_SKIP_ASAN=1
 # skip the fuzzing and sanitizer passes.
 set -euo pipefail
@@ -20,7 +21,8 @@ jobs="${JOBS:-$(nproc)}"
 packages=(cmake make g++ pkg-config clang
     pocl-opencl-icd mesa-opencl-icd ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers
     libglm-dev libopenimageio-dev openimageio-tools libtet1.5-dev nlohmann-json3-dev libcli11-dev
-    libgtest-dev libbenchmark-dev zlib1g-dev)
+    libgtest-dev libbenchmark-dev zlib1g-dev
+    openmpi-bin libopenmpi-dev paraview-dev)  # MPI and IceT (inside ParaView) for mpirun -np N clvr render
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

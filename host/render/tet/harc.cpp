@@ -159,9 +159,12 @@ Image4f HarcRenderer::render(FrameStats& stats)
     const FrameClock clock;
     // Entry points: the boundary front faces' crossings per pixel, sorted by depth, every frame.
     HarcRasterEntryStats peel;
-    const HarcEntryLists lists = rasterEntries_
-                                     ? rasterEntries_->build(camera_, peel)
-                                     : buildHarcEntryLists(mesh_, topology_, camera_, image_.width, image_.height);
+    HarcEntryLists lists = rasterEntries_ ? rasterEntries_->build(camera_, peel)
+                                          : buildHarcEntryLists(mesh_, topology_, camera_, image_.width, image_.height);
+    // A perspective eye inside the mesh: every ray starts in the cell holding the eye, before any crossing.
+    const std::int64_t eyeTet = camera_.parallel ? -1 : locatePoint(mesh_, camera_.position);
+    if (eyeTet >= 0)
+        prependEyeEntry(lists, static_cast<std::uint32_t>(eyeTet));
     const double entryMs = clock.ms();
     const cl::Buffer offsets = device_.upload("harc entry offsets", lists.offsets);
     std::vector<cl_int2> entries = lists.entries;
@@ -253,6 +256,7 @@ Image4f HarcRenderer::render(FrameStats& stats)
     }
     stats.extra["early_termination"] = options_.earlyTermination;
     stats.extra["entry"] = rasterEntries_ ? "raster" : "host";
+    stats.extra["eye_tet"] = eyeTet;
     stats.extra["entry_ms"] = entryMs;
     if (rasterEntries_) {
         stats.extra["entry_layers"] = peel.layers;
@@ -511,6 +515,39 @@ HarcEntryLists buildHarcEntryLists(const TetMesh& mesh, const TetTopology& topol
         }
     }
     return lists;
+}
+
+std::int64_t locatePoint(const TetMesh& mesh, const glm::dvec3& p)
+{
+    for (std::size_t t = 0; t < mesh.tets.size(); ++t) {
+        const glm::uvec4 v = mesh.tets[t];
+        const glm::dvec3 a = mesh.points[v.x], b = mesh.points[v.y], c = mesh.points[v.z], d = mesh.points[v.w];
+        const double whole = signedVolume6(a, b, c, d);
+        if (!(whole > 0.0))
+            continue;
+        // Barycentric coordinates as signed sub-volumes; a point on a face or edge belongs to each cell there.
+        const double tol = -1e-12 * whole;
+        if (signedVolume6(p, b, c, d) >= tol && signedVolume6(a, p, c, d) >= tol && signedVolume6(a, b, p, d) >= tol &&
+            signedVolume6(a, b, c, p) >= tol)
+            return static_cast<std::int64_t>(t);
+    }
+    return -1;
+}
+
+void prependEyeEntry(HarcEntryLists& lists, std::uint32_t tet)
+{
+    const std::size_t pixels = lists.offsets.size() - 1;
+    std::vector<cl_int2> entries;
+    entries.reserve(lists.entries.size() + pixels);
+    const cl_int start = -1 - static_cast<cl_int>(tet);  // λ = 0 (bits 0), no entry face
+    for (std::size_t p = 0; p < pixels; ++p) {
+        const cl_uint first = lists.offsets[p], last = lists.offsets[p + 1];
+        lists.offsets[p] = static_cast<cl_uint>(entries.size());
+        entries.push_back(cl_int2{{0, start}});
+        entries.insert(entries.end(), lists.entries.begin() + first, lists.entries.begin() + last);
+    }
+    lists.offsets[pixels] = static_cast<cl_uint>(entries.size());
+    lists.entries = std::move(entries);
 }
 
 std::unique_ptr<Renderer> makeHarcRenderer(Device& device, const Scene& scene, const TetMesh& mesh,

@@ -70,6 +70,14 @@ struct HarcEntryLists {
 HarcEntryLists buildHarcEntryLists(const TetMesh& mesh, const TetTopology& topology, const Camera& camera,
                                    int width, int height);
 
+// The first tetrahedron that holds `p` (on its faces included), or -1: where a perspective eye inside the
+// mesh starts its rays. Linear in the cells, once per frame.
+std::int64_t locatePoint(const TetMesh& mesh, const glm::dvec3& p);
+
+// Puts (λ = 0, tet `tet`, no entry face; code -1 - tet) first in every pixel's list: the rays of an eye
+// inside `tet` start there, and the walk skips the crossings it passes (kernels/harc.cl).
+void prependEyeEntry(HarcEntryLists& lists, std::uint32_t tet);
+
 // Renderer for "harc" on a mesh that checkMesh() has normalized, with its topology. Throws InputError
 // for bad options or an empty mesh, DeviceError when the mesh does not fit on the device.
 std::unique_ptr<Renderer> makeHarcRenderer(Device& device, const Scene& scene, const TetMesh& mesh,

@@ -1,0 +1,150 @@
+// tools/bench_cluster.cpp — `clvr bench --suite cluster` (docs/cluster.md): each scene rendered sort-last by
+// `mpirun -np N clvr render` for N = 1, 2, 4 on this machine, several runs each; from every run's --stats the
+// steady frame's render time (the slowest rank's), IceT's composite time (blend and collection on rank 0)
+// and their sum, with each rank count's image against one rank's. tools/cluster_model.py fits the scaling
+// model to the JSON and projects it (docs/cluster.md).
+#include "tools/bench.h"
+
+#include "host/io/image_io.h"
+#include "host/runtime/errors.h"
+#include "tools/bench_machine.h"
+
+#include <nlohmann/json.hpp>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+#include <thread>
+
+namespace clvr::tools {
+namespace {
+
+namespace fs = std::filesystem;
+
+double median(std::vector<double> v)
+{
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+double maxDifference(const Image4f& a, const Image4f& b)
+{
+    if (a.width() != b.width() || a.height() != b.height())
+        return INFINITY;
+    double worst = 0.0;
+    for (std::size_t i = 0; i < a.pixelCount(); ++i)
+        for (int c = 0; c < 4; ++c)
+            worst = std::max(worst, std::abs(double(a.pixels()[i][c]) - double(b.pixels()[i][c])));
+    return worst;
+}
+
+// One `mpirun -np ranks clvr render` of the scene; its --stats.
+nlohmann::json runRanks(const fs::path& scene, int ranks, const fs::path& image, const fs::path& stats,
+                        const BenchOptions& options)
+{
+    std::ostringstream cmd;
+    cmd << "mpirun --oversubscribe --bind-to none -np " << ranks << " '" << fs::read_symlink("/proc/self/exe").string()
+        << "' render '" << scene.string() << "' --distribution sort-last -o '" << image.string() << "' --stats '"
+        << stats.string() << "'";
+    if (!options.deviceSpec.empty())
+        cmd << " --device '" << options.deviceSpec << "'";
+    for (const std::string& o : options.overrides)
+        cmd << " --set '" << o << "'";
+    for (const std::string& u : options.unsets)
+        cmd << " --unset '" << u << "'";
+    cmd << " > /dev/null";
+    std::error_code ec;
+    fs::remove(stats, ec);
+    const int rc = std::system(cmd.str().c_str());
+    std::ifstream in(stats);
+    if (rc != 0 || !in)
+        throw DeviceError("clvr bench --suite cluster: `" + cmd.str() + "` failed (status " + std::to_string(rc) + ")");
+    return nlohmann::json::parse(in);
+}
+
+}  // namespace
+
+int benchCluster(const BenchOptions& options)
+{
+#if !CLVR_HAVE_MPI
+    (void)options;
+    throw InputError("--suite cluster: this clvr was built without MPI (CLVR_MPI=OFF; docs/cluster.md)");
+#else
+    std::vector<fs::path> scenes(options.scenes.begin(), options.scenes.end());
+    if (scenes.empty())
+        for (const char* name : {"reg-slice3d-ml256.json", "harc-bluntfin-10.json"})
+            scenes.push_back(repoFile(fs::path("data/scenes/bench") / name));
+    const int runs = std::max(3, options.frames / 2);  // each run: a first frame and a steady one
+    const fs::path outJson = options.outJson;
+    const fs::path outDir = outJson.has_parent_path() ? outJson.parent_path() : fs::path(".");
+    fs::create_directories(outDir);
+    if (::geteuid() == 0) {  // Open MPI refuses root without these (../shared/CLUSTER-NOTES.md)
+        ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 0);
+        ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 0);
+    }
+    nlohmann::json report;
+    report["machine"] = {{"cpu", cpuModel()}, {"cores", std::thread::hardware_concurrency()}, {"date", utcNow()},
+                         {"load_average_start", loadAverage()}};
+    report["runs"] = runs;
+    report["scenes"] = nlohmann::json::array();
+    std::cout << "clvr bench --suite cluster: " << cpuModel() << ", " << std::thread::hardware_concurrency()
+              << " cores, " << utcNow() << ", load average " << loadAverage() << "\n\n";
+    std::cout << std::left << std::setw(26) << "scene" << std::right << std::setw(6) << "ranks" << std::setw(12)
+              << "render ms" << std::setw(14) << "composite ms" << std::setw(11) << "frame ms" << std::setw(10)
+              << "speed-up" << std::setw(14) << "max |diff|" << '\n';
+    for (const fs::path& scene : scenes) {
+        const std::string name = scene.stem().string();
+        nlohmann::json entry = {{"scene", scene.string()}, {"ranks", nlohmann::json::array()}};
+        Image4f oneRank;
+        double oneRankFrame = 0.0;
+        for (int ranks : {1, 2, 4}) {
+            const fs::path image = outDir / ("bench.cluster." + name + ".n" + std::to_string(ranks) + ".exr");
+            const fs::path stats = outDir / ("bench.cluster." + name + ".n" + std::to_string(ranks) + ".json");
+            std::vector<double> render, composite, frame;
+            nlohmann::json last;
+            for (int r = 0; r < runs; ++r) {
+                last = runRanks(scene, ranks, image, stats, options);
+                render.push_back(last["frames"][0]["render_ms"].get<double>());
+                composite.push_back(last["frames"][0]["composite_ms"].get<double>());
+                frame.push_back(last["frames"][0]["frame_ms"].get<double>());
+            }
+            const Image4f picture = readImage(image.string());
+            if (ranks == 1) {
+                oneRank = picture;
+                oneRankFrame = median(frame);
+            }
+            const double diff = maxDifference(picture, oneRank);
+            const nlohmann::json row = {{"ranks", ranks},
+                                        {"render_ms", median(render)},
+                                        {"composite_ms", median(composite)},
+                                        {"frame_ms", median(frame)},
+                                        {"render_ms_runs", render},
+                                        {"composite_ms_runs", composite},
+                                        {"render_ms_per_rank", last["frames"][0]["render_ms_per_rank"]},
+                                        {"setup_ms", last["setup_ms"]},
+                                        {"width", last["width"]},
+                                        {"height", last["height"]},
+                                        {"max_diff_vs_one_rank", diff}};
+            entry["ranks"].push_back(row);
+            std::cout << std::left << std::setw(26) << name << std::right << std::setw(6) << ranks << std::fixed
+                      << std::setprecision(1) << std::setw(12) << median(render) << std::setw(14) << median(composite)
+                      << std::setw(11) << median(frame) << std::setprecision(2) << std::setw(10)
+                      << oneRankFrame / median(frame) << std::scientific << std::setprecision(1) << std::setw(14)
+                      << diff << std::defaultfloat << '\n';
+        }
+        report["scenes"].push_back(entry);
+    }
+    report["machine"]["load_average_end"] = loadAverage();
+    std::ofstream(outJson) << report.dump(2) << '\n';
+    std::cout << "\nwrote " << outJson.string() << '\n';
+    return 0;
+#endif
+}
+
+}  // namespace clvr::tools
