@@ -109,6 +109,15 @@ TEST(Scene, FullSceneParses)
     EXPECT_EQ(s.lighting.material.shininess, 30.0);
 }
 
+TEST(Scene, DistributionIsOneOfTheThreeModes)
+{
+    EXPECT_EQ(parse(kMinimal).distribution, "");
+    EXPECT_EQ(parse(kMinimal, {"distribution=\"frames\""}).distribution, "frames");
+    EXPECT_EQ(parse(kMinimal, {"distribution=\"sort-last\""}).distribution, "sort-last");
+    EXPECT_SCENE_ERROR(errorOf(kMinimal, {"distribution=\"tiles\""}), "scene.json: distribution: unknown distribution");
+    EXPECT_THROW(checkDistribution("sortlast", "--distribution"), InputError);
+}
+
 TEST(Scene, IsoWithoutLightUsesTheHeadlight)
 {
     const Scene s = parse(kMinimal, {"iso.value=0.5"});
