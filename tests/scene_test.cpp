@@ -115,7 +115,7 @@ TEST(Scene, DistributionIsOneOfTheThreeModes)
     EXPECT_EQ(parse(kMinimal, {"distribution=\"frames\""}).distribution, "frames");
     EXPECT_EQ(parse(kMinimal, {"distribution=\"sort-last\""}).distribution, "sort-last");
     EXPECT_SCENE_ERROR(errorOf(kMinimal, {"distribution=\"tiles\""}), "scene.json: distribution: unknown distribution");
-    EXPECT_THROW(checkDistribution("sortlast", "--distribution"), InputError);
+    EXPECT_THROW(clvr::checkDistribution("sortlast", "--distribution"), clvr::InputError);
 }
 
 TEST(Scene, IsoWithoutLightUsesTheHeadlight)
