@@ -36,16 +36,18 @@ function(expect_same a b tolerance)
   message(STATUS "${b}: ${worst} (tolerance ${tolerance})")
 endfunction()
 
-# sort_last(NAME RANKS scene args...): one process and N ranks, PNG and EXR, compared.
+# sort_last(NAME RANKS scene args...): one process and N ranks, compared as EXR (float); PNG (8-bit) for the
+# last N only: within 2e-5 in float, the 8-bit values round at most one step apart anyway.
 function(sort_last name ranks)
-  run_ok(${CLVR} render ${ARGN} -o ${WORK}/${name}-1p.png)
   run_ok(${CLVR} render ${ARGN} -o ${WORK}/${name}-1p.exr)
   foreach(n ${ranks})
-    run_ok(${MPI} -np ${n} ${CLVR} render ${ARGN} -o ${WORK}/${name}-${n}.png)
     run_ok(${MPI} -np ${n} ${CLVR} render ${ARGN} -o ${WORK}/${name}-${n}.exr)
-    expect_same(${WORK}/${name}-1p.png ${WORK}/${name}-${n}.png 0.0040)  # at most one 8-bit step
     expect_same(${WORK}/${name}-1p.exr ${WORK}/${name}-${n}.exr 2e-5)
   endforeach()
+  list(GET ranks -1 n)
+  run_ok(${CLVR} render ${ARGN} -o ${WORK}/${name}-1p.png)
+  run_ok(${MPI} -np ${n} ${CLVR} render ${ARGN} -o ${WORK}/${name}-${n}.png)
+  expect_same(${WORK}/${name}-1p.png ${WORK}/${name}-${n}.png 0.0040)  # at most one 8-bit step
 endfunction()
 
 sort_last(volume "1;2;3;5;8" ${VOLUME})
