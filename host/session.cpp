@@ -138,8 +138,16 @@ nlohmann::json Session::stats(const Frame& frame) const
 
 void Session::setCamera(const Camera& camera)
 {
+    setView(camera, scene_.image);
+}
+
+void Session::setView(const Camera& camera, const ImageSpec& image)
+{
     camera.validate();
+    if (image.width < 1 || image.height < 1)
+        throw InputError("image: width and height must be at least 1");
     scene_.camera = camera;
+    scene_.image = image;
     makeRenderer();
 }
 

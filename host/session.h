@@ -68,6 +68,9 @@ public:
     Frame render();
     // The camera of the following frames (validated: InputError); recreates the renderer (see above).
     void setCamera(const Camera& camera);
+    // The camera and the image size of the following frames (sort-first gives each rank a band of rows
+    // as its image: Camera::bandFullHeight); recreates the renderer as setCamera does.
+    void setView(const Camera& camera, const ImageSpec& image);
 
     const Scene& scene() const { return scene_; }
     const Camera& camera() const { return *scene_.camera; }

@@ -28,7 +28,7 @@ kernel void blend_render(global float4* out, global uint* samples, global uint* 
     const int tf_count = p.tf_count, map_n = p.map_n, shade_on = p.shade_on;
     const float3 to_eye = p.to_eye.xyz;
     const float2 size = (float2)((float)p.width, (float)p.height);
-    const float2 s = clvr_ray_offset(clvr_ray_ndc(clvr_ray_pixel_centre(x, y), size), p.camera);
+    const float2 s = clvr_ray_window_offset(clvr_ray_pixel_centre(x, y), size, p.camera);
     float3 o, d;
     clvr_ray_depth(s, p.camera, &o, &d);
     const float delta = delta_s * clvr_ray_stretch(s, p.camera);

@@ -86,7 +86,7 @@ kernel void harc_render(global float4* out, global uint* stats, global const flo
     const float ert_alpha = params.ert_alpha;
     const float2 size = (float2)((float)params.width, (float)params.height);
     float3 e, d;
-    const float2 offset = clvr_ray_offset(clvr_ray_ndc(clvr_ray_pixel_centre(x, y), size), params.camera);
+    const float2 offset = clvr_ray_window_offset(clvr_ray_pixel_centre(x, y), size, params.camera);
     clvr_ray_unit(offset, params.camera, &e, &d);
 
     /* The ray's parameter range inside the part's box (slab test); everywhere without one. */

@@ -21,7 +21,7 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
     const int width = (int)u->size.x;
     const ClCamera cam = u->camera;
     float3 e, d;
-    clvr_ray_unit(clvr_ray_offset(clvr_ray_ndc(f->window, u->size.xy), cam), cam, &e, &d);
+    clvr_ray_unit(clvr_ray_window_offset(f->window, u->size.xy, cam), cam, &e, &d);
     const int code = (int)rint(f->attr[1].x) | ((int)rint(f->attr[1].y) << 16);
     global const float4* tet = (global const float4*)r->buffer[1] + (size_t)(code >> 2) * 5;
     const int face = code & 3;

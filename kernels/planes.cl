@@ -34,7 +34,7 @@ kernel void planes_render(global float4* out, global uint* samples, global uint*
     /* The ray through the pixel center, origin o and unit direction d (kernels/ray.h). */
     const float2 size = (float2)((float)p.width, (float)p.height);
     float3 o, d;
-    clvr_ray_unit(clvr_ray_offset(clvr_ray_ndc(clvr_ray_pixel_centre(x, y), size), p.camera), p.camera, &o, &d);
+    clvr_ray_unit(clvr_ray_window_offset(clvr_ray_pixel_centre(x, y), size, p.camera), p.camera, &o, &d);
 
     /* Slab test against the box: t0 >= 0 keeps only what lies in front of the camera. */
     float t0 = 0.0f, t1 = INFINITY;

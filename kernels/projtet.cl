@@ -30,7 +30,7 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
 
     /* The ray through the pixel centre, |d| = 1, as harc's (kernels/ray.h). */
     float3 e, d;
-    clvr_ray_unit(clvr_ray_offset(clvr_ray_ndc(f->window, counts.xy), cam), cam, &e, &d);
+    clvr_ray_unit(clvr_ray_window_offset(f->window, counts.xy, cam), cam, &e, &d);
 
     /* Inside: b_i(e + λ d) = b_i(e) + λ dot(h_i, d) >= 0 for all four planes. */
     float lambda_in = 0.0f, lambda_out = INFINITY;

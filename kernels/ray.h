@@ -21,9 +21,10 @@
 
 /* The camera as rays need it: an orthonormal frame and the image plane's extent. */
 typedef struct {
-    cl_float4 position; /* world (or relative to a renderer's shifted origin), w = 0 */
-    cl_float4 forward, right, up; /* unit vectors, w = 0 */
-    cl_float4 params;   /* (scale, aspect = width / height, 1 if parallel else 0, 0), scale =
+    cl_float4 position; /* world (or relative to a renderer's shifted origin); w: the band's first row y0 */
+    cl_float4 forward;  /* unit vector; w: the full image's height H for a band, 0 for the whole image */
+    cl_float4 right, up; /* unit vectors, w = 0 */
+    cl_float4 params;   /* (scale, aspect = width / height of the full image, 1 if parallel else 0, 0), scale =
                          * tan(view_angle / 2) for perspective, parallel_scale for parallel */
 } ClCamera;             /* 80 bytes */
 
@@ -46,6 +47,17 @@ float2 clvr_ray_pixel_centre(const int x, const int y)
 float2 clvr_ray_offset(const float2 ndc, const ClCamera cam)
 {
     return (float2)(ndc.x * cam.params.x * cam.params.y, ndc.y * cam.params.x);
+}
+
+/* The offset s of window position w in an image of `size` pixels. For a band of rows (sort-first: the
+ * image is rows [y0, y0 + size.y) of one H rows tall, cam.position.w = y0, cam.forward.w = H) w is
+ * moved to the full image's window and ndc taken there: row y0 + y's ray, bit for bit as the full
+ * image computes it (y0 + w.y is exact in float). */
+float2 clvr_ray_window_offset(const float2 w, const float2 size, const ClCamera cam)
+{
+    if (cam.forward.w > 0.0f)
+        return clvr_ray_offset(clvr_ray_ndc((float2)(w.x, w.y + cam.position.w), (float2)(size.x, cam.forward.w)), cam);
+    return clvr_ray_offset(clvr_ray_ndc(w, size), cam);
 }
 
 int clvr_ray_parallel(const ClCamera cam)

@@ -10,7 +10,7 @@ kernel void ray_pixels(global float4* out, const ClCamera cam, const int width, 
     CLVR_GUARD_2D(width, height);
     const int x = (int)get_global_id(0), y = (int)get_global_id(1);
     const float2 size = (float2)((float)width, (float)height);
-    const float2 s = clvr_ray_offset(clvr_ray_ndc(clvr_ray_pixel_centre(x, y), size), cam);
+    const float2 s = clvr_ray_window_offset(clvr_ray_pixel_centre(x, y), size, cam);
     float3 o, d;
     if (form == 0)
         clvr_ray_depth(s, cam, &o, &d);

@@ -142,7 +142,7 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
      * ray's point on the slice at depth z is o + z d and a slice spacing deltaS is a ray length
      * deltaS * |d| (= deltaS / cos(theta)). */
     const float2 size = (float2)((float)p.width, (float)p.height);
-    const float2 s = clvr_ray_offset(clvr_ray_ndc(clvr_ray_pixel_centre(x, y), size), p.camera);
+    const float2 s = clvr_ray_window_offset(clvr_ray_pixel_centre(x, y), size, p.camera);
     float3 o, d;
     clvr_ray_depth(s, p.camera, &o, &d);
     const float delta = delta_s * clvr_ray_stretch(s, p.camera);  /* ray length per slice */
@@ -282,7 +282,7 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
         return 0;
 #endif
     const ClCamera cam = u->camera;
-    const float2 s = clvr_ray_offset(clvr_ray_ndc(f->window, u->frame.xy), cam);
+    const float2 s = clvr_ray_window_offset(f->window, u->frame.xy, cam);
     const float delta = u->frame.z * clvr_ray_stretch(s, cam);
     const float4 ct = clvr_tf_eval(r->buffer[1], (int)u->frame.w, clvr_trilinear(r->buffer[0], dims, g));
     const float alpha = 1.0f - exp(-ct.w * delta);

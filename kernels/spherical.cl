@@ -22,7 +22,7 @@ float clvr_spherical_slab_length(const float px, const float py, const ClCamera 
                                  const float4 center, const float r_lo, const float r_hi, const float side)
 {
     float3 origin, dir;
-    clvr_ray_rounded_terms(clvr_ray_offset(clvr_ray_ndc((float2)(px + 0.5f, py + 0.5f), size), cam), cam, &origin,
+    clvr_ray_rounded_terms(clvr_ray_window_offset((float2)(px + 0.5f, py + 0.5f), size, cam), cam, &origin,
                            &dir);
     const float3 oc = center.xyz - origin;
     const float tc = dot(oc, dir);

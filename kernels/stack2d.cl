@@ -126,7 +126,7 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
      * a parallel camera from the pixel's point on the image plane along forward. */
     const ClCamera cam = u->camera;
     float3 origin, d;
-    clvr_ray_offset_first(clvr_ray_offset(clvr_ray_ndc(f->window, u->frame.xy), cam), cam, &origin, &d);
+    clvr_ray_offset_first(clvr_ray_window_offset(f->window, u->frame.xy, cam), cam, &origin, &d);
     /* a fragment's ray meets the quad's plane, so cos_theta > 0; the floor only keeps tau = 0 times
      * an infinite Delta (a plane seen exactly edge-on, rounded) from giving NaN */
     const float cos_theta = fmax(fabs(dot(d, u->axis.xyz)) / length(d), 1e-20f);

@@ -37,7 +37,7 @@ kernel void tetslice_composite(global float4* image, global const float4* front,
     const float s = span > 0.0f ? (R - d) / span * G + (d - B) / span * alpha_s : G;
     const float4 ct = clvr_tf_eval(tf, p.tf_count, s);
     const float2 size = (float2)((float)p.width, (float)p.height);
-    const float2 so = clvr_ray_offset(clvr_ray_ndc(clvr_ray_pixel_centre(x, y), size), p.camera);
+    const float2 so = clvr_ray_window_offset(clvr_ray_pixel_centre(x, y), size, p.camera);
     const float delta = p.delta_s * clvr_ray_stretch(so, p.camera);
     const float a = 1.0f - exp(-ct.w * delta);
     const float4 c = image[i];

@@ -2,7 +2,8 @@
 # image equals the one-process image within 1/255 per channel (PNG) and 2e-5 (EXR, float) for N = 1..8,
 # sort-last on a volume (slice3d) and a non-convex TetGen mesh whose k-d boxes cut through cells (harc),
 # perspective, parallel and an eye inside the volume; frames mode gives the one-process orbit frames;
-# a failure on one rank (missing scene file, kernel build failure, failed launch, technique that cannot
+# sort-first (bands of rows, balanced by the previous frame's cost) gives the one-process image bit for bit
+# (ray casters, the raster stage, planes, an orbit); a failure on one rank (missing scene file, kernel build failure, failed launch, technique that cannot
 # render a part) gives one error line, the same non-zero status from mpirun, within seconds, no output.
 # Inputs: CLVR, MPIEXEC, OIIOTOOL, SRC, WORK. Images are 64x64 or 96x96 to stay fast.
 file(REMOVE_RECURSE "${WORK}")
@@ -55,6 +56,51 @@ sort_last(volume-parallel "2;4" ${VOLUME} --set camera.projection=\"parallel\" -
 sort_last(volume-inside "3;6" ${VOLUME} --set camera.position=[0.2,0.3,0.6] --set camera.view_angle=80)
 sort_last(mesh "1;2;4;7" ${MESH})
 sort_last(mesh-parallel "3" ${MESH} --set camera.projection=\"parallel\" --set camera.parallel_scale=1.4)
+
+# sort_first(NAME ONE_PROCESS RANKS scene args...): every rank renders a band of rows of the whole data;
+# the EXR equals ONE_PROCESS (a one-process EXR of the same arguments, rendered here when it is not there
+# yet) bit for bit: a band takes the full image's rays (kernels/ray.h clvr_ray_window_offset).
+function(sort_first name one ranks)
+  if(NOT EXISTS ${one})
+    run_ok(${CLVR} render ${ARGN} -o ${one})
+  endif()
+  foreach(n ${ranks})
+    run_ok(${MPI} -np ${n} ${CLVR} render ${ARGN} --distribution sort-first -o ${WORK}/${name}-${n}.exr)
+    expect_same(${one} ${WORK}/${name}-${n}.exr 0)
+  endforeach()
+endfunction()
+
+# Sort-first for the techniques sort-last cannot take too (iso3d's raster stage, planes' shading).
+set(SMALL64 --set image.width=64 --set image.height=64)
+sort_first(first-volume ${WORK}/volume-1p.exr "2;8" ${VOLUME})
+sort_first(first-volume-inside ${WORK}/volume-inside-1p.exr "3" ${VOLUME} --set camera.position=[0.2,0.3,0.6]
+           --set camera.view_angle=80)
+sort_first(first-iso ${WORK}/first-iso-1p.exr "5" ${SRC}/data/scenes/engine-iso.json ${SMALL64})
+sort_first(first-planes ${WORK}/first-planes-1p.exr "3" ${SRC}/data/scenes/engine-planes.json ${SMALL64})
+sort_first(first-mesh ${WORK}/mesh-1p.exr "4" ${MESH})
+sort_first(first-mesh-parallel ${WORK}/mesh-parallel-1p.exr "3" ${MESH} --set camera.projection=\"parallel\"
+           --set camera.parallel_scale=1.4)
+
+# Sort-first orbit: each frame as one process renders it, the bands rebalanced from the previous frame's
+# cost (rows per rank in the stats add up to the image's height every frame).
+run_ok(${CLVR} render ${MESH} --orbit 3 -o ${WORK}/first-orbit-1p-%d.exr)
+run_ok(${MPI} -np 3 ${CLVR} render ${MESH} --orbit 3 --distribution sort-first -o ${WORK}/first-orbit-%d.exr
+       --stats ${WORK}/first-orbit.json)
+file(READ ${WORK}/first-orbit.json stats)
+foreach(k RANGE 2)
+  expect_same(${WORK}/first-orbit-1p-${k}.exr ${WORK}/first-orbit-${k}.exr 0)
+  set(sum 0)
+  foreach(r RANGE 2)
+    string(JSON rows GET "${stats}" frames ${k} rows_per_rank ${r})
+    if(rows LESS 1)
+      message(FATAL_ERROR "sort-first orbit frame ${k}: rank ${r} has ${rows} rows\n${stats}")
+    endif()
+    math(EXPR sum "${sum} + ${rows}")
+  endforeach()
+  if(NOT sum EQUAL 96)
+    message(FATAL_ERROR "sort-first orbit frame ${k}: the bands hold ${sum} rows, want 96\n${stats}")
+  endif()
+endforeach()
 
 # Frames: an orbit of 5 frames on 3 ranks, each frame as one process renders it.
 run_ok(${CLVR} render ${VOLUME} --orbit 5 -o ${WORK}/orbit-1p-%d.png)

@@ -13,6 +13,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
+#include <string>
 
 namespace clvr {
 namespace {
@@ -253,6 +255,151 @@ TEST(SortLast, MeshPartsKeepEveryCellThatMeetsTheirBox)
     EXPECT_GE(kept, mesh.tets.size());  // cells on a cut belong to both sides
 }
 
+// Sort-first on one process: the whole image against its bands (Camera::bandFullHeight), each rendered
+// as its own image of its rows and stacked top to bottom, as rank 0 gathers them.
+double sortFirstDifference(const Scene& scene, const std::function<Image4f(const Scene&)>& render,
+                           const std::vector<int>& rows)
+{
+    const Image4f whole = render(scene);
+    float coverage = 0.0f;
+    for (const glm::vec4& p : whole.pixels())
+        coverage = std::max(coverage, p.a);
+    EXPECT_GT(coverage, 0.2f) << scene.technique << ": the whole image is (nearly) empty, the test checks little";
+    Image4f stacked(scene.image.width, scene.image.height);
+    int y0 = 0;
+    for (int r : rows) {
+        Scene band = scene;
+        band.camera->bandFullHeight = scene.image.height;
+        band.camera->bandY0 = y0;
+        band.image.height = r;
+        const Image4f part = render(band);
+        std::copy(part.pixels().begin(), part.pixels().end(),
+                  stacked.pixels().begin() + static_cast<std::ptrdiff_t>(y0) * scene.image.width);
+        y0 += r;
+    }
+    double worst = 0.0;
+    for (std::size_t i = 0; i < whole.pixelCount(); ++i)
+        for (int c = 0; c < 4; ++c) {
+            const double d = std::abs(double(stacked.pixels()[i][c]) - double(whole.pixels()[i][c]));
+            worst = std::isnan(d) ? INFINITY : std::max(worst, d);
+        }
+    return worst;
+}
+
+// Bands of uneven heights (balanceRows' output after an uneven frame), down to one row.
+std::vector<std::vector<int>> sortFirstBands(int height)
+{
+    return {{height}, {height / 2, height - height / 2}, {1, height - 8, 7}, {5, 13, 1, 20, height - 39}};
+}
+
+// The stacked bands equal the whole image bit for bit: a band's kernels take the full image's rays
+// (kernels/ray.h clvr_ray_window_offset), the raster stage's off-centre projection puts every fragment
+// on the full image's pixel centre, and harc's entry lists are built in the full image's rows.
+constexpr double kSortFirstTolerance = 0.0;
+
+TEST(SortFirst, GridBandsStackToTheWholeImage)
+{
+    const Volume v = generateVolume("marschner-lobb", glm::ivec3(33, 29, 31));
+    struct Case {
+        std::string technique;
+        nlohmann::json options;
+    };
+    const std::vector<Case> cases = {{"slice3d", {{"slices", 120}}},
+                                     {"slice3d", {{"slices", 60}, {"path", "raster"}}},
+                                     {"iso3d", {{"slices", 60}}},
+                                     {"stack2d", nlohmann::json::object()},
+                                     {"planes", nlohmann::json::object()},
+                                     {"blend", {{"slices", 60}}}};
+    for (const Case& c : cases)
+        for (const Camera& camera : {test::obliquePerspectiveCamera(40.0), test::obliqueParallelCamera(1.8)}) {
+            Scene scene;
+            scene.technique = c.technique;
+            scene.image = ImageSpec{40, 48, {0.1, 0.2, 0.3}};
+            scene.transferFunction = test::designTransferFunction();
+            scene.options = c.options;
+            scene.camera = camera;
+            if (c.technique == "iso3d")
+                scene.iso = test::isoSpec(0.5, {0.4, 0.6, 1.0}, 0.1, 0.9);
+            for (const std::vector<int>& rows : sortFirstBands(48)) {
+                const double d = sortFirstDifference(scene, [&](const Scene& s) { return test::renderScene(s, v); }, rows);
+                std::printf("sort-first %s %s, %s camera, %zu bands: max |stacked - whole| = %.2g\n",
+                            c.technique.c_str(), c.options.dump().c_str(), camera.parallel ? "parallel" : "perspective",
+                            rows.size(), d);
+                EXPECT_LE(d, kSortFirstTolerance) << c.technique << ", " << rows.size() << " bands";
+            }
+        }
+}
+
+TEST(SortFirst, MeshBandsStackToTheWholeImage)
+{
+    TetMesh mesh = test::boxMesh({{{-1.0, -1.0, -1.0}, {1.0, 0.0, 1.0}, 5}, {{-1.0, 0.0, -1.0}, {0.0, 1.0, 1.0}, 3}},
+                                 {0.3, 0.2, -0.25}, 0.5);
+    checkMesh(mesh);
+    Camera inside = test::perspective({-0.5, 0.4, 0.1}, {0.6, -0.5, -0.2}, 70.0);  // the eye in a cell
+    const std::vector<Camera> cameras = {sortLastCameras()[0], sortLastCameras()[1], inside};
+    for (const char* technique : {"harc", "projtet"})
+        for (std::size_t i = 0; i < cameras.size(); ++i) {
+            const Camera& camera = cameras[i];
+            Scene scene = test::meshScene(technique, camera, test::rampTransferFunction(), 48);
+            const auto render = [&](const Scene& s) {
+                FrameStats stats;
+                return makeMeshRenderer(test::device(), s, mesh)->render(stats);
+            };
+            for (const std::vector<int>& rows : sortFirstBands(48)) {
+                const double d = sortFirstDifference(scene, render, rows);
+                std::printf("sort-first %s, %s camera, %zu bands: max |stacked - whole| = %.2g\n", technique,
+                            camera.parallel ? "parallel" : "perspective", rows.size(), d);
+                EXPECT_LE(d, kSortFirstTolerance) << technique << ", " << rows.size() << " bands";
+            }
+        }
+}
+
+TEST(SortFirst, BalancedRowsTileTheImageAndEvenTheCost)
+{
+    // No times yet: equal shares, the first ranks one row more.
+    EXPECT_EQ(balanceRows(10, {0, 0, 0}, {0.0, 0.0, 0.0}), (std::vector<int>{4, 3, 3}));
+    // Rank 0's rows cost 3x rank 1's: the cut moves to where the cumulative cost halves.
+    // Costs 0.6 and 0.2 per row, total 40: 34 rows of rank 0's reach 20.4 >= 20.
+    EXPECT_EQ(balanceRows(100, {50, 50}, {30.0, 10.0}), (std::vector<int>{34, 66}));
+    // One row holding all the cost still leaves every rank a row.
+    EXPECT_EQ(balanceRows(6, {1, 2, 3}, {100.0, 0.0, 0.0}), (std::vector<int>{1, 1, 4}));
+    // Random costs: the bands tile the image, each rank keeps a row, and every band's predicted cost is
+    // within one row's cost of the mean.
+    std::uint32_t seed = 12345;
+    const auto next = [&] { return (seed = seed * 1664525u + 1013904223u) >> 8; };
+    for (int trial = 0; trial < 200; ++trial) {
+        const int n = 1 + static_cast<int>(next() % 8), height = n + static_cast<int>(next() % 300);
+        std::vector<int> rows = balanceRows(height, std::vector<int>(n, 0), std::vector<double>(n, 0.0));
+        std::vector<double> ms(static_cast<std::size_t>(n));
+        for (double& t : ms)
+            t = 1.0 + next() % 1000;
+        const std::vector<int> out = balanceRows(height, rows, ms);
+        std::vector<double> rowCost;
+        double total = 0.0, maxRow = 0.0;
+        for (int r = 0; r < n; ++r)
+            for (int i = 0; i < rows[static_cast<std::size_t>(r)]; ++i) {
+                rowCost.push_back(ms[static_cast<std::size_t>(r)] / rows[static_cast<std::size_t>(r)]);
+                maxRow = std::max(maxRow, rowCost.back());
+            }
+        for (double t : ms)
+            total += t;
+        int y = 0;
+        for (int r = 0; r < n; ++r) {
+            ASSERT_GE(out[static_cast<std::size_t>(r)], 1);
+            double cost = 0.0;
+            for (int i = 0; i < out[static_cast<std::size_t>(r)]; ++i)
+                cost += rowCost[static_cast<std::size_t>(y++)];
+            // The last bands can be forced to one row each; all others are cut at the first row past
+            // their share of the cumulative cost.
+            if (out[static_cast<std::size_t>(r)] > 1 && r < n - 1)
+                EXPECT_LE(cost, total / n + maxRow + 1e-9 * total) << "trial " << trial << ", rank " << r;
+        }
+        ASSERT_EQ(y, height) << "trial " << trial;
+    }
+    EXPECT_THROW(balanceRows(2, {1, 1, 1}, {0.0, 0.0, 0.0}), InternalError);
+    EXPECT_THROW(balanceRows(5, {1, 1}, {1.0, 1.0}), InternalError);
+}
+
 TEST(SortLast, TechniquesThatCannotRenderAPartSaySo)
 {
     const Volume v = generateVolume("sphere", glm::ivec3(9, 9, 9));
@@ -265,7 +412,7 @@ TEST(SortLast, TechniquesThatCannotRenderAPartSaySo)
         makeRenderer(test::device(), scene, cutGridPart(v, g, 0));
         FAIL() << "iso3d took a part";
     } catch (const InputError& e) {
-        EXPECT_NE(std::string(e.what()).find("--distribution frames"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("--distribution sort-first"), std::string::npos) << e.what();
     }
     scene.technique = "slice3d";
     scene.options = {{"path", "raster"}};

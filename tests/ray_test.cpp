@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -103,6 +104,54 @@ TEST(Ray, RowZeroIsTheTopRow)
     const glm::dvec3 last(rays.direction(37 * 23 - 1));
     EXPECT_LT(glm::dot(last, camera.up()), 0.0);
     EXPECT_GT(glm::dot(last, camera.right()), 0.0);
+}
+
+// Sort-first (Camera::bandFullHeight): a band of rows [7, 12) of a 37x23 image renders the full image's
+// rays of those rows, on the host, in the kernels (bit for bit) and through the raster stage's projection.
+TEST(Ray, BandRaysAreTheFullImagesRows)
+{
+    for (const clvr::Camera& full : {clvr::test::obliquePerspectiveCamera(30.0), clvr::test::obliqueParallelCamera(1.3)}) {
+        SCOPED_TRACE(full.parallel ? "parallel" : "perspective");
+        const int width = 37, height = 23, y0 = 7, rows = 5;
+        clvr::Camera band = full;
+        band.bandFullHeight = height;
+        band.bandY0 = y0;
+        const clvr::PixelRays wholeRays(full, width, height), bandRays(band, width, rows);
+        const DeviceRays device = deviceRays(band, width, rows, Unit);
+        double hostErr = 0.0, originErr = 0.0, directionErr = 0.0;
+        for (int y = 0; y < rows; ++y)
+            for (int x = 0; x < width; ++x) {
+                const clvr::Ray want = wholeRays.at(x, y0 + y), got = bandRays.at(x, y);
+                hostErr = std::max({hostErr, glm::length(got.origin - want.origin), glm::length(got.direction - want.direction)});
+                const std::size_t i = static_cast<std::size_t>(y) * width + x;
+                originErr = std::max(originErr, glm::length(glm::dvec3(device.origin(i)) - want.origin));
+                directionErr = std::max(directionErr, glm::length(glm::normalize(glm::dvec3(device.direction(i))) - want.direction));
+            }
+        EXPECT_LE(hostErr, 1e-12);
+        EXPECT_LE(originErr, kOriginTol);
+        EXPECT_LE(directionErr, kDirectionTol);
+        // And bit for bit the full image's device rays of those rows (the band's window is moved to the
+        // full image's before ndc is taken: kernels/ray.h clvr_ray_window_offset).
+        const DeviceRays wholeDevice = deviceRays(full, width, height, Unit);
+        int differing = 0;
+        for (std::size_t i = 0; i < 2 * static_cast<std::size_t>(width) * rows; ++i)
+            differing += device.values[i] != wholeDevice.values[2 * static_cast<std::size_t>(width) * y0 + i];
+        EXPECT_EQ(differing, 0) << "of " << 2 * width * rows << " ray vectors";
+        // The projection: a point on the ray through a band pixel's centre lands on that pixel's centre of the
+        // band's viewport (rows counted from the top, as the framebuffer's).
+        const glm::dmat4 wholePv = full.projectionMatrix(width, height, 0.1, 100.0) * full.viewMatrix();
+        const glm::dmat4 bandPv = band.projectionMatrix(width, rows, 0.1, 100.0) * band.viewMatrix();
+        for (int y = 0; y < rows; ++y) {
+            const clvr::Ray r = wholeRays.at(11, y0 + y);
+            const glm::dvec4 p(r.origin + 3.0 * r.direction, 1.0);
+            const glm::dvec4 cw = wholePv * p, cb = bandPv * p;
+            const double rowWhole = (1.0 - cw.y / cw.w) * 0.5 * height - 0.5, rowBand = (1.0 - cb.y / cb.w) * 0.5 * rows - 0.5;
+            EXPECT_NEAR(rowWhole, y0 + y, 1e-9);
+            EXPECT_NEAR(rowBand, y, 1e-9);
+            EXPECT_NEAR(cb.x / cb.w, cw.x / cw.w, 1e-12);
+            EXPECT_NEAR(cb.z / cb.w, cw.z / cw.w, 1e-12);  // the same depth
+        }
+    }
 }
 
 }  // namespace

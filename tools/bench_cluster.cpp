@@ -1,8 +1,10 @@
 // tools/bench_cluster.cpp — `clvr bench --suite cluster` (docs/cluster.md): each scene rendered sort-last by
 // `mpirun -np N clvr render` for N = 1, 2, 4 on this machine, several runs each; from every run's --stats the
 // steady frame's render time (the slowest rank's), IceT's composite time (blend and collection on rank 0)
-// and their sum, with each rank count's image against one rank's. tools/cluster_model.py fits the scaling
-// model to the JSON and projects it (docs/cluster.md).
+// and their sum, with each rank count's image against one rank's. Then sort-first on 2 and 4 ranks: an
+// --orbit of kSortFirstFrames frames, each frame's bands balanced by the previous frame's cost; the median
+// over frames 1.. of the slowest rank's render time and the row gather. tools/cluster_model.py fits the
+// scaling model to the sort-last figures and projects it (docs/cluster.md).
 #include "tools/bench.h"
 
 #include "host/io/image_io.h"
@@ -46,12 +48,14 @@ double maxDifference(const Image4f& a, const Image4f& b)
 
 // One `mpirun -np ranks clvr render` of the scene; its --stats.
 nlohmann::json runRanks(const fs::path& scene, int ranks, const fs::path& image, const fs::path& stats,
-                        const BenchOptions& options)
+                        const BenchOptions& options, const std::string& distribution = "sort-last", int orbit = 0)
 {
     std::ostringstream cmd;
     cmd << "mpirun --oversubscribe --bind-to none -np " << ranks << " '" << fs::read_symlink("/proc/self/exe").string()
-        << "' render '" << scene.string() << "' --distribution sort-last -o '" << image.string() << "' --stats '"
-        << stats.string() << "'";
+        << "' render '" << scene.string() << "' --distribution " << distribution << " -o '" << image.string()
+        << "' --stats '" << stats.string() << "'";
+    if (orbit > 0)
+        cmd << " --orbit " << orbit;
     if (!options.deviceSpec.empty())
         cmd << " --device '" << options.deviceSpec << "'";
     for (const std::string& o : options.overrides)
@@ -67,6 +71,10 @@ nlohmann::json runRanks(const fs::path& scene, int ranks, const fs::path& image,
         throw DeviceError("clvr bench --suite cluster: `" + cmd.str() + "` failed (status " + std::to_string(rc) + ")");
     return nlohmann::json::parse(in);
 }
+
+// Sort-first's orbit: frame 0 has equal bands, frames 1.. are balanced by the frame before (a turn of
+// 360/kSortFirstFrames degrees between frames, so the cost moves a little, as in an interactive session).
+constexpr int kSortFirstFrames = 12;
 
 }  // namespace
 
@@ -96,7 +104,7 @@ int benchCluster(const BenchOptions& options)
     std::cout << "clvr bench --suite cluster: " << cpuModel() << ", " << std::thread::hardware_concurrency()
               << " cores, " << utcNow() << ", load average " << loadAverage() << "\n\n";
     std::cout << std::left << std::setw(26) << "scene" << std::right << std::setw(6) << "ranks" << std::setw(12)
-              << "render ms" << std::setw(14) << "composite ms" << std::setw(11) << "frame ms" << std::setw(10)
+              << "render ms" << std::setw(14) << "composite ms"  // (sort-first: the gather of the rows) << std::setw(11) << "frame ms" << std::setw(10)
               << "speed-up" << std::setw(14) << "max |diff|" << '\n';
     for (const fs::path& scene : scenes) {
         const std::string name = scene.stem().string();
@@ -135,6 +143,33 @@ int benchCluster(const BenchOptions& options)
             std::cout << std::left << std::setw(26) << name << std::right << std::setw(6) << ranks << std::fixed
                       << std::setprecision(1) << std::setw(12) << median(render) << std::setw(14) << median(composite)
                       << std::setw(11) << median(frame) << std::setprecision(2) << std::setw(10)
+                      << oneRankFrame / median(frame) << std::scientific << std::setprecision(1) << std::setw(14)
+                      << diff << std::defaultfloat << '\n';
+        }
+        // Sort-first: the frames after the first, each balanced by the one before; frame 0's image (the
+        // scene's camera, equal bands) against one rank's.
+        entry["sort_first"] = nlohmann::json::array();
+        for (int ranks : {2, 4}) {
+            const std::string base = "bench.cluster." + name + ".first.n" + std::to_string(ranks);
+            const fs::path stats = outDir / (base + ".json");
+            const nlohmann::json run =
+                runRanks(scene, ranks, outDir / (base + ".%02d.exr"), stats, options, "sort-first", kSortFirstFrames);
+            std::vector<double> render, gather, frame;
+            for (std::size_t k = 1; k < run["frames"].size(); ++k) {
+                render.push_back(run["frames"][k]["render_ms"].get<double>());
+                gather.push_back(run["frames"][k]["gather_ms"].get<double>());
+                frame.push_back(run["frames"][k]["frame_ms"].get<double>());
+            }
+            const double diff = maxDifference(readImage((outDir / (base + ".00.exr")).string()), oneRank);
+            entry["sort_first"].push_back({{"ranks", ranks},
+                                           {"render_ms", median(render)},
+                                           {"gather_ms", median(gather)},
+                                           {"frame_ms", median(frame)},
+                                           {"frames", run["frames"]},
+                                           {"max_diff_vs_one_rank", diff}});
+            std::cout << std::left << std::setw(26) << (name + " (sort-first)") << std::right << std::setw(6) << ranks
+                      << std::fixed << std::setprecision(1) << std::setw(12) << median(render) << std::setw(14)
+                      << median(gather) << std::setw(11) << median(frame) << std::setprecision(2) << std::setw(10)
                       << oneRankFrame / median(frame) << std::scientific << std::setprecision(1) << std::setw(14)
                       << diff << std::defaultfloat << '\n';
         }

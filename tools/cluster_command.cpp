@@ -4,6 +4,8 @@
 //              with the scene's technique into premultiplied RGBA on a black background; IceT composites
 //              the parts in the view's visibility order (host/cluster/compositor.h); rank 0 adds the
 //              background and writes.
+//   sort-first: every rank holds the whole data and renders a band of image rows (Camera::bandFullHeight),
+//              balanced by the previous frame's cost; rank 0 gathers the rows and writes.
 //   frames:    frame k of --orbit N on rank k mod N; each rank writes its own frames.
 // Every step that can fail runs inside World::agree, so a failure on any rank becomes the same error on
 // every rank (rank 0 prints it, every rank exits with its status) and nobody waits in a collective.
@@ -24,6 +26,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cstring>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -224,6 +227,109 @@ int renderSortLast(const RenderOptions& options, World& world, Job& job)
     return 0;
 }
 
+// Sort-first: each rank renders a band of rows of every frame with all the data; rank 0 gathers the rows.
+int renderSortFirst(const RenderOptions& options, World& world, Job& job)
+{
+    const int count = static_cast<int>(job.outputs.size());
+    const int width = job.scene.image.width, height = job.scene.image.height;
+    std::unique_ptr<Device> device;
+    std::unique_ptr<Session> session;
+    std::vector<int> rows(static_cast<std::size_t>(world.size()), 0);
+    std::vector<double> lastMs(static_cast<std::size_t>(world.size()), 0.0);
+    const auto band = [&](const Camera& camera) {
+        int y0 = 0;
+        for (int r = 0; r < world.rank(); ++r)
+            y0 += rows[static_cast<std::size_t>(r)];
+        Camera c = camera;
+        c.bandFullHeight = height;
+        c.bandY0 = y0;
+        ImageSpec image = job.scene.image;
+        image.height = rows[static_cast<std::size_t>(world.rank())];
+        return std::make_pair(c, image);
+    };
+    Camera camera0;
+    world.agree([&] {
+        if (height < world.size())
+            throw InputError("sort-first needs at least one image row per rank: " + std::to_string(height) +
+                             " rows for " + std::to_string(world.size()) + " ranks");
+        SceneData data = loadSceneData(job.scene);
+        camera0 = sceneCamera(job.scene, data);
+        rows = balanceRows(height, rows, lastMs);
+        auto [camera, image] = band(camera0);
+        Scene bandScene = job.scene;
+        bandScene.camera = camera;
+        bandScene.image = image;
+        device = std::make_unique<Device>(rankDevice(options, world));
+        session = std::make_unique<Session>(*device, bandScene, std::move(data), job.sceneLabel);
+    });
+    WrittenFiles written;
+    nlohmann::json frames = nlohmann::json::array();
+    nlohmann::json frame0Stats;
+    double frame0Ms = 0.0;
+    for (int k = 0; k < count; ++k) {
+        Frame frame;
+        world.agree([&] {
+            if (k != 0) {
+                rows = balanceRows(height, rows, lastMs);
+                auto [camera, image] = band(orbitCamera(camera0, k, count));
+                session->setView(camera, image);
+            }
+            frame = session->render();
+            if (k == 0 && !options.singleFrame)
+                frame = session->render();  // the first frame builds kernels; time a steady one
+        });
+        lastMs = world.allGather(frame.stats.frameMs);
+        const auto t0 = std::chrono::steady_clock::now();
+        std::vector<float> mine(frame.image.pixelCount() * 4);
+        std::memcpy(mine.data(), frame.image.pixels().data(), mine.size() * sizeof(float));
+        const std::vector<float> all = world.gather(mine);
+        const double gatherMs = msSince(t0);
+        world.agree([&] {
+            if (world.rank() != 0)
+                return;
+            Image4f image(width, height);
+            if (all.size() != image.pixelCount() * 4)
+                throw InternalError("sort-first: the ranks' rows do not add up to the image");
+            std::memcpy(image.pixels().data(), all.data(), all.size() * sizeof(float));
+            const std::string& path = job.outputs[static_cast<std::size_t>(k)];
+            writeImage(path, image);
+            written.add(path);
+            double renderMs = 0.0;
+            for (double t : lastMs)
+                renderMs = std::max(renderMs, t);
+            frames.push_back({{"index", k}, {"output", path}, {"render_ms", renderMs}, {"gather_ms", gatherMs},
+                              {"frame_ms", renderMs + gatherMs}, {"render_ms_per_rank", lastMs}, {"rows_per_rank", rows}});
+            if (k == 0) {
+                frame0Stats = session->stats(frame);
+                frame0Ms = renderMs + gatherMs;
+                noteEmptyImage(image, job.scene.technique);
+            }
+        });
+    }
+    world.agree([&] {
+        if (world.rank() != 0 || options.statsPath.empty())
+            return;
+        nlohmann::json stats = frame0Stats;  // rank 0's band, plus the job's figures
+        stats["scene"] = job.sceneLabel;
+        stats["distribution"] = "sort-first";
+        stats["ranks"] = world.size();
+        stats["width"] = width;
+        stats["height"] = height;
+        stats["frame_ms"] = frame0Ms;
+        stats["frames"] = frames;
+        if (options.orbit > 0)
+            stats["orbit"] = options.orbit;
+        writeFileAtomically(options.statsPath, stats.dump(2) + "\n");
+    });
+    written.keep();
+    if (world.rank() == 0)
+        std::cout << "wrote " << options.output << (options.orbit > 0 ? ": " + std::to_string(count) + " frames" : "")
+                  << " (" << width << "x" << height << ", " << job.scene.technique << ", sort-first on "
+                  << world.size() << " ranks, " << std::fixed << std::setprecision(1) << frame0Ms << " ms/frame)"
+                  << std::endl;
+    return 0;
+}
+
 }  // namespace
 
 int renderCluster(const RenderOptions& options)
@@ -247,10 +353,12 @@ int renderCluster(const RenderOptions& options)
             job.scene = useDefault ? defaultScene(options.overrides, options.unsets)
                                    : loadScene(options.scene, options.overrides, options.unsets);
             job.distribution = distributionOf(options, job.scene);
-            if (job.distribution == "sort-first")
-                throw InputError("--distribution sort-first is not built yet (docs/cluster.md); use sort-last or frames");
         });
-        return job.distribution == "frames" ? renderFrames(options, world, job) : renderSortLast(options, world, job);
+        if (job.distribution == "frames")
+            return renderFrames(options, world, job);
+        if (job.distribution == "sort-first")
+            return renderSortFirst(options, world, job);
+        return renderSortLast(options, world, job);
     } catch (...) {
         if (world.rank() != 0)
             quietErrors();  // the same error on every rank: rank 0 prints it

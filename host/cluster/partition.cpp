@@ -44,7 +44,7 @@ int splitGrid(GridPartition& out, const glm::ivec3& c0, const glm::ivec3& c1, co
     const int axis = longestAxis(extent);
     if (extent[axis] < 0.0)
         throw InputError("the volume has too few cells to split into parts for every rank (a part needs at least one "
-                         "cell per axis); use fewer ranks or --distribution frames");
+                         "cell per axis); use fewer ranks, or --distribution sort-first or frames");
     const int below = ranks / 2;
     const double share = static_cast<double>(below) / ranks;
     const int cut = std::clamp(c0[axis] + static_cast<int>(std::lround(cells[axis] * share)), c0[axis] + 1,
@@ -233,6 +233,43 @@ void addBackground(Image4f& image, const glm::dvec3& background)
     const glm::vec3 bg(background);
     for (glm::vec4& p : image.pixels())
         p = glm::vec4(glm::vec3(p) + (1.0f - p.a) * bg, p.a);
+}
+
+std::vector<int> balanceRows(int height, const std::vector<int>& rows, const std::vector<double>& ms)
+{
+    if (rows.empty() || rows.size() != ms.size() || height < static_cast<int>(rows.size()))
+        throw InternalError("balanceRows: one row count and one time per rank, and a row for each");
+    const int n = static_cast<int>(rows.size());
+    std::vector<int> out(static_cast<std::size_t>(n), height / n);
+    for (int r = 0; r < height % n; ++r)
+        ++out[static_cast<std::size_t>(r)];
+    double total = 0.0;
+    for (double t : ms)
+        total += t;
+    if (!(total > 0.0))
+        return out;
+    int given = 0;
+    for (int r : rows)
+        given += r;
+    if (given != height || *std::min_element(rows.begin(), rows.end()) < 1)
+        throw InternalError("balanceRows: the previous bands do not tile the image");
+    std::vector<double> rowCost;  // per image row, top to bottom
+    for (int r = 0; r < n; ++r)
+        for (int i = 0; i < rows[static_cast<std::size_t>(r)]; ++i)
+            rowCost.push_back(ms[static_cast<std::size_t>(r)] / rows[static_cast<std::size_t>(r)]);
+    double acc = 0.0;
+    int rank = 0, start = 0;
+    for (int y = 0; y < height && rank < n - 1; ++y) {
+        acc += rowCost[static_cast<std::size_t>(y)];
+        const int left = height - (y + 1);  // rows still to hand out after this one
+        if (acc >= total * (rank + 1) / n || left == n - 1 - rank) {
+            out[static_cast<std::size_t>(rank)] = y + 1 - start;
+            start = y + 1;
+            ++rank;
+        }
+    }
+    out[static_cast<std::size_t>(n - 1)] = height - start;
+    return out;
 }
 
 }  // namespace clvr

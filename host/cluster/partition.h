@@ -76,4 +76,11 @@ Image4f compositeOver(const std::vector<const Image4f*>& frontToBack);
 // I + (1 - A) * background, alpha kept: what every renderer does last, for a composited image.
 void addBackground(Image4f& image, const glm::dvec3& background);
 
+// Sort-first (docs/cluster.md): image rows per rank for the next frame, top band first. `rows` and `ms`
+// are the previous frame's rows and render times per rank; no time yet (all 0): equal shares, the first
+// ranks one row more. Else each row costs its rank's time over its rows (seeds/001 §6's reference
+// balances tiles by the previous frame's cost the same way) and the new bands cut the cumulative cost
+// into equal parts; every rank keeps at least one row. The counts add up to `height`.
+std::vector<int> balanceRows(int height, const std::vector<int>& rows, const std::vector<double>& ms);
+
 }  // namespace clvr

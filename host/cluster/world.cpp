@@ -118,6 +118,29 @@ std::vector<double> World::gather(double value) const
     return all;
 }
 
+std::vector<double> World::allGather(double value) const
+{
+    std::vector<double> all(static_cast<std::size_t>(size_));
+    MPI_Allgather(&value, 1, MPI_DOUBLE, all.data(), 1, MPI_DOUBLE, MPI_COMM_WORLD);
+    return all;
+}
+
+std::vector<float> World::gather(const std::vector<float>& mine) const
+{
+    const int count = static_cast<int>(mine.size());
+    std::vector<int> counts(static_cast<std::size_t>(size_)), displacements(static_cast<std::size_t>(size_));
+    MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
+    std::size_t total = 0;
+    for (int r = 0; r < size_ && rank_ == 0; ++r) {
+        displacements[static_cast<std::size_t>(r)] = static_cast<int>(total);
+        total += static_cast<std::size_t>(counts[static_cast<std::size_t>(r)]);
+    }
+    std::vector<float> all(total);
+    MPI_Gatherv(mine.data(), count, MPI_FLOAT, all.data(), counts.data(), displacements.data(), MPI_FLOAT, 0,
+                MPI_COMM_WORLD);
+    return all;
+}
+
 double World::maxOver(double value) const
 {
     double out = value;

@@ -38,6 +38,10 @@ public:
     void barrier() const;
     // Gathers one double per rank on rank 0 (others get an empty vector).
     std::vector<double> gather(double value) const;
+    // Every rank's value, in rank order, on every rank.
+    std::vector<double> allGather(double value) const;
+    // Gathers every rank's floats on rank 0, in rank order (others get an empty vector).
+    std::vector<float> gather(const std::vector<float>& mine) const;
     // The largest value over all ranks, on every rank.
     double maxOver(double value) const;
 

@@ -30,6 +30,8 @@ void Camera::validate() const
         throw InputError("camera: view_angle must be in (0, 180) degrees, got " + std::to_string(viewAngle));
     if (parallel && !(parallelScale > 0.0 && std::isfinite(parallelScale)))
         throw InputError("camera: parallel_scale must be > 0, got " + std::to_string(parallelScale));
+    if (bandFullHeight < 0 || bandY0 < 0 || (bandFullHeight == 0 && bandY0 != 0))
+        throw InternalError("camera: a band must lie in an image of positive height");
 }
 
 glm::dvec3 Camera::forward() const { return glm::normalize(focalPoint - position); }
@@ -43,9 +45,9 @@ Ray Camera::ray(double px, double py, int width, int height) const
 
 PixelRays::PixelRays(const Camera& camera, int width, int height)
     : position_(camera.position), forward_(camera.forward()), right_(camera.right()), up_(camera.up()),
-      width_(width), height_(height), aspect_(static_cast<double>(width) / height),
+      width_(width), height_(camera.fullHeight(height)), aspect_(static_cast<double>(width) / camera.fullHeight(height)),
       scale_(camera.parallel ? camera.parallelScale : std::tan(glm::radians(camera.viewAngle) * 0.5)),
-      parallel_(camera.parallel)
+      y0_(camera.bandY0), parallel_(camera.parallel)
 {
 }
 
@@ -53,7 +55,7 @@ Ray PixelRays::at(double px, double py) const
 {
     // Normalized device coordinates of the pixel center, y up.
     const double ndcX = (px + 0.5) / width_ * 2.0 - 1.0;
-    const double ndcY = 1.0 - (py + 0.5) / height_ * 2.0;
+    const double ndcY = 1.0 - (py + y0_ + 0.5) / height_ * 2.0;  // y0_ = 0: the whole image
     if (parallel_) {
         const glm::dvec3 origin = position_ + (ndcX * scale_ * aspect_) * right_ + (ndcY * scale_) * up_;
         return {origin, forward_};
@@ -68,6 +70,14 @@ glm::dmat4 Camera::viewMatrix() const
 
 glm::dmat4 Camera::projectionMatrix(int width, int height, double near, double far) const
 {
+    if (bandFullHeight > 0) {  // an off-centre frustum holding only the band's rows
+        const double full = bandFullHeight, aspect = width / full;
+        const double top = 1.0 - 2.0 * bandY0 / full, bottom = 1.0 - 2.0 * (bandY0 + height) / full;
+        const double s = parallel ? parallelScale : std::tan(glm::radians(viewAngle) * 0.5);
+        if (parallel)
+            return glm::ortho(-s * aspect, s * aspect, s * bottom, s * top, near, far);
+        return glm::frustum(-s * aspect * near, s * aspect * near, s * bottom * near, s * top * near, near, far);
+    }
     const double aspect = static_cast<double>(width) / height;
     if (parallel)
         return glm::ortho(-parallelScale * aspect, parallelScale * aspect, -parallelScale, parallelScale, near, far);

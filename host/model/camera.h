@@ -19,9 +19,15 @@ struct Camera {
     double viewAngle = 30.0;  // degrees, vertical
     bool parallel = false;
     double parallelScale = 1.0;
+    // Sort-first (docs/cluster.md): the camera renders only rows [bandY0, bandY0 + height) of an image
+    // bandFullHeight rows tall, `height` being the height its users pass (ray, PixelRays, projectionMatrix,
+    // toClCamera); the pixels are those of the full image's rows. 0: the whole image.
+    int bandFullHeight = 0;
+    int bandY0 = 0;
 
     // Throws InputError ("camera: ...") for position == focal point, view_up parallel to the view
     // direction, a view angle outside (0, 180), a parallel scale <= 0, or non-finite values.
+    // (The band is set by code, never by a scene: InternalError for a negative one.)
     void validate() const;
 
     // Orthonormal frame: forward (towards the focal point), right, up (view_up made orthogonal).
@@ -36,6 +42,10 @@ struct Camera {
     // OpenGL-style matrices for the raster stage: world -> eye, eye -> clip (near/far > 0 in eye units).
     glm::dmat4 viewMatrix() const;
     glm::dmat4 projectionMatrix(int width, int height, double near, double far) const;
+
+    // The full image's height for a band (or `height` itself), and the image plane's vertical extent of
+    // the band as fractions of the full one: rows [y0, y0 + height) -> [top, bottom] in [-1, 1] NDC.
+    int fullHeight(int height) const { return bandFullHeight > 0 ? bandFullHeight : height; }
 };
 
 // The rays of one camera and image size, with the basis (forward, right, up, tan of the half angle)
@@ -48,6 +58,7 @@ public:
 private:
     glm::dvec3 position_, forward_, right_, up_;
     double width_, height_, aspect_, scale_;  // scale: tan(view_angle / 2), or parallel_scale
+    double y0_;                               // the band's first row (0 for the whole image)
     bool parallel_;
 };
 

@@ -18,8 +18,11 @@ namespace clvr {
 // precision moves the camera with it).
 inline ClCamera toClCamera(const Camera& camera, int width, int height, const glm::dvec3& shift = glm::dvec3(0.0))
 {
-    const double aspect = static_cast<double>(width) / height;
+    // A band (Camera::bandFullHeight) of rows [y0, y0 + height) of an image H rows tall: position.w = y0,
+    // forward.w = H, and the full image's aspect, so the kernels take the full image's ray of each row
+    // (kernels/ray.h's clvr_ray_window_offset). The whole image: both 0.
     const double scale = camera.parallel ? camera.parallelScale : std::tan(glm::radians(camera.viewAngle) * 0.5);
+    const double aspect = static_cast<double>(width) / camera.fullHeight(height);
     auto pack = [](const glm::dvec3& v) {
         return cl_float4{{static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z), 0.0f}};
     };
@@ -29,6 +32,10 @@ inline ClCamera toClCamera(const Camera& camera, int width, int height, const gl
     cl.right = pack(camera.right());
     cl.up = pack(camera.up());
     cl.params = cl_float4{{static_cast<float>(scale), static_cast<float>(aspect), camera.parallel ? 1.0f : 0.0f, 0.0f}};
+    if (camera.bandFullHeight > 0) {
+        cl.position.s[3] = static_cast<float>(camera.bandY0);
+        cl.forward.s[3] = static_cast<float>(camera.bandFullHeight);
+    }
     return cl;
 }
 

@@ -24,7 +24,7 @@ namespace {
         if (other.sortLast)
             able += (able.empty() ? "" : ", ") + other.name;
     throw InputError("technique " + t.name + " does not render a part of a data set (sort-last renders " + able +
-                     "); use --distribution frames (sort-first is not built yet)");
+                     "); use --distribution sort-first (every rank renders image rows of the whole data) or frames");
 }
 
 std::string joined(const std::vector<std::string>& names)

@@ -90,7 +90,7 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
     const GridPart& part = volume.part ? *volume.part : whole;
     if (volume.part && options_.path != Slice3dOptions::Path::Fused)
         throw InputError("slice3d: the raster path (options.path \"raster\", clip meshes) does not render a part "
-                         "of a volume; use --distribution frames (sort-first is not built yet)");
+                         "of a volume; use --distribution sort-first or frames");
     origin_ = part.fullOrigin;
     lo_ = part.fullBoundsMin();
     hi_ = part.fullBoundsMax(spacing_);

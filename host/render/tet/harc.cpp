@@ -414,7 +414,8 @@ HarcEntryLists buildHarcEntryLists(const TetMesh& mesh, const TetTopology& topol
     };
     const glm::dvec3 f = camera.forward(), r = camera.right(), u = camera.up();
     const PixelRays rays(camera, width, height);
-    const double aspect = static_cast<double>(width) / height;
+    const double fullHeight = camera.fullHeight(height), firstRow = camera.bandY0;  // a band of rows (sort-first)
+    const double aspect = static_cast<double>(width) / fullHeight;
     const double scale = camera.parallel ? camera.parallelScale : std::tan(glm::radians(camera.viewAngle) * 0.5);
     // Boundary faces in chunks over the host's threads, each thread with its own hits; the per-pixel
     // sort below (by λ, then face) makes the result independent of which thread found what.
@@ -448,7 +449,7 @@ HarcEntryLists buildHarcEntryLists(const TetMesh& mesh, const TetTopology& topol
                         sy /= z;
                     }
                     const double px = (sx / (scale * aspect) + 1.0) * 0.5 * width - 0.5;
-                    const double py = (1.0 - sy / scale) * 0.5 * height - 0.5;
+                    const double py = (1.0 - sy / scale) * 0.5 * fullHeight - 0.5 - firstRow;
                     minX = std::min(minX, px);
                     maxX = std::max(maxX, px);
                     minY = std::min(minY, py);
