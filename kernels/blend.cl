@@ -15,7 +15,8 @@
  * forward + sx right + sy up for perspective, forward for parallel with o on the image plane), so slice k
  * at eye depth depth0 + (k + 0.5) delta_s is met at o + z_k d and a slice stands for a ray length
  * delta = delta_s |d|. Slices from the farthest (slice_count - 1) to the nearest; only samples inside the
- * grid count (samples[]). alpha = 1 - exp(-tau delta); alpha <= threshold: clear (skipped[], not shaded);
+ * grid (and, for a sort-last part, its own: clvr_grid_owned) count (samples[]). alpha = 1 - exp(-tau
+ * delta); alpha <= threshold: clear (skipped[], not shaded);
  * else c = C shade alpha + (1 - alpha) c, A = alpha + (1 - alpha) A. Pixel c + (1 - A) background, A. */
 kernel void blend_render(global float4* out, global uint* samples, global uint* skipped,
                          global const float4* volume, global const float* tf, global const float4* map,
@@ -23,7 +24,8 @@ kernel void blend_render(global float4* out, global uint* samples, global uint* 
 {
     CLVR_GUARD_2D(p.width, p.height);
     const int x = (int)get_global_id(0), y = (int)get_global_id(1);
-    const int4 dims = p.dims;
+    const int4 dims = p.dims, offset = p.part_offset;
+    const float3 own_lo = p.own_lo.xyz, own_hi = p.own_hi.xyz;
     const float depth0 = p.depth0, delta_s = p.delta_s, threshold = p.threshold;
     const int tf_count = p.tf_count, map_n = p.map_n, shade_on = p.shade_on;
     const float3 to_eye = p.to_eye.xyz;
@@ -41,10 +43,10 @@ kernel void blend_render(global float4* out, global uint* samples, global uint* 
     uint taken = 0, below = 0;
     for (int k = p.slice_count - 1; k >= 0; --k) {
         const float3 g = go + (depth0 + ((float)k + 0.5f) * delta_s) * gd;
-        if (!clvr_grid_inside(g, dims))
+        if (!clvr_grid_owned(g, own_lo, own_hi)) /* outside the grid, or another part's (sort-last) */
             continue;
         ++taken;
-        const float4 v = clvr_trilinear4(volume, dims, g);
+        const float4 v = clvr_trilinear4(volume, dims, clvr_grid_local(g, offset));
         const float4 ct = clvr_tf_eval(tf, tf_count, v.w);
         const float alpha = 1.0f - exp2(ct.w * neg_delta_log2e);
         if (alpha <= threshold) { /* written clear: blending it changes nothing */

@@ -9,11 +9,13 @@
 
 typedef struct {
     ClCamera camera;
-    cl_int4 dims;           /* grid points per axis, w = 0 */
-    cl_float4 grid_origin;  /* world position of grid point (0, 0, 0), w = 0 */
+    cl_int4 dims;           /* grid points per axis (of this volume, a part's own), w = 0 */
+    cl_int4 part_offset;    /* this volume's point 0 in the full grid (sort-last part; else 0), w = 0 */
+    cl_float4 grid_origin;  /* world position of the full grid's point (0, 0, 0), w = 0 */
     cl_float4 inv_spacing;  /* 1 / spacing per axis, w = 0 */
     cl_float4 to_eye;       /* unit vector towards the eye (-forward), for the reflectance map */
     cl_float4 background;   /* image background, w = 0 */
+    cl_float4 own_lo, own_hi; /* the full grid coordinates this volume samples (volume_sampling.h), w = 0 */
     cl_int width, height;   /* image size in pixels */
     cl_int tf_count;        /* control points of the transfer function */
     cl_int map_n;           /* reflectance map size */
@@ -23,6 +25,6 @@ typedef struct {
     cl_int slice_count;
     cl_float threshold;     /* samples with alpha <= this are written clear */
     cl_int pad0, pad1, pad2;
-} ClBlendParams;            /* 208 bytes */
+} ClBlendParams;            /* 256 bytes */
 
 #endif

@@ -12,6 +12,7 @@
 #include "ray.h"
 #include "reflectance_map.h"
 #include "transfer_function.h"
+#include "volume_sampling.h"
 
 /* One work-item per pixel. The chord [t0, t1] of the ray inside the box [lo, hi] (t0 >= 0) is cut into
  * count = ceil((t1 - t0) / step) equal segments of length h <= step; sample k sits at the middle of
@@ -27,7 +28,8 @@ kernel void planes_render(global float4* out, global uint* samples, global uint*
     CLVR_GUARD_2D(p.width, p.height);
     const int x = (int)get_global_id(0), y = (int)get_global_id(1);
     /* the values the sample loop reads, as locals */
-    const int4 dims = p.dims;
+    const int4 dims = p.dims, offset = p.part_offset;
+    const float3 own_lo = p.own_lo.xyz, own_hi = p.own_hi.xyz;
     const float3 grid_origin = p.grid_origin.xyz, inv_spacing = p.inv_spacing.xyz, to_eye = p.to_eye.xyz;
     const int tf_count = p.tf_count, map_n = p.map_n, shade_on = p.shade_on;
     const float ert_alpha = p.ert_alpha, threshold = p.threshold;
@@ -61,12 +63,14 @@ kernel void planes_render(global float4* out, global uint* samples, global uint*
         const int count = max(1, (int)ceil((t1 - t0) / p.step));
         const float h = (t1 - t0) / (float)count;
         const float neg_h_log2e = -h * M_LOG2E_F; /* exp(-tau h) = exp2(tau * this) */
-        const float3 last = convert_float3(dims.xyz - 1);
+        const float3 last = convert_float3(p.full_dims.xyz - 1);
         for (int k = 0; k < count; ++k) {
             const float3 q = o + (t0 + ((float)k + 0.5f) * h) * d;
             /* inside the box by construction; the clamp absorbs float rounding at its faces */
             const float3 g = clamp((q - grid_origin) * inv_spacing, (float3)(0.0f), last);
-            const float4 s = clvr_trilinear4(volume, dims, g);
+            if (!clvr_grid_owned(g, own_lo, own_hi)) /* another part's sample (sort-last) */
+                continue;
+            const float4 s = clvr_trilinear4(volume, dims, clvr_grid_local(g, offset));
             const float4 ct = clvr_tf_eval(tf, tf_count, s.w);
             ++taken;
             const float alpha = 1.0f - exp2(ct.w * neg_h_log2e);

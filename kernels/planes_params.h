@@ -9,10 +9,13 @@
 
 typedef struct {
     ClCamera camera;
-    cl_int4 dims;           /* grid points per axis, w = 0 */
-    cl_float4 grid_origin;  /* world position of grid point (0, 0, 0), w = 0 */
+    cl_int4 dims;           /* grid points per axis (of this volume, a part's own), w = 0 */
+    cl_int4 part_offset;    /* this volume's point 0 in the full grid (sort-last part; else 0), w = 0 */
+    cl_int4 full_dims;      /* the full grid's points per axis (= dims for a whole volume), w = 0 */
+    cl_float4 grid_origin;  /* world position of the full grid's point (0, 0, 0), w = 0 */
     cl_float4 inv_spacing;  /* 1 / spacing per axis, w = 0 */
-    cl_float4 box_lo, box_hi; /* the volume's bounds, world, w = 0 */
+    cl_float4 box_lo, box_hi; /* the full grid's bounds, world, w = 0 */
+    cl_float4 own_lo, own_hi; /* the full grid coordinates this volume samples (volume_sampling.h), w = 0 */
     cl_float4 to_eye;       /* unit vector towards the eye (-forward), for the reflectance map */
     cl_float4 background;   /* image background, w = 0 */
     cl_int width, height;   /* image size in pixels */
@@ -22,6 +25,6 @@ typedef struct {
     cl_float step;          /* sample spacing along the ray, world units */
     cl_float ert_alpha;     /* stop once the opacity reaches this (1 or more: off) */
     cl_float threshold;     /* samples with alpha <= this are skipped */
-} ClPlanesParams;           /* 224 bytes */
+} ClPlanesParams;           /* 288 bytes */
 
 #endif

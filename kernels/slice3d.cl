@@ -44,21 +44,6 @@ float3 slice3d_point(const float3 go, const float3 gd, const float depth0, const
     return go + (depth0 + (float)k * delta_s) * gd;
 }
 
-/* 1 when full-grid coordinates g are this volume's to sample (own_lo <= g < own_hi per axis; for the
- * whole grid own_hi is the next float above n - 1, so this is clvr_grid_inside's g <= n - 1). */
-int slice3d_owned(const float3 g, const float3 own_lo, const float3 own_hi)
-{
-    return g.x >= own_lo.x && g.y >= own_lo.y && g.z >= own_lo.z && g.x < own_hi.x && g.y < own_hi.y &&
-           g.z < own_hi.z;
-}
-
-/* The volume's own grid coordinates of owned full-grid coordinates g: g - offset, exact in float (g >=
- * offset >= 0 and g < 2^24, so the difference is a multiple of g's ulp no larger than g). */
-float3 slice3d_local(const float3 g, const int4 offset)
-{
-    return g - convert_float3(offset.xyz);
-}
-
 /* Brick (x, y, z) of the cell clvr_trilinear uses at the volume's own coordinates gl (its lower corner,
  * clamped to n - 2). */
 int4 slice3d_brick(const float3 gl, const int4 dims)
@@ -72,9 +57,9 @@ int slice3d_in_cube(const float3 go, const float3 gd, const float depth0, const 
                     const ClSlice3dParams* p, const int4 b, const int r)
 {
     const float3 g = slice3d_point(go, gd, depth0, delta_s, k);
-    if (!slice3d_owned(g, p->own_lo.xyz, p->own_hi.xyz))
+    if (!clvr_grid_owned(g, p->own_lo.xyz, p->own_hi.xyz))
         return 0;
-    const uint4 c = abs_diff(slice3d_brick(slice3d_local(g, p->part_offset), p->dims), b);
+    const uint4 c = abs_diff(slice3d_brick(clvr_grid_local(g, p->part_offset), p->dims), b);
     return max(c.x, max(c.y, c.z)) <= (uint)r;
 }
 
@@ -191,9 +176,9 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
         float transmittance = 1.0f;
         for (int k = k_lo; k <= k_hi; ++k) {
             const float3 g = slice3d_point(go, gd, depth0, delta_s, k);
-            if (!slice3d_owned(g, own_lo, own_hi))
+            if (!clvr_grid_owned(g, own_lo, own_hi))
                 continue;
-            const float3 gl = slice3d_local(g, offset);
+            const float3 gl = clvr_grid_local(g, offset);
             if (skip) {
                 const int4 b = slice3d_brick(gl, dims);
                 const int space_b = slice3d_space(space, bdims, b);
@@ -221,9 +206,9 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
     } else {
         for (int k = k_hi; k >= k_lo; --k) {
             const float3 g = slice3d_point(go, gd, depth0, delta_s, k);
-            if (!slice3d_owned(g, own_lo, own_hi))
+            if (!clvr_grid_owned(g, own_lo, own_hi))
                 continue;
-            const float3 gl = slice3d_local(g, offset);
+            const float3 gl = clvr_grid_local(g, offset);
             if (skip) {
                 const int4 b = slice3d_brick(gl, dims);
                 const int space_b = slice3d_space(space, bdims, b);

@@ -11,6 +11,22 @@ int clvr_grid_inside(const float3 g, const int4 dims)
            g.y <= (float)(dims.y - 1) && g.z <= (float)(dims.z - 1);
 }
 
+/* Sort-last parts (host/model/volume.h GridPart): 1 when full-grid coordinates g are this volume's to
+ * sample (own_lo <= g < own_hi per axis; for the whole grid own_hi is the next float above n - 1, so
+ * this is clvr_grid_inside's g <= n - 1). */
+int clvr_grid_owned(const float3 g, const float3 own_lo, const float3 own_hi)
+{
+    return g.x >= own_lo.x && g.y >= own_lo.y && g.z >= own_lo.z && g.x < own_hi.x && g.y < own_hi.y &&
+           g.z < own_hi.z;
+}
+
+/* The volume's own grid coordinates of owned full-grid coordinates g: g - offset, exact in float (g >=
+ * offset >= 0 and g < 2^24, so the difference is a multiple of g's ulp no larger than g). */
+float3 clvr_grid_local(const float3 g, const int4 offset)
+{
+    return g - convert_float3(offset.xyz);
+}
+
 /* Trilinear value at grid coordinates g, which the caller has checked with clvr_grid_inside. The
  * lower corner is clamped to n-2 so that g = n-1 takes the last cell with weight 1. At most
  * 2^32 - 1 grid points. */

@@ -134,8 +134,8 @@ TEST(Layout, EveryParamsStructFitsTheKernelArgumentSpace)
     // The sizes the headers document (a field added without its padding shows here first).
     EXPECT_EQ(sizeof(ClCamera), 80u);
     EXPECT_EQ(sizeof(ClSlice3dParams), 352u);
-    EXPECT_EQ(sizeof(ClPlanesParams), 224u);
-    EXPECT_EQ(sizeof(ClBlendParams), 208u);
+    EXPECT_EQ(sizeof(ClPlanesParams), 288u);
+    EXPECT_EQ(sizeof(ClBlendParams), 256u);
     EXPECT_EQ(sizeof(ClHarcParams), 192u);
     EXPECT_EQ(sizeof(ClSphericalParams), 192u);
     EXPECT_EQ(sizeof(ClSlice3dOverBackgroundParams), 32u);

@@ -146,7 +146,7 @@ int renderSortLast(const RenderOptions& options, World& world, Job& job)
         } else {
             const GridPartition partition = partitionGrid(data.volume.dims, data.volume.origin, data.volume.spacing,
                                                           world.size());
-            data.volume = cutGridPart(data.volume, partition, world.rank());
+            data.volume = cutGridPart(data.volume, partition, world.rank(), technique(job.scene.technique).sortLastGhost);
             tree = partition.tree;
             const glm::ivec3 n = data.volume.dims;
             partText = std::to_string(n.x) + "x" + std::to_string(n.y) + "x" + std::to_string(n.z) + " points";

@@ -153,7 +153,7 @@ int run(int argc, char** argv)
         ->check(CLI::Range(1, 100000));
     render->add_option("--distribution", renderOptions.distribution,
                        "under mpirun: sort-last (the data split over the ranks, images composited by IceT), "
-                       "sort-first or frames (--orbit frames shared out); default: the scene's, else sort-last, "
+                       "sort-first (image rows shared out, every technique) or frames (--orbit frames shared out); default: the scene's, else sort-last, "
                        "frames with --orbit (docs/cluster.md)");
     render->add_flag("--single-frame", renderOptions.singleFrame,
                      "render once (by default a first frame and a steady frame are rendered; frame_ms is the steady one)");

@@ -51,8 +51,11 @@ struct GridPartition {
 // per axis).
 GridPartition partitionGrid(const glm::ivec3& dims, const glm::dvec3& origin, const glm::dvec3& spacing, int n);
 
-// Part p of `volume` as its own Volume (the grid points [lo[p], hi[p]], GridPart set).
-Volume cutGridPart(const Volume& volume, const GridPartition& partition, int p);
+// Part p of `volume` as its own Volume: the grid points [lo[p], hi[p]] plus `ghost` (0 or 1) more layers
+// on each side where the grid goes on (GridPart set, ghostLo/ghostHi saying how many it holds). The part
+// owns the samples of [lo[p], hi[p]] either way; the ghost layer gives planes' and blend's Sobel
+// gradients their neighbours (TechniqueInfo::sortLastGhost).
+Volume cutGridPart(const Volume& volume, const GridPartition& partition, int p, int ghost = 0);
 
 // A tetrahedral mesh cut into n k-d boxes (part p: [lo[p], hi[p]]) of its bounding box.
 struct MeshPartition {

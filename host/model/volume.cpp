@@ -9,6 +9,18 @@
 
 namespace clvr {
 
+glm::vec3 GridPart::ownLo() const { return glm::vec3(offset + ghostLo); }
+
+glm::vec3 GridPart::ownHi(const glm::ivec3& dims) const
+{
+    glm::vec3 hi;
+    for (int a = 0; a < 3; ++a) {
+        const int last = offset[a] + dims[a] - 1 - ghostHi[a];
+        hi[a] = last == fullDims[a] - 1 ? std::nextafter(static_cast<float>(last), INFINITY) : static_cast<float>(last);
+    }
+    return hi;
+}
+
 void checkHostMemoryForVoxels(const std::string& source, std::uint64_t voxels)
 {
     const long pages = ::sysconf(_SC_PHYS_PAGES), pageSize = ::sysconf(_SC_PAGE_SIZE);

@@ -18,15 +18,22 @@ void checkHostMemoryForVoxels(const std::string& source, std::uint64_t voxels);
 
 // Where a volume sits in the larger grid it was cut from (sort-last cluster rendering, host/cluster/):
 // its grid point (0, 0, 0) is point `offset` of that grid, whose dims and origin these are (same
-// spacing). Such a volume "owns" the grid coordinates [offset, offset + dims - 1) per axis, closed at
-// the full grid's last point, so that parts cut with one shared layer of points own every sample once.
+// spacing). It may hold `ghostLo`/`ghostHi` extra layers of points beyond its own on each axis (0 or 1;
+// planes and blend need one for their Sobel gradients). Such a volume "owns" the full grid coordinates
+// [offset + ghostLo, offset + dims - 1 - ghostHi) per axis, closed at the full grid's last point, so that
+// parts cut with one shared layer of points own every sample once.
 struct GridPart {
     glm::ivec3 offset{0};
     glm::ivec3 fullDims{0};
     glm::dvec3 fullOrigin{0.0};
+    glm::ivec3 ghostLo{0}, ghostHi{0};
 
     glm::dvec3 fullBoundsMin() const { return fullOrigin; }
     glm::dvec3 fullBoundsMax(const glm::dvec3& spacing) const { return fullOrigin + glm::dvec3(fullDims - 1) * spacing; }
+    // The owned range as the kernels test it, own_lo <= g < own_hi in full grid coordinates (own_hi is
+    // the next float above the full grid's last point where the part reaches it). `dims`: the part's.
+    glm::vec3 ownLo() const;
+    glm::vec3 ownHi(const glm::ivec3& dims) const;
 };
 
 struct Volume {

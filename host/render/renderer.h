@@ -65,6 +65,9 @@ struct TechniqueInfo {
     // Renders a part of a larger data set (Volume::part, TetMesh::part) so that the parts' images
     // composited in visibility order give the whole one: sort-last cluster rendering (docs/cluster.md).
     bool sortLast = false;
+    // Layers of grid points a volume part needs beyond its own (host/cluster/partition.h cutGridPart):
+    // 1 for techniques whose per-point values (Sobel gradients) look at the neighbours.
+    int sortLastGhost = 0;
     // The factory for the technique's data kind (the other one is empty).
     std::function<std::unique_ptr<Renderer>(Device&, const Scene&, const Volume&)> makeForVolume;
     std::function<std::unique_ptr<Renderer>(Device&, const Scene&, const TetMesh&)> makeForMesh;

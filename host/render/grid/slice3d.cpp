@@ -95,12 +95,8 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
     lo_ = part.fullBoundsMin();
     hi_ = part.fullBoundsMax(spacing_);
     partOffset_ = part.offset;
-    for (int a = 0; a < 3; ++a) {
-        const int last = part.offset[a] + dims_[a] - 1;
-        ownLo_[a] = static_cast<float>(part.offset[a]);
-        ownHi_[a] = last == part.fullDims[a] - 1 ? std::nextafter(static_cast<float>(last), INFINITY)
-                                                 : static_cast<float>(last);
-    }
+    ownLo_ = part.ownLo();
+    ownHi_ = part.ownHi(dims_);
     camera_ = frameCamera(scene, lo_, hi_);
     plan_ = planSlices(camera_, lo_, hi_, options_);
     if (options_.clip) {
