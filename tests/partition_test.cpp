@@ -131,6 +131,18 @@ TEST(Partition, GridPartHoldsItsPointsAndKnowsWhereItSits)
     }
 }
 
+// The largest channel difference of two images of the same size; infinite where either holds a NaN.
+double maxChannelDifference(const Image4f& a, const Image4f& b)
+{
+    double worst = 0.0;
+    for (std::size_t i = 0; i < a.pixelCount(); ++i)
+        for (int c = 0; c < 4; ++c) {
+            const double d = std::abs(double(a.pixels()[i][c]) - double(b.pixels()[i][c]));
+            worst = std::isnan(d) ? INFINITY : std::max(worst, d);
+        }
+    return worst;
+}
+
 // Renders `scene` whole and as n parts (each part on its own, background 0, composited over in the
 // tree's order, then the background added), and returns the largest channel difference.
 double sortLastDifference(const Scene& scene, const std::function<Image4f(const Scene&, int, int)>& renderPart,
@@ -147,13 +159,7 @@ double sortLastDifference(const Scene& scene, const std::function<Image4f(const 
         ordered.push_back(&images[static_cast<std::size_t>(p)]);
     Image4f composite = compositeOver(ordered);
     addBackground(composite, scene.image.background);
-    double worst = 0.0;
-    for (std::size_t i = 0; i < whole.pixelCount(); ++i)
-        for (int c = 0; c < 4; ++c) {
-            const double d = std::abs(double(composite.pixels()[i][c]) - double(whole.pixels()[i][c]));
-            worst = std::isnan(d) ? INFINITY : std::max(worst, d);
-        }
-    return worst;
+    return maxChannelDifference(composite, whole);
 }
 
 // Float tolerance of the sort-last composite against the whole image: the same samples (slice3d) or the
@@ -243,8 +249,7 @@ TEST(SortLast, PlanesAndBlendPartsWithAGhostLayerCompositeToTheWholeImage)
         scene.technique = technique;
         scene.image = ImageSpec{48, 48, {0.1, 0.2, 0.3}};
         scene.transferFunction = test::designTransferFunction();
-        scene.lighting.lights = {{glm::normalize(glm::dvec3(0.3, 0.5, 1.0)), glm::dvec3(0.8)},
-                                 {glm::normalize(glm::dvec3(-0.6, 0.2, 0.4)), glm::dvec3(0.4)}};
+        scene.lighting = test::twoLightLighting();
         scene.options = std::string(technique) == "planes" ? nlohmann::json{{"early_termination", 1.0}}
                                                            : nlohmann::json{{"slices", 90}};
         for (const Camera& camera : sortLastCameras()) {
@@ -312,13 +317,7 @@ double sortFirstDifference(const Scene& scene, const std::function<Image4f(const
                   stacked.pixels().begin() + static_cast<std::ptrdiff_t>(y0) * scene.image.width);
         y0 += r;
     }
-    double worst = 0.0;
-    for (std::size_t i = 0; i < whole.pixelCount(); ++i)
-        for (int c = 0; c < 4; ++c) {
-            const double d = std::abs(double(stacked.pixels()[i][c]) - double(whole.pixels()[i][c]));
-            worst = std::isnan(d) ? INFINITY : std::max(worst, d);
-        }
-    return worst;
+    return maxChannelDifference(stacked, whole);
 }
 
 // Bands of uneven heights (balanceRows' output after an uneven frame), down to one row.

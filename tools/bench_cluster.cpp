@@ -3,8 +3,8 @@
 // steady frame's render time (the slowest rank's), IceT's composite time (blend and collection on rank 0)
 // and their sum, with each rank count's image against one rank's. Then sort-first on 1, 2 and 4 ranks: an
 // --orbit of kSortFirstFrames frames, each frame's bands balanced by the previous frame's cost; the median
-// over frames 1.. of the slowest rank's render time and the row gather; frame 0 against 1 rank's. tools/cluster_model.py fits the
-// scaling model to the sort-last figures and projects it (docs/cluster.md).
+// over frames 1.. of the slowest rank's render time and the row gather; frame 0 against 1 rank's.
+// tools/cluster_model.py fits the scaling model to the sort-last figures and projects it (docs/cluster.md).
 #include "tools/bench.h"
 
 #include "host/io/image_io.h"
@@ -70,6 +70,17 @@ nlohmann::json runRanks(const fs::path& scene, int ranks, const fs::path& image,
     if (rc != 0 || !in)
         throw DeviceError("clvr bench --suite cluster: `" + cmd.str() + "` failed (status " + std::to_string(rc) + ")");
     return nlohmann::json::parse(in);
+}
+
+// One row of the table: render, composite (sort-first: gather) and frame ms, the speed-up over one rank's
+// frame, the image against one rank's.
+void printRow(const std::string& label, int ranks, double renderMs, double secondMs, double frameMs,
+              double oneRankFrameMs, double diff)
+{
+    std::cout << std::left << std::setw(26) << label << std::right << std::setw(6) << ranks << std::fixed
+              << std::setprecision(1) << std::setw(12) << renderMs << std::setw(14) << secondMs << std::setw(11)
+              << frameMs << std::setprecision(2) << std::setw(10) << oneRankFrameMs / frameMs << std::scientific
+              << std::setprecision(1) << std::setw(14) << diff << std::defaultfloat << '\n';
 }
 
 // Sort-first's orbit: frame 0 has equal bands, frames 1.. are balanced by the frame before (a turn of
@@ -141,11 +152,7 @@ int benchCluster(const BenchOptions& options)
                                         {"height", last["height"]},
                                         {"max_diff_vs_one_rank", diff}};
             entry["ranks"].push_back(row);
-            std::cout << std::left << std::setw(26) << name << std::right << std::setw(6) << ranks << std::fixed
-                      << std::setprecision(1) << std::setw(12) << median(render) << std::setw(14) << median(composite)
-                      << std::setw(11) << median(frame) << std::setprecision(2) << std::setw(10)
-                      << oneRankFrame / median(frame) << std::scientific << std::setprecision(1) << std::setw(14)
-                      << diff << std::defaultfloat << '\n';
+            printRow(name, ranks, median(render), median(composite), median(frame), oneRankFrame, diff);
         }
         // Sort-first: the frames after the first, each balanced by the one before; frame 0's image (the
         // scene's camera, equal bands) against one rank's.
@@ -175,11 +182,8 @@ int benchCluster(const BenchOptions& options)
                                            {"frame_ms", median(frame)},
                                            {"frames", run["frames"]},
                                            {"max_diff_vs_one_rank", diff}});
-            std::cout << std::left << std::setw(26) << (name + " (sort-first)") << std::right << std::setw(6) << ranks
-                      << std::fixed << std::setprecision(1) << std::setw(12) << median(render) << std::setw(14)
-                      << median(gather) << std::setw(11) << median(frame) << std::setprecision(2) << std::setw(10)
-                      << firstOneRankFrame / median(frame) << std::scientific << std::setprecision(1) << std::setw(14)
-                      << diff << std::defaultfloat << '\n';
+            printRow(name + " (sort-first)", ranks, median(render), median(gather), median(frame), firstOneRankFrame,
+                     diff);
         }
         report["scenes"].push_back(entry);
     }

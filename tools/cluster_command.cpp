@@ -80,6 +80,38 @@ struct Job {
     std::string distribution;
 };
 
+// Rank 0, sort-last and sort-first: the job's --stats, rank 0's own frame-0 session stats (with the mode's
+// own figures already in `stats`) plus the job's; nothing without --stats.
+void writeImageJobStats(const RenderOptions& options, const World& world, const Job& job, nlohmann::json stats,
+                        const nlohmann::json& frames, double frame0Ms)
+{
+    if (world.rank() != 0 || options.statsPath.empty())
+        return;
+    stats["scene"] = job.sceneLabel;
+    stats["distribution"] = job.distribution;
+    stats["ranks"] = world.size();
+    stats["frame_ms"] = frame0Ms;
+    stats["frames"] = frames;
+    if (options.orbit > 0)
+        stats["orbit"] = options.orbit;
+    writeFileAtomically(options.statsPath, stats.dump(2) + "\n");
+}
+
+// Rank 0, sort-last and sort-first: the one line a finished job prints.
+void printImageJobDone(const RenderOptions& options, const World& world, const Job& job, double frame0Ms)
+{
+    if (world.rank() != 0)
+        return;
+    std::ostringstream line;
+    line << "wrote " << options.output;
+    if (options.orbit > 0)
+        line << ": " << job.outputs.size() << " frames";
+    line << " (" << job.scene.image.width << "x" << job.scene.image.height << ", " << job.scene.technique << ", "
+         << job.distribution << " on " << world.size() << " ranks, " << std::fixed << std::setprecision(1) << frame0Ms
+         << " ms/frame)";
+    std::cout << line.str() << std::endl;
+}
+
 // Frames: each rank renders and writes the orbit frames k with k mod size == rank.
 int renderFrames(const RenderOptions& options, World& world, Job& job)
 {
@@ -198,32 +230,14 @@ int renderSortLast(const RenderOptions& options, World& world, Job& job)
         });
     }
     world.agree([&] {
-        if (world.rank() != 0 || options.statsPath.empty())
-            return;
-        nlohmann::json stats = frame0Stats;  // rank 0's own part, plus the job's figures
-        stats["scene"] = job.sceneLabel;
-        stats["distribution"] = "sort-last";
-        stats["ranks"] = world.size();
+        nlohmann::json stats = frame0Stats;  // rank 0's own part
         stats["rank0_part"] = partText;
         stats["setup_ms"] = setupMs;
-        stats["frame_ms"] = frame0Ms;
         stats["composite_ms"] = composite0Ms;
-        stats["frames"] = frames;
-        if (options.orbit > 0)
-            stats["orbit"] = options.orbit;
-        writeFileAtomically(options.statsPath, stats.dump(2) + "\n");
+        writeImageJobStats(options, world, job, stats, frames, frame0Ms);
     });
     written.keep();
-    if (world.rank() == 0) {
-        std::ostringstream line;
-        line << "wrote " << options.output;
-        if (options.orbit > 0)
-            line << ": " << count << " frames";
-        line << " (" << job.scene.image.width << "x" << job.scene.image.height << ", " << job.scene.technique
-             << ", sort-last on " << world.size() << " ranks, " << std::fixed << std::setprecision(1) << frame0Ms
-             << " ms/frame)";
-        std::cout << line.str() << std::endl;
-    }
+    printImageJobDone(options, world, job, frame0Ms);
     return 0;
 }
 
@@ -294,9 +308,7 @@ int renderSortFirst(const RenderOptions& options, World& world, Job& job)
             const std::string& path = job.outputs[static_cast<std::size_t>(k)];
             writeImage(path, image);
             written.add(path);
-            double renderMs = 0.0;
-            for (double t : lastMs)
-                renderMs = std::max(renderMs, t);
+            const double renderMs = *std::max_element(lastMs.begin(), lastMs.end());  // the slowest band
             frames.push_back({{"index", k}, {"output", path}, {"render_ms", renderMs}, {"gather_ms", gatherMs},
                               {"frame_ms", renderMs + gatherMs}, {"render_ms_per_rank", lastMs}, {"rows_per_rank", rows}});
             if (k == 0) {
@@ -307,26 +319,13 @@ int renderSortFirst(const RenderOptions& options, World& world, Job& job)
         });
     }
     world.agree([&] {
-        if (world.rank() != 0 || options.statsPath.empty())
-            return;
-        nlohmann::json stats = frame0Stats;  // rank 0's band, plus the job's figures
-        stats["scene"] = job.sceneLabel;
-        stats["distribution"] = "sort-first";
-        stats["ranks"] = world.size();
+        nlohmann::json stats = frame0Stats;  // rank 0's band
         stats["width"] = width;
         stats["height"] = height;
-        stats["frame_ms"] = frame0Ms;
-        stats["frames"] = frames;
-        if (options.orbit > 0)
-            stats["orbit"] = options.orbit;
-        writeFileAtomically(options.statsPath, stats.dump(2) + "\n");
+        writeImageJobStats(options, world, job, stats, frames, frame0Ms);
     });
     written.keep();
-    if (world.rank() == 0)
-        std::cout << "wrote " << options.output << (options.orbit > 0 ? ": " + std::to_string(count) + " frames" : "")
-                  << " (" << width << "x" << height << ", " << job.scene.technique << ", sort-first on "
-                  << world.size() << " ranks, " << std::fixed << std::setprecision(1) << frame0Ms << " ms/frame)"
-                  << std::endl;
+    printImageJobDone(options, world, job, frame0Ms);
     return 0;
 }
 

@@ -45,7 +45,7 @@ Ray Camera::ray(double px, double py, int width, int height) const
 
 PixelRays::PixelRays(const Camera& camera, int width, int height)
     : position_(camera.position), forward_(camera.forward()), right_(camera.right()), up_(camera.up()),
-      width_(width), height_(camera.fullHeight(height)), aspect_(static_cast<double>(width) / camera.fullHeight(height)),
+      width_(width), height_(camera.fullHeight(height)), aspect_(width / height_),
       scale_(camera.parallel ? camera.parallelScale : std::tan(glm::radians(camera.viewAngle) * 0.5)),
       y0_(camera.bandY0), parallel_(camera.parallel)
 {

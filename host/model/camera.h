@@ -43,8 +43,7 @@ struct Camera {
     glm::dmat4 viewMatrix() const;
     glm::dmat4 projectionMatrix(int width, int height, double near, double far) const;
 
-    // The full image's height for a band (or `height` itself), and the image plane's vertical extent of
-    // the band as fractions of the full one: rows [y0, y0 + height) -> [top, bottom] in [-1, 1] NDC.
+    // The full image's height for a band, else `height` itself.
     int fullHeight(int height) const { return bandFullHeight > 0 ? bandFullHeight : height; }
 };
 

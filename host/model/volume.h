@@ -43,6 +43,8 @@ struct Volume {
     std::vector<float> values;  // data units, as stored (int16 CT numbers stay CT numbers)
     std::string source;         // file or generator it came from, for messages
     std::optional<GridPart> part;  // set only on a part of a larger grid (sort-last); see GridPart
+    // `part`, or for a whole volume the GridPart that makes it the only part of itself (offset 0).
+    GridPart gridPart() const { return part ? *part : GridPart{glm::ivec3(0), dims, origin}; }
 
     std::size_t voxelCount() const { return static_cast<std::size_t>(dims.x) * dims.y * dims.z; }
     glm::dvec3 boundsMin() const { return origin; }

@@ -4,6 +4,7 @@
 // share (one name, one meaning, one check, one line of help), and a host vector as a cl_float4.
 #pragma once
 
+#include "host/model/volume.h"
 #include "host/runtime/errors.h"
 #include "host/render/renderer.h"
 
@@ -130,6 +131,18 @@ inline OptionInfo clipTextureInfo()
 inline cl_float4 toCl4(const glm::dvec3& v, double w = 0.0)
 {
     return {{static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z), static_cast<float>(w)}};
+}
+
+// The sort-last fields every grid kernel's parameters carry (part_offset, own_lo, own_hi: the part's point
+// 0 in the full grid and the full grid coordinates it samples; kernels/volume_sampling.h clvr_grid_owned)
+// for `part` of a volume of `dims` points.
+template <class Params>
+void setGridPartParams(Params& params, const GridPart& part, const glm::ivec3& dims)
+{
+    const glm::vec3 lo = part.ownLo(), hi = part.ownHi(dims);
+    params.part_offset = cl_int4{{part.offset.x, part.offset.y, part.offset.z, 0}};
+    params.own_lo = cl_float4{{lo.x, lo.y, lo.z, 0.0f}};
+    params.own_hi = cl_float4{{hi.x, hi.y, hi.z, 0.0f}};
 }
 
 }  // namespace clvr

@@ -31,9 +31,8 @@ private:
     Camera camera_;
     ImageSpec image_;
     glm::ivec3 dims_;
-    glm::dvec3 origin_, spacing_;             // the full grid's origin (a part's point 0 is inside it)
-    glm::ivec3 partOffset_{0};                // sort-last part: its point 0 in the full grid
-    glm::vec3 ownLo_{0.0f}, ownHi_{0.0f};     // the full grid coordinates this volume samples
+    glm::dvec3 origin_, spacing_;  // the full grid's origin (a part's point 0 is inside it)
+    GridPart part_;                // where the volume sits in the full grid (sort-last; else the whole)
     Lighting lighting_;
     SlicePlan plan_;
     TransferFunctionUpload tf_;
@@ -50,13 +49,9 @@ BlendRenderer::BlendRenderer(Device& device, const Scene& scene, const Volume& v
     spacing_ = volume.spacing;
     // A part of a larger grid (sort-last) takes the full grid's slices and keeps the samples it owns;
     // its ghost layer gives the Sobel gradients at its own points their neighbours (planes.cpp).
-    const GridPart whole{glm::ivec3(0), volume.dims, volume.origin};
-    const GridPart& part = volume.part ? *volume.part : whole;
-    origin_ = part.fullOrigin;
-    partOffset_ = part.offset;
-    ownLo_ = part.ownLo();
-    ownHi_ = part.ownHi(dims_);
-    const glm::dvec3 lo = part.fullBoundsMin(), hi = part.fullBoundsMax(spacing_);
+    part_ = volume.gridPart();
+    origin_ = part_.fullOrigin;
+    const glm::dvec3 lo = part_.fullBoundsMin(), hi = part_.fullBoundsMax(spacing_);
     camera_ = frameCamera(scene, lo, hi);
     // the same slab planning as slice3d
     plan_ = planSlices(camera_, lo, hi, options_.slices, options_.sliceSpacing);
@@ -86,10 +81,8 @@ Image4f BlendRenderer::render(FrameStats& stats)
     ClBlendParams params{};
     params.camera = toClCamera(camera_, image_.width, image_.height);
     params.dims = cl_int4{{dims_.x, dims_.y, dims_.z, 0}};
-    params.part_offset = cl_int4{{partOffset_.x, partOffset_.y, partOffset_.z, 0}};
+    setGridPartParams(params, part_, dims_);
     params.grid_origin = toCl4(origin_);
-    params.own_lo = cl_float4{{ownLo_.x, ownLo_.y, ownLo_.z, 0.0f}};
-    params.own_hi = cl_float4{{ownHi_.x, ownHi_.y, ownHi_.z, 0.0f}};
     params.inv_spacing = toCl4(1.0 / spacing_);
     params.to_eye = toCl4(-camera_.forward());
     params.background = toCl4(image_.background);

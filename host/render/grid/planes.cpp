@@ -35,9 +35,8 @@ private:
     ImageSpec image_;
     glm::ivec3 dims_;
     glm::dvec3 origin_, spacing_, lo_, hi_;  // the full grid's origin and box (a part's are inside them)
-    glm::ivec3 partOffset_{0}, fullDims_{0};  // sort-last part: its point 0 in the full grid, the full dims
-    glm::vec3 ownLo_{0.0f}, ownHi_{0.0f};     // the full grid coordinates this volume samples
-    bool part_ = false;
+    GridPart part_;        // where the volume sits in the full grid (sort-last; else the whole)
+    bool isPart_ = false;  // a part of a larger grid: no early ray termination
     Lighting lighting_;
     glm::dvec3 toEye_;
     TransferFunctionUpload tf_;
@@ -58,16 +57,11 @@ PlanesRenderer::PlanesRenderer(Device& device, const Scene& scene, const Volume&
     // A part of a larger grid (sort-last) casts the full grid's rays with the full grid's samples and
     // keeps the ones it owns; its ghost layer (TechniqueInfo::sortLastGhost) gives the Sobel gradients
     // at its own points their neighbours, so every owned sample is the whole volume's, bit for bit.
-    const GridPart whole{glm::ivec3(0), volume.dims, volume.origin};
-    const GridPart& part = volume.part ? *volume.part : whole;
-    part_ = volume.part.has_value();
-    origin_ = part.fullOrigin;
-    lo_ = part.fullBoundsMin();
-    hi_ = part.fullBoundsMax(spacing_);
-    partOffset_ = part.offset;
-    fullDims_ = part.fullDims;
-    ownLo_ = part.ownLo();
-    ownHi_ = part.ownHi(dims_);
+    part_ = volume.gridPart();
+    isPart_ = volume.part.has_value();
+    origin_ = part_.fullOrigin;
+    lo_ = part_.fullBoundsMin();
+    hi_ = part_.fullBoundsMax(spacing_);
     camera_ = frameCamera(scene, lo_, hi_);
     if (options_.sampleSpacing == 0.0)
         options_.sampleSpacing = 0.5 * std::min({spacing_.x, spacing_.y, spacing_.z});
@@ -111,14 +105,12 @@ Image4f PlanesRenderer::render(FrameStats& stats)
     ClPlanesParams params{};
     params.camera = toClCamera(camera_, image_.width, image_.height);
     params.dims = cl_int4{{dims_.x, dims_.y, dims_.z, 0}};
-    params.part_offset = cl_int4{{partOffset_.x, partOffset_.y, partOffset_.z, 0}};
-    params.full_dims = cl_int4{{fullDims_.x, fullDims_.y, fullDims_.z, 0}};
+    setGridPartParams(params, part_, dims_);
+    params.full_dims = cl_int4{{part_.fullDims.x, part_.fullDims.y, part_.fullDims.z, 0}};
     params.grid_origin = toCl4(origin_);
     params.inv_spacing = toCl4(1.0 / spacing_);
     params.box_lo = toCl4(lo_);
     params.box_hi = toCl4(hi_);
-    params.own_lo = cl_float4{{ownLo_.x, ownLo_.y, ownLo_.z, 0.0f}};
-    params.own_hi = cl_float4{{ownHi_.x, ownHi_.y, ownHi_.z, 0.0f}};
     params.to_eye = toCl4(toEye_);
     params.background = toCl4(image_.background);
     params.width = image_.width;
@@ -128,7 +120,7 @@ Image4f PlanesRenderer::render(FrameStats& stats)
     params.shade_on = lighting_.shaded() ? 1 : 0;
     params.step = static_cast<cl_float>(options_.sampleSpacing);
     // A part cannot see the opacity in front of it: it never stops early (docs/cluster.md).
-    params.ert_alpha = part_ ? 2.0f : static_cast<cl_float>(options_.earlyTermination);
+    params.ert_alpha = isPart_ ? 2.0f : static_cast<cl_float>(options_.earlyTermination);
     params.threshold = static_cast<cl_float>(options_.opacityThreshold);
     int a = 0;
     kernel_.setArg(a++, out_);
@@ -151,7 +143,7 @@ Image4f PlanesRenderer::render(FrameStats& stats)
     stats.extra["samples_below_threshold"] = below;
     stats.extra["rays_terminated"] = std::accumulate(stopped.begin(), stopped.end(), std::uint64_t(0));
     stats.extra["sample_spacing"] = options_.sampleSpacing;
-    stats.extra["early_termination"] = part_ ? 1.0 : options_.earlyTermination;
+    stats.extra["early_termination"] = isPart_ ? 1.0 : options_.earlyTermination;
     stats.extra["opacity_threshold"] = options_.opacityThreshold;
     stats.extra["reflectance_map_size"] = options_.reflectanceMapSize;
     stats.extra["shaded"] = lighting_.shaded();

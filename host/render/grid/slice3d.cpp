@@ -46,8 +46,7 @@ private:
     ImageSpec image_;
     glm::ivec3 dims_;
     glm::dvec3 origin_, spacing_, lo_, hi_;  // the full grid's origin and box (a part's are inside them)
-    glm::ivec3 partOffset_{0};               // the volume's point 0 in the full grid (sort-last part)
-    glm::vec3 ownLo_{0.0f}, ownHi_{0.0f};    // full-grid coordinates the volume samples (ClSlice3dParams)
+    GridPart part_;                          // where the volume sits in the full grid (sort-last; else the whole)
     TransferFunctionUpload tf_;
     SlicePlan plan_;
     cl::Buffer volume_;
@@ -86,17 +85,13 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
     spacing_ = volume.spacing;
     // A part of a larger grid (sort-last) takes the full grid's slices and sample positions and keeps
     // the samples it owns (host/model/volume.h's GridPart): the parts' images composite to the full one.
-    const GridPart whole{glm::ivec3(0), volume.dims, volume.origin};
-    const GridPart& part = volume.part ? *volume.part : whole;
+    part_ = volume.gridPart();
     if (volume.part && options_.path != Slice3dOptions::Path::Fused)
         throw InputError("slice3d: the raster path (options.path \"raster\", clip meshes) does not render a part "
                          "of a volume; use --distribution sort-first or frames");
-    origin_ = part.fullOrigin;
-    lo_ = part.fullBoundsMin();
-    hi_ = part.fullBoundsMax(spacing_);
-    partOffset_ = part.offset;
-    ownLo_ = part.ownLo();
-    ownHi_ = part.ownHi(dims_);
+    origin_ = part_.fullOrigin;
+    lo_ = part_.fullBoundsMin();
+    hi_ = part_.fullBoundsMax(spacing_);
     camera_ = frameCamera(scene, lo_, hi_);
     plan_ = planSlices(camera_, lo_, hi_, options_);
     if (options_.clip) {
@@ -265,9 +260,7 @@ Image4f Slice3dRenderer::renderFused(FrameStats& stats)
     params.slice_count = plan_.count;
     params.front_to_back = frontToBack ? 1 : 0;
     params.ert_alpha = ert;
-    params.part_offset = cl_int4{{partOffset_.x, partOffset_.y, partOffset_.z, 0}};
-    params.own_lo = cl_float4{{ownLo_.x, ownLo_.y, ownLo_.z, 0.0f}};
-    params.own_hi = cl_float4{{ownHi_.x, ownHi_.y, ownHi_.z, 0.0f}};
+    setGridPartParams(params, part_, dims_);
     int a = 0;
     fused_.setArg(a++, out_);
     fused_.setArg(a++, samples_);
