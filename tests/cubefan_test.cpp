@@ -1,6 +1,7 @@
 // tests/cubefan_test.cpp — seeds/002's tables and classification (host/render/grid/cube_fans.h),
 // checked against brute-force constructions from the cube's own geometry.
 #include "host/render/grid/cube_fans.h"
+#include "host/render/grid/cube_octree.h"
 
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
@@ -317,6 +318,123 @@ TEST(CubefanTemplates, CoverTheProjectedBoxOnceWithTheChordAsThickness)
     // 0.053, 2.8% of the largest chord; it falls with the box's depth over its distance).
     EXPECT_LT(worstChord[1], 2e-3 * largestChord);
     EXPECT_LT(worstChord[2], 0.05 * largestChord);
+}
+
+// ---- the octree (§6) -------------------------------------------------------------------------------------
+
+Volume randomVolume(glm::ivec3 dims, std::uint64_t seed)
+{
+    Volume v;
+    v.dims = dims;
+    v.spacing = {0.5, 0.7, 0.6};
+    v.origin = {-1.0, 0.2, 0.4};
+    test::Rng rng(seed);
+    for (int i = 0; i < dims.x * dims.y * dims.z; ++i)
+        v.values.push_back(static_cast<float>(rng.uniform()));
+    return v;
+}
+
+// Every cube of every level against the voxels inside its box, by brute force.
+TEST(CubefanOctree, ValuesAreLeafMeansAndErrorsTheLargestLeafDeviation)
+{
+    const Volume v = randomVolume({7, 5, 6}, 11);
+    const CubeOctree tree(v);
+    ASSERT_EQ(tree.levels(), 4);  // 7 -> 4 -> 2 -> 1
+    EXPECT_EQ(tree.dims(3), glm::ivec3(1));
+    for (int level = 0; level < tree.levels(); ++level) {
+        glm::ivec3 i;
+        for (i.z = 0; i.z < tree.dims(level).z; ++i.z)
+            for (i.y = 0; i.y < tree.dims(level).y; ++i.y)
+                for (i.x = 0; i.x < tree.dims(level).x; ++i.x) {
+                    glm::dvec3 lo, hi;
+                    tree.box(level, i, lo, hi);
+                    std::vector<double> inside;
+                    for (int z = 0; z < v.dims.z; ++z)
+                        for (int y = 0; y < v.dims.y; ++y)
+                            for (int x = 0; x < v.dims.x; ++x) {
+                                const glm::dvec3 p = v.origin + glm::dvec3(x, y, z) * v.spacing;
+                                if (glm::all(glm::greaterThan(p, lo)) && glm::all(glm::lessThan(p, hi)))
+                                    inside.push_back(v.at(x, y, z));
+                            }
+                    ASSERT_FALSE(inside.empty());
+                    double mean = 0.0;
+                    for (double x : inside)
+                        mean += x / inside.size();
+                    double err = 0.0;
+                    for (double x : inside)
+                        err = std::max(err, std::abs(x - tree.value(level, i)));
+                    EXPECT_NEAR(tree.value(level, i), mean, 1e-6) << level;
+                    EXPECT_NEAR(tree.error(level, i), err, 1e-6) << level;
+                }
+    }
+}
+
+// Two boxes that share a face with positive area: +1 when the eye (or, parallel, the viewer) is on b's
+// side of the shared plane (a must come first), -1 on a's side, 0 when they do not share a face.
+int frontOf(const Cube& a, const Cube& b, const glm::dvec3& eye, const glm::dvec3& forward, bool parallel)
+{
+    for (int axis = 0; axis < 3; ++axis)
+        for (const int sign : {-1, 1}) {
+            const double plane = sign > 0 ? a.hi[axis] : a.lo[axis];
+            const double other = sign > 0 ? b.lo[axis] : b.hi[axis];
+            if (std::abs(plane - other) > 1e-9)
+                continue;
+            bool overlap = true;
+            for (int q = 0; q < 3; ++q)
+                if (q != axis && !(std::min(a.hi[q], b.hi[q]) - std::max(a.lo[q], b.lo[q]) > 1e-9))
+                    overlap = false;
+            if (!overlap)
+                continue;
+            const double towardsB = parallel ? -sign * forward[axis] : sign * (eye[axis] - plane);
+            return towardsB > 0.0 ? 1 : (towardsB < 0.0 ? -1 : 0);
+        }
+    return 0;
+}
+
+// Tolerance 0 selects every voxel the transfer function does not make transparent; larger tolerances
+// select cubes within it; in every case disjoint cubes, and of every two that share a face, the one
+// behind (from the eye outside or inside the volume, or along a parallel view) comes first.
+TEST(CubefanOctree, SelectionIsWithinToleranceAndBackToFront)
+{
+    const Volume v = randomVolume({9, 6, 7}, 5);
+    const CubeOctree tree(v);
+    const TransferFunction tf({{0.0, glm::dvec3(0.0), 0.0}, {0.3, glm::dvec3(0.0), 0.0}, {0.5, glm::dvec3(1.0), 2.0},
+                               {1.0, glm::dvec3(1.0), 3.0}});
+    const glm::dvec3 inside = v.origin + glm::dvec3(4.2, 2.3, 3.1) * v.spacing;
+    const struct { glm::dvec3 eye; bool parallel; } views[] = {
+        {{6.0, -3.0, 9.0}, false}, {inside, false}, {{0.0, 0.0, 0.0}, true}};
+    const glm::dvec3 forward = glm::normalize(glm::dvec3(0.3, 0.8, -0.5));
+    std::uint64_t opaqueVoxels = 0;
+    for (float x : v.values)
+        opaqueVoxels += tf(x).a > 0.0;
+    for (const double tolerance : {0.0, 0.3, 0.6})
+        for (const auto& view : views) {
+            SelectionStats stats;
+            const std::vector<Cube> cubes = tree.select(tolerance, tf, view.eye, forward, view.parallel, &stats);
+            EXPECT_EQ(stats.selected, cubes.size());
+            if (tolerance == 0.0) {
+                EXPECT_EQ(cubes.size(), opaqueVoxels);
+            }
+            int shared = 0;
+            for (std::size_t i = 0; i < cubes.size(); ++i) {
+                EXPECT_LE(tree.error(cubes[i].level, cubes[i].index), tolerance * tree.dataRange() + 1e-6);
+                EXPECT_GT(tf(cubes[i].value).a, 0.0);
+                for (std::size_t j = i + 1; j < cubes.size(); ++j) {
+                    bool disjoint = false;
+                    for (int q = 0; q < 3; ++q)
+                        disjoint |= std::min(cubes[i].hi[q], cubes[j].hi[q]) - std::max(cubes[i].lo[q], cubes[j].lo[q]) <= 1e-9;
+                    EXPECT_TRUE(disjoint);
+                    const int order = frontOf(cubes[i], cubes[j], view.eye, forward, view.parallel);
+                    shared += order != 0;
+                    EXPECT_GE(order, 0) << "cube " << j << " is behind cube " << i << " but comes later";
+                }
+            }
+            if (cubes.size() > 4)  // enough cubes that some share faces
+                EXPECT_GT(shared, 0) << cubes.size() << " cubes at tolerance " << tolerance;
+            std::printf("tolerance %.1f: %zu cubes, %d face pairs\n", tolerance, cubes.size(), shared);
+        }
+    // Tolerance 1 takes the root unless it is transparent.
+    EXPECT_EQ(tree.select(1.0, tf, views[0].eye, forward, false).size(), tf(tree.value(tree.levels() - 1, glm::ivec3(0))).a > 0.0 ? 1u : 0u);
 }
 
 }  // namespace

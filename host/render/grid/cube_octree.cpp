@@ -1,0 +1,145 @@
+// host/render/grid/cube_octree.cpp — the octree of seeds/002 §6: built bottom up, selected depth first,
+// back to front.
+#include "host/render/grid/cube_octree.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace clvr::cubefan {
+
+namespace {
+
+// Voxels of level-k cube i along an axis of n voxels.
+int leavesAlong(int i, int k, int n)
+{
+    const long long first = static_cast<long long>(i) << k;
+    return static_cast<int>(std::min<long long>((static_cast<long long>(i) + 1) << k, n) - first);
+}
+
+}  // namespace
+
+double maxExtinction(const TransferFunction& tf, double a, double b)
+{
+    double m = std::max(tf(a).a, tf(b).a);
+    for (const ControlPoint& p : tf.points())
+        if (p.s > a && p.s < b)
+            m = std::max(m, p.tau);
+    return m;
+}
+
+CubeOctree::CubeOctree(const Volume& volume)
+    : voxels_(volume.dims), origin_(volume.origin), spacing_(volume.spacing)
+{
+    Level leaves;
+    leaves.dims = volume.dims;
+    leaves.mean = volume.values;
+    leaves.min = volume.values;
+    leaves.max = volume.values;
+    const glm::dvec2 r = volume.range();
+    range_ = r.y - r.x;
+    levels_.push_back(std::move(leaves));
+    while (glm::any(glm::greaterThan(levels_.back().dims, glm::ivec3(1)))) {
+        const int k = static_cast<int>(levels_.size()) - 1;  // the finer level
+        const Level& fine = levels_.back();
+        Level coarse;
+        coarse.dims = (fine.dims + 1) / 2;
+        const std::size_t count = static_cast<std::size_t>(coarse.dims.x) * coarse.dims.y * coarse.dims.z;
+        coarse.mean.resize(count);
+        coarse.min.resize(count);
+        coarse.max.resize(count);
+        glm::ivec3 c;
+        for (c.z = 0; c.z < coarse.dims.z; ++c.z)
+            for (c.y = 0; c.y < coarse.dims.y; ++c.y)
+                for (c.x = 0; c.x < coarse.dims.x; ++c.x) {
+                    double sum = 0.0, leavesBelow = 0.0;
+                    float lo = INFINITY, hi = -INFINITY;
+                    for (int m = 0; m < 8; ++m) {
+                        const glm::ivec3 f = 2 * c + glm::ivec3(m & 1, (m >> 1) & 1, (m >> 2) & 1);
+                        if (glm::any(glm::greaterThanEqual(f, fine.dims)))
+                            continue;
+                        const std::size_t j = (static_cast<std::size_t>(f.z) * fine.dims.y + f.y) * fine.dims.x + f.x;
+                        const double n = static_cast<double>(leavesAlong(f.x, k, voxels_.x)) *
+                                         leavesAlong(f.y, k, voxels_.y) * leavesAlong(f.z, k, voxels_.z);
+                        sum += n * fine.mean[j];
+                        leavesBelow += n;
+                        lo = std::min(lo, fine.min[j]);
+                        hi = std::max(hi, fine.max[j]);
+                    }
+                    const std::size_t i = (static_cast<std::size_t>(c.z) * coarse.dims.y + c.y) * coarse.dims.x + c.x;
+                    coarse.mean[i] = static_cast<float>(sum / leavesBelow);
+                    coarse.min[i] = lo;
+                    coarse.max[i] = hi;
+                }
+        levels_.push_back(std::move(coarse));
+    }
+}
+
+float CubeOctree::error(int level, const glm::ivec3& i) const
+{
+    const Level& l = levels_[level];
+    const std::size_t j = at(level, i);
+    return std::max(l.max[j] - l.mean[j], l.mean[j] - l.min[j]);
+}
+
+void CubeOctree::box(int level, const glm::ivec3& i, glm::dvec3& lo, glm::dvec3& hi) const
+{
+    for (int a = 0; a < 3; ++a) {
+        const double first = static_cast<double>(static_cast<long long>(i[a]) << level);
+        lo[a] = origin_[a] + (first - 0.5) * spacing_[a];
+        hi[a] = origin_[a] + (first + leavesAlong(i[a], level, voxels_[a]) - 0.5) * spacing_[a];
+    }
+}
+
+std::vector<Cube> CubeOctree::select(double tolerance, const TransferFunction& tf, const glm::dvec3& eye,
+                                     const glm::dvec3& forward, bool parallel, SelectionStats* stats) const
+{
+    std::vector<Cube> out;
+    SelectionStats s;
+    const double allowed = tolerance * range_;
+    // Recursion depth is the level count (at most 32 for any int dims), so plain recursion is bounded.
+    auto visit = [&](auto&& self, int level, const glm::ivec3& i) -> void {
+        ++s.visited;
+        const Level& l = levels_[level];
+        const std::size_t j = at(level, i);
+        if (maxExtinction(tf, l.min[j], l.max[j]) <= 0.0) {
+            ++s.transparent;
+            return;
+        }
+        if (level == 0 || error(level, i) <= allowed) {
+            if (tf(l.mean[j]).a <= 0.0) {
+                ++s.transparent;
+                return;
+            }
+            Cube c;
+            c.level = level;
+            c.index = i;
+            c.value = l.mean[j];
+            box(level, i, c.lo, c.hi);
+            s.largestDiagonal = std::max(s.largestDiagonal, glm::length(c.hi - c.lo));
+            out.push_back(c);
+            return;
+        }
+        // The children's split planes; bit a of `near` set when the eye is on the high side of axis a's.
+        glm::dvec3 lo, hi;
+        box(level - 1, 2 * i, lo, hi);
+        int nearSide = 0;
+        for (int a = 0; a < 3; ++a) {
+            const bool high = parallel ? forward[a] < 0.0 : eye[a] > hi[a];
+            nearSide |= high ? (1 << a) : 0;
+        }
+        const glm::ivec3 childDims = levels_[level - 1].dims;
+        for (int m = 7; m >= 0; --m) {  // farthest first: the child on the far side of every plane
+            const int child = nearSide ^ m;
+            const glm::ivec3 ci = 2 * i + glm::ivec3(child & 1, (child >> 1) & 1, (child >> 2) & 1);
+            if (glm::all(glm::lessThan(ci, childDims)))
+                self(self, level - 1, ci);
+        }
+    };
+    visit(visit, levels() - 1, glm::ivec3(0));
+    s.selected = out.size();
+    if (stats)
+        *stats = s;
+    return out;
+}
+
+}  // namespace clvr::cubefan
