@@ -555,26 +555,26 @@ TEST(ProjtetNonConvex, ThreeSticksCycleIsBrokenAndCounted)
     EXPECT_LE(wrong, inPair[pair]);
 }
 
-// The shipped TetGen torus (data/scenes/torus.json) at 64², the scene camera and one through the hole
-// (near tube, gap, far tube; tests/harc_test.cpp's), perspective and parallel: mpvonc-boundary within
-// harc's tolerance of the exact reference; the adjacency-only order's error printed beside.
-TEST(ProjtetMeshes, TetgenTorusMatchesExactReference)
+// The shipped TetGen scenes (data/scenes/torus.json, l-block.json) at 64², the scene camera and one
+// along which rays leave the mesh and enter it again (tests/harc_test.cpp's: the torus nearly edge-on
+// through its hole, the L across its notch), perspective and parallel: mpvonc-boundary within harc's
+// tolerance of the exact reference; the adjacency-only order's error printed beside.
+void checkShippedScene(const char* name, const Camera& through)
 {
-    Scene scene = loadScene(test::repoData("scenes/torus.json"));
+    Scene scene = loadScene(test::repoData(std::string("scenes/") + name));
     scene.technique = "projtet";
     scene.image.width = scene.image.height = 64;
     const TetMesh mesh = loadMesh(*scene.mesh);
     const TetTopology topology = buildTopology(mesh);
-    Camera through = perspective({0.3, -2.6, 0.35}, {0.0, 0.0, 0.0}, 40.0);
     Camera parallel = through;
     parallel.parallel = true;
     parallel.parallelScale = 0.5 * glm::length(mesh.boundsMax() - mesh.boundsMin());
     const std::pair<const char*, Camera> cameras[] = {
-        {"scene camera", *scene.camera}, {"through the hole", through}, {"through the hole, parallel", parallel}};
+        {"scene camera", *scene.camera}, {"through the gap", through}, {"through the gap, parallel", parallel}};
     for (const auto& [label, camera] : cameras) {
         scene.camera = camera;
         const Image4d expected = tetReferenceIntegral(mesh, scene.transferFunction, camera, scene.image);
-        const std::string what = std::string("torus, ") + label;
+        const std::string what = std::string(name) + ", " + label;
         scene.options = json::object();
         FrameStats stats;
         const Image4f image = makeProjtetRenderer(test::device(), scene, mesh, topology)->render(stats);
@@ -589,6 +589,57 @@ TEST(ProjtetMeshes, TetgenTorusMatchesExactReference)
                     stats.extra["boundary_ms"].get<double>(), stats.extra["sort_ms"].get<double>());
         EXPECT_TRUE(test::imagesNear(image, expected, {.maxAbs = 2e-3, .meanAbs = 2e-4})) << what;
         EXPECT_EQ(stats.extra["order_cycles_broken"].get<std::uint64_t>(), 0u) << what;
+    }
+}
+
+TEST(ProjtetMeshes, TetgenTorusMatchesExactReference)
+{
+    checkShippedScene("torus.json", perspective({0.3, -2.6, 0.35}, {0.0, 0.0, 0.0}, 40.0));
+}
+
+TEST(ProjtetMeshes, TetgenLBlockMatchesExactReference)
+{
+    checkShippedScene("l-block.json", perspective({-2.2, 2.6, -0.2}, {0.25, 0.15, -0.5}, 40.0));
+}
+
+// The oxygen post (shared/data/post, a box of cells around a cylindrical post: non-convex where the rays
+// pass the post) at 64², harc's mesh-test cameras and transfer function (tests/harc_test.cpp).
+TEST(ProjtetMeshes, PostMatchesExactReference)
+{
+    const json spec = {{"file", test::sharedData("post/post.vtk")}};
+    const TetMesh mesh = loadMesh(spec, "/");
+    const glm::dvec2 range = mesh.scalarRange();
+    auto at = [&](double f) { return range.x + f * (range.y - range.x); };
+    const double size = glm::length(mesh.boundsMax() - mesh.boundsMin());
+    const TransferFunction tf({{at(0.0), {0.1, 0.1, 0.5}, 0.0},
+                               {at(0.3), {0.2, 0.6, 1.0}, 1.0 / size},
+                               {at(0.6), {0.9, 0.9, 0.2}, 3.0 / size},
+                               {at(1.0), {1.0, 0.3, 0.1}, 8.0 / size}});
+    const glm::dvec3 lo = mesh.boundsMin(), hi = mesh.boundsMax(), center = 0.5 * (lo + hi);
+    const double radius = 0.5 * glm::length(hi - lo);
+    const TetTopology topology = buildTopology(mesh);
+    for (const bool parallel : {false, true}) {
+        Camera camera;
+        camera.focalPoint = center;
+        camera.position = center + radius * glm::dvec3(1.3, 0.9, 2.2);
+        camera.viewUp = {0.0, 1.0, 0.0};
+        camera.viewAngle = 34.0;
+        if (parallel) {
+            camera.parallel = true;
+            camera.parallelScale = 0.8 * radius;
+        }
+        const Scene scene = makeScene(camera, tf, 64);
+        const Image4d expected = tetReferenceIntegral(mesh, tf, camera, scene.image);
+        FrameStats stats;
+        const Image4f image = makeProjtetRenderer(test::device(), scene, mesh, topology)->render(stats);
+        const std::string what = std::string("post") + (parallel ? ", parallel" : ", perspective");
+        printError(what + ", mpvonc-boundary", image, expected);
+        const Image4f adjacency =
+            makeProjtetRenderer(test::device(), makeScene(camera, tf, 64, json{{"order", "mpvonc"}}), mesh, topology)
+                ->render(stats);
+        printError(what + ", mpvonc", adjacency, expected);
+        EXPECT_TRUE(test::imagesNear(image, expected, {.maxAbs = 2e-3, .meanAbs = 2e-4})) << what;
+        std::printf("%s: %zu tets\n", what.c_str(), mesh.tets.size());
     }
 }
 
