@@ -65,7 +65,8 @@ VisibilitySorter::VisibilitySorter(const TetMesh& mesh, const TetTopology& topol
     }
 }
 
-VisibilitySorter::Result VisibilitySorter::sort(const Camera& camera, ProjtetOptions::Order order) const
+VisibilitySorter::Result VisibilitySorter::sort(const Camera& camera, ProjtetOptions::Order order, int width,
+                                                int height) const
 {
     const std::size_t cells = centres_.size();
     const glm::dvec3 eye = camera.position, forward = camera.forward();
@@ -107,7 +108,7 @@ VisibilitySorter::Result VisibilitySorter::sort(const Camera& camera, ProjtetOpt
     // The boundary relations as lists per back cell (CSR), each one more cell behind its front cell.
     std::vector<std::uint32_t> extraStart, extraFront;
     if (order == ProjtetOptions::Order::MpvoncBoundary) {
-        const std::vector<Behind> extra = boundaryOrder(camera, result.boundary);
+        const std::vector<Behind> extra = boundaryOrder(camera, result.boundary, width, height);
         extraStart.assign(cells + 1, 0);
         for (const Behind& r : extra)
             ++extraStart[r.back + 1];
@@ -226,7 +227,8 @@ double depthAt(const ScreenFace& f, const glm::dvec2& s, bool parallel)
 
 }  // namespace
 
-std::vector<VisibilitySorter::Behind> VisibilitySorter::boundaryOrder(const Camera& camera, BoundaryStats& stats) const
+std::vector<VisibilitySorter::Behind> VisibilitySorter::boundaryOrder(const Camera& camera, BoundaryStats& stats,
+                                                                      int width, int height) const
 {
     const auto t0 = std::chrono::steady_clock::now();
     stats = BoundaryStats{};
@@ -240,7 +242,15 @@ std::vector<VisibilitySorter::Behind> VisibilitySorter::boundaryOrder(const Came
     for (const OuterFace& face : boundary_)
         for (const glm::dvec3& p : face.points)
             depthScale = std::max(depthScale, std::abs(glm::dot(p - eye, forward)));
-    const double zNear = 1e-9 * depthScale;  // perspective: what is nearer cannot be projected
+    const double zNear = 1e-6 * depthScale;  // perspective: what is nearer cannot be projected
+    // The view on the image plane (PixelRays: |x| <= scale * aspect, |y| <= scale), grown by 2 pixels.
+    const bool windowed = width > 0 && height > 0;
+    glm::dvec2 window(0.0);
+    if (windowed) {
+        const double full = camera.fullHeight(height);
+        const double scale = parallel ? camera.parallelScale : std::tan(glm::radians(camera.viewAngle) * 0.5);
+        window = scale * glm::dvec2(width / full, 1.0) + glm::dvec2(4.0 * scale / full);
+    }
 
     // Every boundary face the rays enter or leave the mesh by, projected.
     std::vector<ScreenFace> exits, entries;
@@ -253,6 +263,12 @@ std::vector<VisibilitySorter::Behind> VisibilitySorter::boundaryOrder(const Came
             solid.p[solid.n++] = toCamera(p);
         if (!parallel)
             solid = clipConvex(solid, [&](const glm::dvec3& p) { return p.z - zNear; });
+        if (windowed)  // |x| <= window.x (times z, perspective), |y| <= window.y: four planes in 3D
+            for (int axis = 0; axis < 2; ++axis)
+                for (const double sign : {1.0, -1.0})
+                    solid = clipConvex(solid, [&](const glm::dvec3& p) {
+                        return window[axis] * (parallel ? 1.0 : p.z) - sign * p[axis];
+                    });
         if (solid.n < 3)
             continue;
         ScreenFace s;
@@ -489,7 +505,7 @@ Image4f ProjtetRenderer::render(FrameStats& stats)
 {
     const FrameClock clock;
     auto t0 = std::chrono::steady_clock::now();
-    const VisibilitySorter::Result sorted = sorter_.sort(camera_, options_.order);
+    const VisibilitySorter::Result sorted = sorter_.sort(camera_, options_.order, image_.width, image_.height);
     const double boundaryMs = sorted.boundary.ms;
     const double sortMs = msSince(t0) - boundaryMs;
 

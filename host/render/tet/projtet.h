@@ -68,16 +68,18 @@ public:
     // ones, where cells that share no face can still overlap, the distance priority is a heuristic).
     // MpvoncBoundary: the same with boundaryOrder()'s relations added (exact where the relation has no
     // cycle, docs/projtet.md). When no cell is ready (a cycle), the farthest cell left is emitted and
-    // counted. Centroid: the centres' distances, farthest first.
-    Result sort(const Camera& camera, ProjtetOptions::Order order) const;
+    // counted. Centroid: the centres' distances, farthest first. width x height: the image (0: unbounded),
+    // outside of which boundaryOrder() looks for no overlaps.
+    Result sort(const Camera& camera, ProjtetOptions::Order order, int width = 0, int height = 0) const;
 
     // The relations a ray adds where it leaves the mesh and enters it again (Williams' boundary
     // extension of MPVONC): for every boundary face the ray leaves by (exit) and every boundary face it
     // enters by (entry) whose projections overlap with positive area (exact convex clipping, candidates
     // from a grid on the image plane), "entry's cell behind exit's cell" if the entry face is not in
-    // front of the exit face along a ray through the overlap. Faces are clipped at the near plane
-    // (perspective); faces seen edge-on give nothing.
-    std::vector<Behind> boundaryOrder(const Camera& camera, BoundaryStats& stats) const;
+    // front of the exit face along a ray through the overlap. Faces are clipped to the view (the
+    // width x height image's window grown by 2 pixels, unbounded for 0; perspective: at a near plane
+    // 1e-6 of the farthest boundary point's depth); faces seen edge-on give nothing.
+    std::vector<Behind> boundaryOrder(const Camera& camera, BoundaryStats& stats, int width = 0, int height = 0) const;
 
 private:
     struct InnerFace {
