@@ -1,7 +1,9 @@
 // tests/projtet_test.cpp — cell projection in visibility order (host/render/tet/projtet.h): options, the
 // Shirley-Tuchman classes, the visibility order (every interior face's constraint kept, no cycles on a
 // convex grid), convex box grids against the exact tetrahedral reference (perspective and parallel) and
-// against harc, the centre-distance order's larger error, and identical bits twice.
+// against harc, the centre-distance order's larger error, identical bits twice; non-convex meshes (the
+// boundary relations against the adjacency-only order on interleaved combs, the TetGen torus and L-block,
+// the oxygen post) and a cycle of cells (three sticks: broken, counted, its error bounded).
 #include "host/render/tet/projtet.h"
 
 #include "host/io/mesh_io.h"
@@ -164,6 +166,9 @@ TEST(Projtet, ConvexBoxGridMatchesExactReference)
                       stats.extra["cells_degenerate_projection"].get<std::uint64_t>(),
                   mesh.tets.size());
         EXPECT_EQ(stats.extra["cells_near_plane"].get<std::uint64_t>(), 0u);
+        // Convex: no ray leaves the mesh and enters it again, so no boundary relation.
+        EXPECT_GT(stats.extra["boundary_exit_faces"].get<std::uint64_t>(), 0u);
+        EXPECT_EQ(stats.extra["boundary_relations"].get<std::uint64_t>(), 0u);
     }
 }
 

@@ -1,10 +1,11 @@
 // host/render/tet/projtet.h — cell projection of tetrahedral meshes in visibility order: each cell's
 // projected silhouette split into 3 or 4 triangles around its thick vertex (Shirley & Tuchman 1990),
-// the cells sorted back to front on the host (MPVONC over the face adjacency, Williams 1992, or the
-// centre-distance sort), all drawn in that order through the raster stage (raster/rasterizer.h) with
-// kernels/projtet.cl's fragment program: the exact ray segment of the fragment's own ray through its
-// cell, integrated with harc's partial pre-integration (kernels/segment_integral.h), blended
-// ONE, ONE_MINUS_SRC_ALPHA. docs/projtet.md.
+// the cells sorted back to front on the host (MPVONC over the face adjacency, Williams 1992, with
+// relations between overlapping boundary faces for non-convex meshes, or the centre-distance sort),
+// all drawn in that order through the raster stage (raster/rasterizer.h) with kernels/projtet.cl's
+// fragment program: the exact ray segment of the fragment's own ray through its cell, integrated with
+// harc's partial pre-integration (kernels/segment_integral.h), blended ONE, ONE_MINUS_SRC_ALPHA.
+// docs/projtet.md.
 #pragma once
 
 #include "host/model/camera.h"
