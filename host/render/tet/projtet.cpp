@@ -43,8 +43,14 @@ VisibilitySorter::VisibilitySorter(const TetMesh& mesh, const TetTopology& topol
         centres_[t] = 0.25 * c;
         for (std::uint32_t f = 0; f < 4; ++f) {
             const std::int32_t n = topology.neighbor[t][f];
-            if (n <= static_cast<std::int32_t>(t))
-                continue;  // the boundary, or the pair was taken from n
+            if (n < 0) {
+                const std::array<glm::dvec3, 3> p = outwardFace(mesh, t, f);
+                const glm::dvec3 normal = glm::cross(p[1] - p[0], p[2] - p[0]);
+                boundary_.push_back({t, p, normal, glm::dot(normal, p[0])});
+                continue;
+            }
+            if (n < static_cast<std::int32_t>(t))
+                continue;  // the pair was taken from n
             const std::array<glm::dvec3, 3> p = outwardFace(mesh, t, f);
             const glm::dvec3 normal = glm::cross(p[1] - p[0], p[2] - p[0]);
             const std::int32_t index = static_cast<std::int32_t>(faces_.size());
@@ -59,7 +65,8 @@ VisibilitySorter::VisibilitySorter(const TetMesh& mesh, const TetTopology& topol
     }
 }
 
-VisibilitySorter::Result VisibilitySorter::sort(const Camera& camera, ProjtetOptions::Order order) const
+VisibilitySorter::Result VisibilitySorter::sort(const Camera& camera, ProjtetOptions::Order order, int width,
+                                                int height) const
 {
     const std::size_t cells = centres_.size();
     const glm::dvec3 eye = camera.position, forward = camera.forward();
@@ -98,6 +105,22 @@ VisibilitySorter::Result VisibilitySorter::sort(const Camera& camera, ProjtetOpt
             ++pending[face.a];
         }
     }
+    // The boundary relations as lists per back cell (CSR), each one more cell behind its front cell.
+    std::vector<std::uint32_t> extraStart, extraFront;
+    if (order == ProjtetOptions::Order::MpvoncBoundary) {
+        const std::vector<Behind> extra = boundaryOrder(camera, result.boundary, width, height);
+        extraStart.assign(cells + 1, 0);
+        for (const Behind& r : extra)
+            ++extraStart[r.back + 1];
+        for (std::size_t c = 0; c < cells; ++c)
+            extraStart[c + 1] += extraStart[c];
+        extraFront.resize(extra.size());
+        std::vector<std::uint32_t> fill(extraStart.begin(), extraStart.end() - 1);
+        for (const Behind& r : extra) {
+            extraFront[fill[r.back]++] = r.front;
+            ++pending[r.front];
+        }
+    }
     std::vector<std::uint8_t> emitted(cells, 0);
     std::priority_queue<std::pair<double, std::uint32_t>> ready;  // farthest first
     for (std::uint32_t c = 0; c < cells; ++c)
@@ -117,6 +140,12 @@ VisibilitySorter::Result VisibilitySorter::sort(const Camera& camera, ProjtetOpt
             if (!emitted[next] && --pending[next] == 0)
                 ready.push({key[next], next});
         }
+        if (!extraStart.empty())
+            for (std::uint32_t k = extraStart[c]; k < extraStart[c + 1]; ++k) {
+                const std::uint32_t next = extraFront[k];
+                if (!emitted[next] && --pending[next] == 0)
+                    ready.push({key[next], next});
+            }
     };
     std::size_t cursor = 0;
     while (result.order.size() < cells) {
@@ -136,6 +165,216 @@ VisibilitySorter::Result VisibilitySorter::sort(const Camera& camera, ProjtetOpt
             emit(c);
     }
     return result;
+}
+
+// ---- the boundary extension ------------------------------------------------------------------------
+
+namespace {
+
+// A convex polygon: a boundary triangle clipped at the near plane (4 corners at most), or the overlap of
+// two of them (one clipped by the other's edges: 8 at most).
+template <typename P>
+struct Convex {
+    std::array<P, 8> p;
+    int n = 0;
+};
+
+// Sutherland-Hodgman: the part of `in` where inside(x) >= 0, `inside` affine along edges.
+template <typename P, typename F>
+Convex<P> clipConvex(const Convex<P>& in, F inside)
+{
+    Convex<P> out;
+    for (int i = 0; i < in.n; ++i) {
+        const P& a = in.p[i];
+        const P& b = in.p[(i + 1) % in.n];
+        const double da = inside(a), db = inside(b);
+        if (da >= 0.0 && out.n < 8)
+            out.p[out.n++] = a;
+        if ((da >= 0.0) != (db >= 0.0) && out.n < 8)
+            out.p[out.n++] = a + (da / (da - db)) * (b - a);
+    }
+    return out;
+}
+
+double signedArea(const Convex<glm::dvec2>& c)
+{
+    double a = 0.0;
+    for (int i = 0; i < c.n; ++i) {
+        const glm::dvec2& p = c.p[i];
+        const glm::dvec2& q = c.p[(i + 1) % c.n];
+        a += p.x * q.y - p.y * q.x;
+    }
+    return 0.5 * a;
+}
+
+// A boundary face on the image plane (perspective: (x/z, y/z) in the camera frame; parallel: (x, y)),
+// with its depth range (z, along forward) and its plane in the camera frame, dot(normal, p) = offset.
+struct ScreenFace {
+    std::uint32_t cell;
+    Convex<glm::dvec2> shape;  // counter-clockwise
+    glm::dvec2 lo, hi;
+    double zMin, zMax;
+    glm::dvec3 normal;
+    double offset;
+};
+
+// Depth z of the face's plane on the ray through image-plane point s.
+double depthAt(const ScreenFace& f, const glm::dvec2& s, bool parallel)
+{
+    return parallel ? (f.offset - f.normal.x * s.x - f.normal.y * s.y) / f.normal.z
+                    : f.offset / glm::dot(f.normal, glm::dvec3(s, 1.0));
+}
+
+}  // namespace
+
+std::vector<VisibilitySorter::Behind> VisibilitySorter::boundaryOrder(const Camera& camera, BoundaryStats& stats,
+                                                                      int width, int height) const
+{
+    const auto t0 = std::chrono::steady_clock::now();
+    stats = BoundaryStats{};
+    const glm::dvec3 eye = camera.position, forward = camera.forward(), right = camera.right(), up = camera.up();
+    const bool parallel = camera.parallel;
+    auto toCamera = [&](const glm::dvec3& p) {
+        const glm::dvec3 d = p - eye;
+        return glm::dvec3(glm::dot(d, right), glm::dot(d, up), glm::dot(d, forward));
+    };
+    double depthScale = 0.0;
+    for (const OuterFace& face : boundary_)
+        for (const glm::dvec3& p : face.points)
+            depthScale = std::max(depthScale, std::abs(glm::dot(p - eye, forward)));
+    const double zNear = 1e-6 * depthScale;  // perspective: what is nearer cannot be projected
+    // The view on the image plane (PixelRays: |x| <= scale * aspect, |y| <= scale), grown by 2 pixels.
+    const bool windowed = width > 0 && height > 0;
+    glm::dvec2 window(0.0);
+    if (windowed) {
+        const double full = camera.fullHeight(height);
+        const double scale = parallel ? camera.parallelScale : std::tan(glm::radians(camera.viewAngle) * 0.5);
+        window = scale * glm::dvec2(width / full, 1.0) + glm::dvec2(4.0 * scale / full);
+    }
+
+    // Every boundary face the rays enter or leave the mesh by, projected.
+    std::vector<ScreenFace> exits, entries;
+    for (const OuterFace& face : boundary_) {
+        const double side = parallel ? -glm::dot(face.normal, forward) : glm::dot(face.normal, eye) - face.offset;
+        if (side == 0.0 || !std::isfinite(side))
+            continue;  // seen edge-on
+        Convex<glm::dvec3> solid;
+        for (const glm::dvec3& p : face.points)
+            solid.p[solid.n++] = toCamera(p);
+        if (!parallel)
+            solid = clipConvex(solid, [&](const glm::dvec3& p) { return p.z - zNear; });
+        if (windowed)  // |x| <= window.x (times z, perspective), |y| <= window.y: four planes in 3D
+            for (int axis = 0; axis < 2; ++axis)
+                for (const double sign : {1.0, -1.0})
+                    solid = clipConvex(solid, [&](const glm::dvec3& p) {
+                        return window[axis] * (parallel ? 1.0 : p.z) - sign * p[axis];
+                    });
+        if (solid.n < 3)
+            continue;
+        ScreenFace s;
+        s.cell = face.cell;
+        s.zMin = std::numeric_limits<double>::infinity();
+        s.zMax = -s.zMin;
+        for (int i = 0; i < solid.n; ++i) {
+            const glm::dvec3& p = solid.p[i];
+            s.shape.p[i] = parallel ? glm::dvec2(p.x, p.y) : glm::dvec2(p.x / p.z, p.y / p.z);
+            s.zMin = std::min(s.zMin, p.z);
+            s.zMax = std::max(s.zMax, p.z);
+        }
+        s.shape.n = solid.n;
+        const double area = signedArea(s.shape);
+        if (!(std::abs(area) > 0.0))
+            continue;
+        if (area < 0.0)
+            std::reverse(s.shape.p.begin(), s.shape.p.begin() + s.shape.n);
+        s.lo = s.hi = s.shape.p[0];
+        for (int i = 1; i < s.shape.n; ++i) {
+            s.lo = glm::min(s.lo, s.shape.p[i]);
+            s.hi = glm::max(s.hi, s.shape.p[i]);
+        }
+        s.normal = glm::dvec3(glm::dot(face.normal, right), glm::dot(face.normal, up), glm::dot(face.normal, forward));
+        s.offset = face.offset - glm::dot(face.normal, eye);
+        (side < 0.0 ? exits : entries).push_back(s);
+    }
+    stats.exitFaces = exits.size();
+    stats.entryFaces = entries.size();
+    std::vector<Behind> relations;
+    if (exits.empty() || entries.empty()) {
+        stats.ms = msSince(t0);
+        return relations;
+    }
+
+    // The exit faces binned on a grid over their bounds, about one face per bin.
+    glm::dvec2 lo = exits[0].lo, hi = exits[0].hi;
+    for (const ScreenFace& f : exits) {
+        lo = glm::min(lo, f.lo);
+        hi = glm::max(hi, f.hi);
+    }
+    const int bins = std::clamp(static_cast<int>(std::ceil(std::sqrt(static_cast<double>(exits.size())))), 1, 2048);
+    const glm::dvec2 extent = glm::max(hi - lo, glm::dvec2(1e-300));
+    auto bin = [&](double x, double origin, double size) {
+        const double b = std::floor((x - origin) / size * bins);
+        return static_cast<int>(std::clamp(b, 0.0, static_cast<double>(bins - 1)));
+    };
+    std::vector<std::uint32_t> start(static_cast<std::size_t>(bins) * bins + 1, 0), members;
+    auto forBins = [&](const ScreenFace& f, auto visit) {
+        const int x0 = bin(f.lo.x, lo.x, extent.x), x1 = bin(f.hi.x, lo.x, extent.x);
+        const int y0 = bin(f.lo.y, lo.y, extent.y), y1 = bin(f.hi.y, lo.y, extent.y);
+        for (int y = y0; y <= y1; ++y)
+            for (int x = x0; x <= x1; ++x)
+                visit(static_cast<std::size_t>(y) * bins + x);
+    };
+    for (const ScreenFace& f : exits)
+        forBins(f, [&](std::size_t b) { ++start[b + 1]; });
+    for (std::size_t b = 0; b + 1 < start.size(); ++b)
+        start[b + 1] += start[b];
+    members.resize(start.back());
+    {
+        std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+        for (std::uint32_t i = 0; i < exits.size(); ++i)
+            forBins(exits[i], [&](std::size_t b) { members[fill[b]++] = i; });
+    }
+
+    const double minArea = 1e-12 * std::max(extent.x, extent.y) * std::max(extent.x, extent.y);
+    const double depthTolerance = 1e-9 * depthScale;
+    for (const ScreenFace& entry : entries) {
+        if (entry.hi.x < lo.x || entry.hi.y < lo.y || entry.lo.x > hi.x || entry.lo.y > hi.y)
+            continue;
+        forBins(entry, [&](std::size_t b) {
+            for (std::uint32_t k = start[b]; k < start[b + 1]; ++k) {
+                const ScreenFace& exit = exits[members[k]];
+                const glm::dvec2 overlapLo = glm::max(entry.lo, exit.lo), overlapHi = glm::min(entry.hi, exit.hi);
+                if (overlapLo.x >= overlapHi.x || overlapLo.y >= overlapHi.y || exit.cell == entry.cell)
+                    continue;
+                // Each pair once: in the bin of its bounds' overlap's low corner.
+                if (static_cast<std::size_t>(bin(overlapLo.y, lo.y, extent.y)) * bins + bin(overlapLo.x, lo.x, extent.x) != b)
+                    continue;
+                if (entry.zMax < exit.zMin - depthTolerance)
+                    continue;  // the entry face is in front of the exit face wherever they overlap
+                ++stats.pairsTested;
+                Convex<glm::dvec2> overlap = entry.shape;
+                for (int e = 0; e < exit.shape.n && overlap.n >= 3; ++e) {
+                    const glm::dvec2 a = exit.shape.p[e], d = exit.shape.p[(e + 1) % exit.shape.n] - a;
+                    overlap = clipConvex(overlap, [&](const glm::dvec2& p) { return d.x * (p.y - a.y) - d.y * (p.x - a.x); });
+                }
+                if (overlap.n < 3 || !(signedArea(overlap) > minArea))
+                    continue;
+                glm::dvec2 inside(0.0);
+                for (int i = 0; i < overlap.n; ++i)
+                    inside += overlap.p[i];
+                inside /= static_cast<double>(overlap.n);
+                // The faces cross no ray at the same point except where they coincide (two parts of the
+                // mesh that touch without sharing points): there the ray leaves one and enters the other.
+                if (entry.zMin >= exit.zMax ||
+                    depthAt(entry, inside, parallel) >= depthAt(exit, inside, parallel) - depthTolerance) {
+                    relations.push_back({entry.cell, exit.cell});
+                }
+            }
+        });
+    }
+    stats.relations = relations.size();
+    stats.ms = msSince(t0);
+    return relations;
 }
 
 // ---- Shirley-Tuchman classification -----------------------------------------------------------------
@@ -266,8 +505,9 @@ Image4f ProjtetRenderer::render(FrameStats& stats)
 {
     const FrameClock clock;
     auto t0 = std::chrono::steady_clock::now();
-    const VisibilitySorter::Result sorted = sorter_.sort(camera_, options_.order);
-    const double sortMs = msSince(t0);
+    const VisibilitySorter::Result sorted = sorter_.sort(camera_, options_.order, image_.width, image_.height);
+    const double boundaryMs = sorted.boundary.ms;
+    const double sortMs = msSince(t0) - boundaryMs;
 
     // Projection: every point to normalized device coordinates (double, then float as the raster stage
     // gets them, so neighbouring cells share their silhouette edges bit for bit). A cell with a point at
@@ -391,16 +631,26 @@ Image4f ProjtetRenderer::render(FrameStats& stats)
     Image4f image = readImage(device_, fb_.color(), image_.width, image_.height);
     const raster::DrawStats drawn = rasterizer_.takeStats();
 
-    std::vector<PassTime> hostPasses = {{"projtet: visibility sort (host)", sortMs},
+    std::vector<PassTime> hostPasses;
+    if (options_.order == ProjtetOptions::Order::MpvoncBoundary)
+        hostPasses.push_back({"projtet: boundary overlaps (host)", boundaryMs});
+    hostPasses.insert(hostPasses.end(), {{"projtet: visibility sort (host)", sortMs},
                                         {"projtet: projection and classification (host)", projectMs},
-                                        {"projtet: raster set-up and binning (host)", setUpMs}};
+                                        {"projtet: raster set-up and binning (host)", setUpMs}});
     finishFrame(device_, clock, stats, std::move(hostPasses));
     counts_.report(stats);
     stats.extra["resident_bytes"] = residentBytes_;
     stats.extra["bytes_per_tet"] = static_cast<double>(residentBytes_) / static_cast<double>(tets_.size());
-    stats.extra["order"] = options_.order == ProjtetOptions::Order::Mpvonc ? "mpvonc" : "centroid";
+    stats.extra["order"] = orderName(options_.order);
     stats.extra["order_cycles_broken"] = sorted.cyclesBroken;
     stats.extra["sort_ms"] = sortMs;
+    if (options_.order == ProjtetOptions::Order::MpvoncBoundary) {
+        stats.extra["boundary_ms"] = boundaryMs;
+        stats.extra["boundary_exit_faces"] = sorted.boundary.exitFaces;
+        stats.extra["boundary_entry_faces"] = sorted.boundary.entryFaces;
+        stats.extra["boundary_pairs_tested"] = sorted.boundary.pairsTested;
+        stats.extra["boundary_relations"] = sorted.boundary.relations;
+    }
     stats.extra["projection_ms"] = projectMs;
     stats.extra["cells_class1"] = class1;
     stats.extra["cells_class2"] = class2;
@@ -414,6 +664,16 @@ Image4f ProjtetRenderer::render(FrameStats& stats)
 
 }  // namespace
 
+const char* orderName(ProjtetOptions::Order order)
+{
+    switch (order) {
+    case ProjtetOptions::Order::MpvoncBoundary: return "mpvonc-boundary";
+    case ProjtetOptions::Order::Mpvonc: return "mpvonc";
+    case ProjtetOptions::Order::Centroid: return "centroid";
+    }
+    return "?";
+}
+
 TechniqueInfo projtetTechnique()
 {
     TechniqueInfo t;
@@ -421,7 +681,9 @@ TechniqueInfo projtetTechnique()
     t.data = DataKind::Mesh;
     t.description = "cell projection (Shirley-Tuchman) in visibility order with partial pre-integration (docs/projtet.md)";
     t.options = {
-        {"order", "mpvonc", "", "visibility order: \"mpvonc\" (adjacency, Williams 1992) or \"centroid\" (centre distance)"},
+        {"order", "mpvonc-boundary", "",
+         "visibility order: \"mpvonc-boundary\" (adjacency and overlapping boundary faces, exact without cycles), "
+         "\"mpvonc\" (adjacency only, Williams 1992: exact on convex meshes) or \"centroid\" (centre distance)"},
     };
     t.makeForMesh = [](Device& device, const Scene& scene, const TetMesh& mesh) -> std::unique_ptr<Renderer> {
         return makeProjtetRenderer(device, scene, mesh, buildTopology(mesh));
@@ -436,12 +698,14 @@ ProjtetOptions parseProjtetOptions(const nlohmann::json& options)
     forEachOption(options, info, [&](const std::string& key, const nlohmann::json& value) {
         if (key == "order") {
             const std::string s = value.is_string() ? value.get<std::string>() : "";
-            if (s == "mpvonc")
+            if (s == "mpvonc-boundary")
+                o.order = ProjtetOptions::Order::MpvoncBoundary;
+            else if (s == "mpvonc")
                 o.order = ProjtetOptions::Order::Mpvonc;
             else if (s == "centroid")
                 o.order = ProjtetOptions::Order::Centroid;
             else
-                badOption(key, "must be \"mpvonc\" or \"centroid\", got " + value.dump());
+                badOption(key, "must be \"mpvonc-boundary\", \"mpvonc\" or \"centroid\", got " + value.dump());
         } else {
             unparsedOption(info, key);
         }

@@ -1,10 +1,11 @@
 // host/render/tet/projtet.h — cell projection of tetrahedral meshes in visibility order: each cell's
 // projected silhouette split into 3 or 4 triangles around its thick vertex (Shirley & Tuchman 1990),
-// the cells sorted back to front on the host (MPVONC over the face adjacency, Williams 1992, or the
-// centre-distance sort), all drawn in that order through the raster stage (raster/rasterizer.h) with
-// kernels/projtet.cl's fragment program: the exact ray segment of the fragment's own ray through its
-// cell, integrated with harc's partial pre-integration (kernels/segment_integral.h), blended
-// ONE, ONE_MINUS_SRC_ALPHA. docs/projtet.md.
+// the cells sorted back to front on the host (MPVONC over the face adjacency, Williams 1992, with
+// relations between overlapping boundary faces for non-convex meshes, or the centre-distance sort),
+// all drawn in that order through the raster stage (raster/rasterizer.h) with kernels/projtet.cl's
+// fragment program: the exact ray segment of the fragment's own ray through its cell, integrated with
+// harc's partial pre-integration (kernels/segment_integral.h), blended ONE, ONE_MINUS_SRC_ALPHA.
+// docs/projtet.md.
 #pragma once
 
 #include "host/model/camera.h"
@@ -22,36 +23,64 @@
 namespace clvr {
 
 struct ProjtetOptions {
-    // "mpvonc": topological sort of the adjacency's in-front-of relation; "centroid": the cells'
-    // centres sorted by distance from the eye (depth along the view for parallel cameras).
-    enum class Order { Mpvonc, Centroid };
-    Order order = Order::Mpvonc;
+    // "mpvonc-boundary" (the default): topological sort of the adjacency's in-front-of relation plus
+    // "behind" relations between boundary faces that overlap on screen (exact for acyclic non-convex
+    // meshes); "mpvonc": the adjacency alone (exact for convex meshes); "centroid": the cells' centres
+    // sorted by distance from the eye (depth along the view for parallel cameras).
+    enum class Order { MpvoncBoundary, Mpvonc, Centroid };
+    Order order = Order::MpvoncBoundary;
 };
+
+// The option's value for `order` ("mpvonc-boundary", "mpvonc", "centroid").
+const char* orderName(ProjtetOptions::Order order);
 
 // Its registry entry (host/render/renderer.h).
 TechniqueInfo projtetTechnique();
 
-// Reads the scene's "options" for projtet: "order" ("mpvonc" | "centroid"). InputError naming the key
-// for unknown keys, wrong types and values.
+// Reads the scene's "options" for projtet: "order" ("mpvonc-boundary" | "mpvonc" | "centroid").
+// InputError naming the key for unknown keys, wrong types and values.
 ProjtetOptions parseProjtetOptions(const nlohmann::json& options);
 
 // The view-independent part of the visibility order: per interior face its two cells and its plane
-// (outward normal of `a`, offset: dot(normal, x) = offset on the face), and the cells' centres.
+// (outward normal of `a`, offset: dot(normal, x) = offset on the face), the boundary faces (cell, points,
+// outward plane) and the cells' centres.
 class VisibilitySorter {
 public:
     VisibilitySorter(const TetMesh& mesh, const TetTopology& topology);
 
+    // "Cell `back` is drawn before cell `front`": both meet one ray, `back` farther along it.
+    struct Behind {
+        std::uint32_t back, front;
+    };
+    struct BoundaryStats {
+        std::uint64_t exitFaces = 0, entryFaces = 0;  // boundary faces the rays leave / enter the mesh by
+        std::uint64_t pairsTested = 0;                // exit x entry pairs given the exact overlap test
+        std::uint64_t relations = 0;                  // of them, an entry face behind an exit face
+        double ms = 0.0;                              // time of boundaryOrder()
+    };
     struct Result {
         std::vector<std::uint32_t> order;  // every cell once, back to front
         std::uint64_t cyclesBroken = 0;    // cells emitted before all cells behind them (cycles)
+        BoundaryStats boundary;            // MpvoncBoundary only
     };
     // Back to front for `camera`. Mpvonc: Kahn's topological sort of "a is behind b" across each
     // interior face (the side of the face's plane the eye is on; the view direction for parallel
     // cameras), the ready cell farthest from the eye first (exact for convex meshes; for non-convex
-    // ones, where cells that share no face can still overlap, the distance priority is a heuristic,
-    // docs/projtet.md). When no cell is ready (a cycle), the farthest cell left is emitted and counted.
-    // Centroid: the centres' distances, farthest first.
-    Result sort(const Camera& camera, ProjtetOptions::Order order) const;
+    // ones, where cells that share no face can still overlap, the distance priority is a heuristic).
+    // MpvoncBoundary: the same with boundaryOrder()'s relations added (exact where the relation has no
+    // cycle, docs/projtet.md). When no cell is ready (a cycle), the farthest cell left is emitted and
+    // counted. Centroid: the centres' distances, farthest first. width x height: the image (0: unbounded),
+    // outside of which boundaryOrder() looks for no overlaps.
+    Result sort(const Camera& camera, ProjtetOptions::Order order, int width = 0, int height = 0) const;
+
+    // The relations a ray adds where it leaves the mesh and enters it again (Williams' boundary
+    // extension of MPVONC): for every boundary face the ray leaves by (exit) and every boundary face it
+    // enters by (entry) whose projections overlap with positive area (exact convex clipping, candidates
+    // from a grid on the image plane), "entry's cell behind exit's cell" if the entry face is not in
+    // front of the exit face along a ray through the overlap. Faces are clipped to the view (the
+    // width x height image's window grown by 2 pixels, unbounded for 0; perspective: at a near plane
+    // 1e-6 of the farthest boundary point's depth); faces seen edge-on give nothing.
+    std::vector<Behind> boundaryOrder(const Camera& camera, BoundaryStats& stats, int width = 0, int height = 0) const;
 
 private:
     struct InnerFace {
@@ -59,8 +88,15 @@ private:
         glm::dvec3 normal;  // out of a
         double offset;
     };
+    struct OuterFace {
+        std::uint32_t cell;
+        std::array<glm::dvec3, 3> points;
+        glm::dvec3 normal;  // out of the cell
+        double offset;
+    };
     std::vector<InnerFace> faces_;
     std::vector<std::array<std::int32_t, 4>> faceOf_;  // per cell, its inner faces' indices (-1: none)
+    std::vector<OuterFace> boundary_;
     std::vector<glm::dvec3> centres_;
 };
 
