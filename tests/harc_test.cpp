@@ -27,6 +27,7 @@ namespace {
 using nlohmann::json;
 using test::Box;
 using test::boxMesh;
+using test::meshCamera;
 using test::perspective;
 
 // Face adjacency by hand (sorted point triples), as buildTopology defines it.
@@ -601,23 +602,6 @@ Image4f renderWithEntry(Scene scene, const TetMesh& mesh, const TetTopology& top
 }
 
 
-// The camera of the mesh tests: fitted to the bounds, perspective or parallel.
-Camera meshCamera(const TetMesh& mesh, bool parallel)
-{
-    const glm::dvec3 lo = mesh.boundsMin(), hi = mesh.boundsMax(), center = 0.5 * (lo + hi);
-    const double radius = 0.5 * glm::length(hi - lo);
-    Camera camera;
-    camera.focalPoint = center;
-    camera.position = center + radius * glm::dvec3(1.3, 0.9, 2.2);
-    camera.viewUp = {0.0, 1.0, 0.0};
-    camera.viewAngle = 34.0;
-    if (parallel) {
-        camera.parallel = true;
-        camera.parallelScale = 0.8 * radius;
-    }
-    return camera;
-}
-
 void checkMeshAgainstReference(const MeshCase& c, bool parallel)
 {
     TetMesh mesh = loadMesh(c.spec, "/");
@@ -642,11 +626,7 @@ MeshCase bluntfinCase()
             {{"file", test::sharedData("bluntfin/bluntfinxyz.bin")},
              {"q_file", test::sharedData("bluntfin/bluntfinq.bin")},
              {"scalar", "density"}},
-            TransferFunction({{0.2, {0.0, 0.0, 0.3}, 0.0},
-                              {0.8, {0.1, 0.3, 1.0}, 0.1},
-                              {1.5, {0.2, 1.0, 0.3}, 0.4},
-                              {2.5, {1.0, 0.8, 0.1}, 0.8},
-                              {4.0, {1.0, 0.2, 0.1}, 1.5}})};
+            test::bluntfinTransferFunction()};
 }
 
 TEST(HarcMeshes, BluntfinMatchesExactReference)
@@ -658,16 +638,8 @@ TEST(HarcMeshes, BluntfinMatchesExactReference)
 
 MeshCase postCase()
 {
-    TetMesh probe = loadMesh(nlohmann::json{{"file", test::sharedData("post/post.vtk")}}, "/");
-    const glm::dvec2 range = probe.scalarRange();
-    auto at = [&](double f) { return range.x + f * (range.y - range.x); };
-    const double size = glm::length(probe.boundsMax() - probe.boundsMin());
-    return {"post",
-            {{"file", test::sharedData("post/post.vtk")}},
-            TransferFunction({{at(0.0), {0.1, 0.1, 0.5}, 0.0},
-                              {at(0.3), {0.2, 0.6, 1.0}, 1.0 / size},
-                              {at(0.6), {0.9, 0.9, 0.2}, 3.0 / size},
-                              {at(1.0), {1.0, 0.3, 0.1}, 8.0 / size}})};
+    const TetMesh probe = loadMesh(nlohmann::json{{"file", test::sharedData("post/post.vtk")}}, "/");
+    return {"post", {{"file", test::sharedData("post/post.vtk")}}, test::postTransferFunction(probe)};
 }
 
 TEST(HarcMeshes, PostMatchesExactReference)

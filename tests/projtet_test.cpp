@@ -299,24 +299,10 @@ TEST(ProjtetMeshes, BluntfinMatchesExactReference)
                                  {"q_file", test::sharedData("bluntfin/bluntfinq.bin")},
                                  {"scalar", "density"}},
                             "/");
-    const TransferFunction tf({{0.2, {0.0, 0.0, 0.3}, 0.0},
-                               {0.8, {0.1, 0.3, 1.0}, 0.1},
-                               {1.5, {0.2, 1.0, 0.3}, 0.4},
-                               {2.5, {1.0, 0.8, 0.1}, 0.8},
-                               {4.0, {1.0, 0.2, 0.1}, 1.5}});
-    const glm::dvec3 lo = mesh.boundsMin(), hi = mesh.boundsMax(), center = 0.5 * (lo + hi);
-    const double radius = 0.5 * glm::length(hi - lo);
+    const TransferFunction tf = test::bluntfinTransferFunction();
     const TetTopology topology = buildTopology(mesh);
     for (const bool parallel : {false, true}) {
-        Camera camera;
-        camera.focalPoint = center;
-        camera.position = center + radius * glm::dvec3(1.3, 0.9, 2.2);
-        camera.viewUp = {0.0, 1.0, 0.0};
-        camera.viewAngle = 34.0;
-        if (parallel) {
-            camera.parallel = true;
-            camera.parallelScale = 0.8 * radius;
-        }
+        const Camera camera = test::meshCamera(mesh, parallel);
         const Scene scene = makeScene(camera, tf, 64);
         const Image4d expected = tetReferenceIntegral(mesh, tf, camera, scene.image);
         FrameStats stats;
@@ -613,26 +599,10 @@ TEST(ProjtetMeshes, PostMatchesExactReference)
 {
     const json spec = {{"file", test::sharedData("post/post.vtk")}};
     const TetMesh mesh = loadMesh(spec, "/");
-    const glm::dvec2 range = mesh.scalarRange();
-    auto at = [&](double f) { return range.x + f * (range.y - range.x); };
-    const double size = glm::length(mesh.boundsMax() - mesh.boundsMin());
-    const TransferFunction tf({{at(0.0), {0.1, 0.1, 0.5}, 0.0},
-                               {at(0.3), {0.2, 0.6, 1.0}, 1.0 / size},
-                               {at(0.6), {0.9, 0.9, 0.2}, 3.0 / size},
-                               {at(1.0), {1.0, 0.3, 0.1}, 8.0 / size}});
-    const glm::dvec3 lo = mesh.boundsMin(), hi = mesh.boundsMax(), center = 0.5 * (lo + hi);
-    const double radius = 0.5 * glm::length(hi - lo);
+    const TransferFunction tf = test::postTransferFunction(mesh);
     const TetTopology topology = buildTopology(mesh);
     for (const bool parallel : {false, true}) {
-        Camera camera;
-        camera.focalPoint = center;
-        camera.position = center + radius * glm::dvec3(1.3, 0.9, 2.2);
-        camera.viewUp = {0.0, 1.0, 0.0};
-        camera.viewAngle = 34.0;
-        if (parallel) {
-            camera.parallel = true;
-            camera.parallelScale = 0.8 * radius;
-        }
+        const Camera camera = test::meshCamera(mesh, parallel);
         const Scene scene = makeScene(camera, tf, 64);
         const Image4d expected = tetReferenceIntegral(mesh, tf, camera, scene.image);
         FrameStats stats;

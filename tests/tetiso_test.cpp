@@ -302,9 +302,8 @@ TEST(TetisoMeshes, PostMatchesTheExactFirstCrossing)
 {
     TetMesh mesh = loadMesh(json{{"file", test::sharedData("post/post.vtk")}}, "/");
     const glm::dvec2 range = mesh.scalarRange();
-    const glm::dvec3 lo = mesh.boundsMin(), hi = mesh.boundsMax(), center = 0.5 * (lo + hi);
-    const double radius = 0.5 * glm::length(hi - lo);
-    const Camera camera = perspective(center + radius * glm::dvec3(1.3, 0.9, 2.2), center, 34.0);
+    const double radius = 0.5 * glm::length(mesh.boundsMax() - mesh.boundsMin());
+    const Camera camera = test::meshCamera(mesh);
     const Comparison c = compare(isoScene(camera, 64, range.x + 0.55 * (range.y - range.x)), mesh, nullptr);
     ASSERT_GT(c.bothHit, 100u);                           // measured 132
     EXPECT_LE(c.coverageDiffersInside * 100, c.bothHit);  // at most 1% (measured 0)

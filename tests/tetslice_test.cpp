@@ -74,6 +74,7 @@ TEST(TetsliceActiveCells, EachSliceListsExactlyTheCellsItCuts)
     EXPECT_THROW(lists.next(), InternalError);
 }
 
+using test::meshCamera;
 using test::perspective;
 
 Scene makeScene(const Camera& camera, const TransferFunction& tf, int size, json options = json::object())
@@ -197,38 +198,20 @@ TEST(Tetslice, TransferFunctionChangeEqualsAFreshRenderer)
 
 // ---- the paper's meshes and a non-convex TetGen mesh ----------------------------------------------------
 
-// The harc tests' camera: fitted to the bounds, looking from an oblique direction.
-Camera meshCamera(const TetMesh& mesh)
-{
-    const glm::dvec3 lo = mesh.boundsMin(), hi = mesh.boundsMax(), center = 0.5 * (lo + hi);
-    const double radius = 0.5 * glm::length(hi - lo);
-    return perspective(center + radius * glm::dvec3(1.3, 0.9, 2.2), center, 34.0);
-}
-
 TEST(TetsliceMeshes, BluntfinConverges)
 {
     TetMesh mesh = loadMesh(json{{"file", test::sharedData("bluntfin/bluntfinxyz.bin")},
                                  {"q_file", test::sharedData("bluntfin/bluntfinq.bin")},
                                  {"scalar", "density"}},
                             "/");
-    const TransferFunction tf({{0.2, {0.0, 0.0, 0.3}, 0.0},
-                               {0.8, {0.1, 0.3, 1.0}, 0.1},
-                               {1.5, {0.2, 1.0, 0.3}, 0.4},
-                               {2.5, {1.0, 0.8, 0.1}, 0.8},
-                               {4.0, {1.0, 0.2, 0.1}, 1.5}});
+    const TransferFunction tf = test::bluntfinTransferFunction();
     expectConvergence("bluntfin", mesh, makeScene(meshCamera(mesh), tf, 48), {64, 256, 1024}, 2e-3, 5e-2);
 }
 
 TEST(TetsliceMeshes, PostConverges)
 {
     TetMesh mesh = loadMesh(json{{"file", test::sharedData("post/post.vtk")}}, "/");
-    const glm::dvec2 range = mesh.scalarRange();
-    auto at = [&](double f) { return range.x + f * (range.y - range.x); };
-    const double size = glm::length(mesh.boundsMax() - mesh.boundsMin());
-    const TransferFunction tf({{at(0.0), {0.1, 0.1, 0.5}, 0.0},
-                               {at(0.3), {0.2, 0.6, 1.0}, 1.0 / size},
-                               {at(0.6), {0.9, 0.9, 0.2}, 3.0 / size},
-                               {at(1.0), {1.0, 0.3, 0.1}, 8.0 / size}});
+    const TransferFunction tf = test::postTransferFunction(mesh);
     expectConvergence("post", mesh, makeScene(meshCamera(mesh), tf, 48), {64, 256, 1024}, 2e-3, 5e-2);
 }
 

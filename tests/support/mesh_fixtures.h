@@ -73,6 +73,47 @@ inline TransferFunction rampTransferFunction()
                              {1.0, {0.3, 0.2, 1.0}, 1.0}});
 }
 
+// The real-mesh tests' camera (harc, projtet, tetslice, tetiso): fitted to the bounds, looking at their
+// centre from the oblique direction (1.3, 0.9, 2.2) times the bounding radius, 34 degrees; parallel with
+// a parallel scale of 0.8 bounding radii.
+inline Camera meshCamera(const TetMesh& mesh, bool parallel = false)
+{
+    const glm::dvec3 lo = mesh.boundsMin(), hi = mesh.boundsMax(), center = 0.5 * (lo + hi);
+    const double radius = 0.5 * glm::length(hi - lo);
+    Camera camera;
+    camera.focalPoint = center;
+    camera.position = center + radius * glm::dvec3(1.3, 0.9, 2.2);
+    camera.viewUp = {0.0, 1.0, 0.0};
+    camera.viewAngle = 34.0;
+    if (parallel) {
+        camera.parallel = true;
+        camera.parallelScale = 0.8 * radius;
+    }
+    return camera;
+}
+
+// The bluntfin tests' transfer function on its density (0.2 .. 4, tau up to 1.5 per unit).
+inline TransferFunction bluntfinTransferFunction()
+{
+    return TransferFunction({{0.2, {0.0, 0.0, 0.3}, 0.0},
+                             {0.8, {0.1, 0.3, 1.0}, 0.1},
+                             {1.5, {0.2, 1.0, 0.3}, 0.4},
+                             {2.5, {1.0, 0.8, 0.1}, 0.8},
+                             {4.0, {1.0, 0.2, 0.1}, 1.5}});
+}
+
+// The oxygen post tests' transfer function: on the mesh's scalar range, tau up to 8 per bounding diagonal.
+inline TransferFunction postTransferFunction(const TetMesh& mesh)
+{
+    const glm::dvec2 range = mesh.scalarRange();
+    auto at = [&](double f) { return range.x + f * (range.y - range.x); };
+    const double size = glm::length(mesh.boundsMax() - mesh.boundsMin());
+    return TransferFunction({{at(0.0), {0.1, 0.1, 0.5}, 0.0},
+                             {at(0.3), {0.2, 0.6, 1.0}, 1.0 / size},
+                             {at(0.6), {0.9, 0.9, 0.2}, 3.0 / size},
+                             {at(1.0), {1.0, 0.3, 0.1}, 8.0 / size}});
+}
+
 // A perspective camera with +y up.
 inline Camera perspective(glm::dvec3 position, glm::dvec3 focal = {0.5, 0.5, 0.5}, double angle = 35.0)
 {
