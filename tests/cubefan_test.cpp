@@ -429,8 +429,9 @@ TEST(CubefanOctree, SelectionIsWithinToleranceAndBackToFront)
                     EXPECT_GE(order, 0) << "cube " << j << " is behind cube " << i << " but comes later";
                 }
             }
-            if (cubes.size() > 4)  // enough cubes that some share faces
+            if (cubes.size() > 4) {  // enough cubes that some share faces
                 EXPECT_GT(shared, 0) << cubes.size() << " cubes at tolerance " << tolerance;
+            }
             std::printf("tolerance %.1f: %zu cubes, %d face pairs\n", tolerance, cubes.size(), shared);
         }
     // Tolerance 1 takes the root unless it is transparent.

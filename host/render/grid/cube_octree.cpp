@@ -2,6 +2,8 @@
 // back to front.
 #include "host/render/grid/cube_octree.h"
 
+#include "host/render/grid/slice3d.h"  // tauZeroOn: the empty-brick test of slice3d's space skipping
+
 #include <algorithm>
 #include <cmath>
 
@@ -17,15 +19,6 @@ int leavesAlong(int i, int k, int n)
 }
 
 }  // namespace
-
-double maxExtinction(const TransferFunction& tf, double a, double b)
-{
-    double m = std::max(tf(a).a, tf(b).a);
-    for (const ControlPoint& p : tf.points())
-        if (p.s > a && p.s < b)
-            m = std::max(m, p.tau);
-    return m;
-}
 
 CubeOctree::CubeOctree(const Volume& volume)
     : voxels_(volume.dims), origin_(volume.origin), spacing_(volume.spacing)
@@ -101,7 +94,7 @@ std::vector<Cube> CubeOctree::select(double tolerance, const TransferFunction& t
         ++s.visited;
         const Level& l = levels_[level];
         const std::size_t j = at(level, i);
-        if (maxExtinction(tf, l.min[j], l.max[j]) <= 0.0) {
+        if (tauZeroOn(tf, l.min[j], l.max[j])) {
             ++s.transparent;
             return;
         }

@@ -49,7 +49,7 @@ public:
 
     // Depth first from the root: a cube is taken when it is a voxel or its error <= tolerance * data
     // range, and kept when tf's extinction at its value is > 0; a subtree whose value range the transfer
-    // function makes transparent throughout is skipped whole. Children are visited farthest first from
+    // function makes transparent throughout (slice3d's tauZeroOn, as for its empty bricks) is skipped whole. Children are visited farthest first from
     // the eye (perspective) or along forward (parallel: eye unused), so the result is back to front.
     std::vector<Cube> select(double tolerance, const TransferFunction& tf, const glm::dvec3& eye,
                              const glm::dvec3& forward, bool parallel, SelectionStats* stats = nullptr) const;
@@ -69,8 +69,5 @@ private:
     glm::dvec3 origin_{0.0}, spacing_{1.0};
     double range_ = 0.0;
 };
-
-// The largest extinction of tf over [a, b] (piecewise linear: the ends and the control points inside).
-double maxExtinction(const TransferFunction& tf, double a, double b);
 
 }  // namespace clvr::cubefan
