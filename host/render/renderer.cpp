@@ -4,6 +4,7 @@
 
 #include "host/runtime/errors.h"
 #include "host/render/grid/blend.h"
+#include "host/render/grid/cubefan.h"
 #include "host/render/tet/harc.h"
 #include "host/render/tet/projtet.h"
 #include "host/render/tet/tetiso.h"
@@ -77,7 +78,7 @@ const std::vector<TechniqueInfo>& techniques()
     static const std::vector<TechniqueInfo> all = {slice3dTechnique(), stack2dTechnique(), iso3dTechnique(),
                                                    planesTechnique(),  blendTechnique(),   sphericalTechnique(),
                                                    harcTechnique(),    tetsliceTechnique(), tetisoTechnique(),
-                                                   projtetTechnique()};
+                                                   projtetTechnique(),  cubefanTechnique()};
     return all;
 }
 

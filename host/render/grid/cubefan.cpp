@@ -1,0 +1,391 @@
+// host/render/grid/cubefan.cpp — options, the exp-opacity texture and the cubefan renderer: per frame the
+// octree's selection (back to front), every cube projected as its class's triangles (cube_fans.h) and
+// drawn in that order through the raster stage in batches, kernels/cubefan.cl's fragment program per
+// fragment, then slice3d's pass over the background.
+#include "host/render/grid/cubefan.h"
+
+#include "host/render/camera_args.h"
+#include "host/render/fragment_uniforms.h"
+#include "host/render/grid/cube_fans.h"
+#include "host/render/grid/cube_octree.h"
+#include "host/render/options_util.h"
+#include "host/render/scaffold.h"
+#include "host/render/transfer_function_upload.h"
+#include "host/runtime/embedded_kernels.h"
+#include "host/runtime/errors.h"
+#include "kernels/cubefan_params.h"
+#include "kernels/slice3d_params.h"  // ClSlice3dOverBackgroundParams: the last pass is slice3d's
+#include "raster/framebuffer.h"
+#include "raster/rasterizer.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <string>
+
+namespace clvr {
+
+static_assert(sizeof(ClCubefanUniforms) == 112, "float4s only: the fragment program reads it from its uniforms");
+
+const char* opacityName(CubefanOptions::Opacity opacity)
+{
+    switch (opacity) {
+    case CubefanOptions::Opacity::Texture: return "texture";
+    case CubefanOptions::Opacity::Exp: return "exp";
+    case CubefanOptions::Opacity::Linear: return "linear";
+    }
+    return "?";
+}
+
+std::vector<float> expOpacityTexels(int size, double k)
+{
+    std::vector<float> texels(static_cast<std::size_t>(size) * size);
+    const double step = 1.0 / (size - 1);
+    for (int j = 0; j < size; ++j)
+        for (int i = 0; i < size; ++i)
+            texels[static_cast<std::size_t>(j) * size + i] = static_cast<float>(-std::expm1(-k * (i * step) * (j * step)));
+    return texels;
+}
+
+double maxExtinction(const TransferFunction& tf)
+{
+    double m = 0.0;
+    for (const auto& p : tf.points())
+        m = std::max(m, p.tau);
+    return m;
+}
+
+namespace {
+
+// Vertices per draw: 2^19 raster::Vertex are 40 MiB on the host, about 14,000 cubes of 12 triangles.
+constexpr std::size_t kBatchVertices = std::size_t(1) << 19;
+
+std::string programSource(const char* define)
+{
+    return std::string("#define ") + define + " 1\n" + std::string(embeddedKernelSource("cubefan.cl"));
+}
+
+glm::dvec3 cornerOf(const glm::dvec3& lo, const glm::dvec3& hi, int v)
+{
+    return {(v & 1) ? hi.x : lo.x, (v & 2) ? hi.y : lo.y, (v & 4) ? hi.z : lo.z};
+}
+
+// The six faces as corner quadruples (v = x + 2y + 4z), in cyclic order; face f is 0 -x, 1 +x, ... 5 +z.
+constexpr int kFaceCorners[6][4] = {{0, 2, 6, 4}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 5, 7, 6}};
+
+class CubefanRenderer final : public Renderer {
+public:
+    CubefanRenderer(Device& device, const Scene& scene, const Volume& volume);
+    Image4f render(FrameStats& stats) override;
+    std::uint64_t residentBytes() const override { return residentBytes_; }
+    void setTransferFunction(const TransferFunction& tf) override
+    {
+        tfHost_ = tf;
+        tf_.replace(device_, "cubefan transfer function", tf, residentBytes_);
+        textureK_ = -1.0;  // tau_max may have changed
+    }
+
+private:
+    void updateTexture(double k);
+
+    Device& device_;
+    CubefanOptions options_;
+    Camera camera_;
+    ImageSpec image_;
+    glm::dvec3 shift_{0.0}, lo_{0.0}, hi_{0.0};  // the cube field's box
+    TransferFunction tfHost_;
+    TransferFunctionUpload tf_;
+    std::unique_ptr<cubefan::CubeOctree> octree_;
+    double hierarchyMs_ = 0.0;
+    cl::Buffer texture_;
+    std::uint64_t textureBytes_ = 0;
+    double textureK_ = -1.0;  // the k of the texture on the device; < 0: none yet
+    double textureMs_ = 0.0;
+    raster::Rasterizer rasterizer_;
+    raster::Framebuffer fb_;
+    raster::FragmentProgram fan_, box_;
+    cl::Kernel finish_;
+    std::vector<raster::Vertex> fanVertices_, boxVertices_;  // kept across frames: pages touched once
+    std::uint64_t residentBytes_ = 0;
+};
+
+CubefanRenderer::CubefanRenderer(Device& device, const Scene& scene, const Volume& volume)
+    : device_(device), options_(parseCubefanOptions(scene.options)), image_(scene.image),
+      tfHost_(scene.transferFunction), rasterizer_(device), fb_(device, scene.image.width, scene.image.height)
+{
+    checkGridVolume(volume, "cubefan");
+    if (volume.part)
+        throw InputError(volume.source + ": cubefan renders whole volumes only (no sort-last parts)");
+    camera_ = frameCamera(scene, volume.boundsMin(), volume.boundsMax());
+    lo_ = volume.origin - 0.5 * volume.spacing;
+    hi_ = volume.origin + (glm::dvec3(volume.dims) - 0.5) * volume.spacing;
+    shift_ = 0.5 * (lo_ + hi_);
+    const auto t0 = std::chrono::steady_clock::now();
+    octree_ = std::make_unique<cubefan::CubeOctree>(volume);
+    hierarchyMs_ = msSince(t0);
+    tf_.upload(device_, "cubefan transfer function", tfHost_);
+    residentBytes_ = tf_.bytes();
+    fan_.source = programSource("CLVR_CUBEFAN_FAN");
+    fan_.attributes = 1;  // (l / l_max or alpha, value)
+    box_.source = programSource("CLVR_CUBEFAN_BOX");
+    box_.attributes = 3;  // (0, value), lo, hi
+    finish_ = device_.kernel("slice3d.cl", "slice3d_over_background");
+}
+
+void CubefanRenderer::updateTexture(double k)
+{
+    if (k == textureK_)
+        return;
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::vector<float> texels = expOpacityTexels(options_.textureSize, k);
+    residentBytes_ -= textureBytes_;
+    texture_ = device_.upload("cubefan exp-opacity texture", texels);
+    textureBytes_ = texels.size() * sizeof(float);
+    residentBytes_ += textureBytes_;
+    textureK_ = k;
+    textureMs_ = msSince(t0);
+}
+
+Image4f CubefanRenderer::render(FrameStats& stats)
+{
+    const FrameClock clock;
+    const glm::dvec3 eye = camera_.position, forward = camera_.forward();
+
+    // Selection (§6): the cubes within the tolerance, back to front, transparent ones skipped.
+    auto t0 = std::chrono::steady_clock::now();
+    cubefan::SelectionStats selection;
+    const std::vector<cubefan::Cube> cubes =
+        octree_->select(options_.error, tfHost_, eye, forward, camera_.parallel, &selection);
+    const double selectionMs = msSince(t0);
+
+    // The texture's axes: u = l / l_max over the selected cubes' longest chord, v = tau / tau_max.
+    const double lMax = std::max(selection.largestDiagonal, 1e-30);
+    const double tauMax = std::max(maxExtinction(tfHost_), 1e-30);
+    textureMs_ = 0.0;
+    if (options_.opacity == CubefanOptions::Opacity::Texture && !options_.exactThickness)
+        updateTexture(lMax * tauMax);
+
+    // The projection: eye depth of the field's box sets the clip planes; a cube with a corner at or
+    // behind the near plane is drawn as its back faces in clip space (the raster stage clips them).
+    double depthMax = 0.0;
+    for (int v = 0; v < 8; ++v)
+        depthMax = std::max(depthMax, glm::dot(cornerOf(lo_, hi_, v) - eye, forward));
+    const double nearZ = 1e-4 * depthMax + 1e-9;
+    const double farZ = 2.0 * depthMax + 1.0;
+    cubefan::CubeView view;
+    view.viewProjection = camera_.projectionMatrix(image_.width, image_.height, nearZ, farZ) * camera_.viewMatrix();
+    view.eye = eye;
+    view.forward = forward;
+    view.parallel = camera_.parallel;
+
+    raster::DrawState state;
+    state.fragment.blend.enabled = true;  // back to front, premultiplied: dst = src + (1 - src.alpha) dst
+    state.fragment.blend.srcRgb = raster::BlendFactor::One;
+    state.fragment.blend.dstRgb = raster::BlendFactor::OneMinusSrcAlpha;
+    state.fragment.blend.srcAlpha = raster::BlendFactor::One;
+    state.fragment.blend.dstAlpha = raster::BlendFactor::OneMinusSrcAlpha;
+    ClCubefanUniforms uniforms{};
+    uniforms.camera = toClCamera(camera_, image_.width, image_.height, shift_);
+    const int mode = options_.opacity == CubefanOptions::Opacity::Texture ? CUBEFAN_OPACITY_TEXTURE
+                     : options_.opacity == CubefanOptions::Opacity::Exp   ? CUBEFAN_OPACITY_EXP
+                                                                          : CUBEFAN_OPACITY_LINEAR;
+    uniforms.counts = cl_float4{{static_cast<float>(image_.width), static_cast<float>(image_.height),
+                                 static_cast<float>(tf_.count()), static_cast<float>(mode)}};
+    uniforms.scale = cl_float4{{static_cast<float>(lMax), static_cast<float>(tauMax),
+                                static_cast<float>(options_.textureSize), 0.0f}};
+    for (raster::FragmentProgram* p : {&fan_, &box_}) {
+        p->uniforms = fragmentUniforms(uniforms);
+        p->buffers[1] = tf_.buffer();
+        p->buffers[2] = texture_;
+    }
+    fb_.clearColor(device_, glm::vec4(0.0f));
+
+    double drawMs = 0.0;
+    auto flush = [&](std::vector<raster::Vertex>& vertices, const raster::FragmentProgram& program) {
+        if (vertices.empty())
+            return;
+        const auto d0 = std::chrono::steady_clock::now();
+        rasterizer_.draw(fb_, state, raster::Topology::Triangles, vertices, program);
+        drawMs += msSince(d0);
+        vertices.clear();
+    };
+    fanVertices_.clear();
+    boxVertices_.clear();
+    std::uint64_t culled = 0, nearCubes = 0, boxCubes = 0, triangles = 0;
+    std::array<std::uint64_t, 4> byKind{};
+    t0 = std::chrono::steady_clock::now();
+    for (const cubefan::Cube& cube : cubes) {
+        std::array<glm::dvec4, 8> clip;
+        std::array<glm::dvec2, 8> ndc;
+        int behind = 0, out[4] = {0, 0, 0, 0};
+        for (int v = 0; v < 8; ++v) {
+            const glm::dvec3 p = cornerOf(cube.lo, cube.hi, v);
+            clip[v] = view.viewProjection * glm::dvec4(p, 1.0);
+            behind += glm::dot(p - eye, forward) <= nearZ ? 1 : 0;
+            out[0] += clip[v].x > clip[v].w;
+            out[1] += clip[v].x < -clip[v].w;
+            out[2] += clip[v].y > clip[v].w;
+            out[3] += clip[v].y < -clip[v].w;
+        }
+        if (behind == 8 || (behind == 0 && (out[0] == 8 || out[1] == 8 || out[2] == 8 || out[3] == 8))) {
+            ++culled;  // wholly behind the near plane, or beside the view
+            continue;
+        }
+        cubefan::ProjectedCube projected;
+        if (behind == 0 && !options_.exactThickness) {
+            for (int v = 0; v < 8; ++v)  // float, as the raster stage takes them: neighbours share the bits
+                ndc[v] = glm::dvec2(glm::vec2(static_cast<float>(clip[v].x / clip[v].w), static_cast<float>(clip[v].y / clip[v].w)));
+            projected = cubefan::projectCube(view, cube.lo, cube.hi, ndc);
+        }
+        if (projected.triangleCount == 0) {
+            // At the near plane (or holding the eye), or exact thickness: its back faces in clip space, the
+            // chord per fragment. Every ray through the cube in front of the eye leaves it by one back face.
+            flush(fanVertices_, fan_);
+            nearCubes += behind > 0 ? 1 : 0;
+            ++boxCubes;
+            raster::Vertex vertex;
+            vertex.attributes[0] = glm::vec4(0.0f, cube.value, 0.0f, 0.0f);
+            vertex.attributes[1] = glm::vec4(glm::vec3(cube.lo - shift_), 0.0f);
+            vertex.attributes[2] = glm::vec4(glm::vec3(cube.hi - shift_), 0.0f);
+            for (int f = 0; f < 6; ++f) {
+                const int axis = f / 2;
+                const double normal = (f & 1) ? 1.0 : -1.0;  // outward along the axis
+                const double plane = (f & 1) ? cube.hi[axis] : cube.lo[axis];
+                const double towardsEye = camera_.parallel ? -forward[axis] * normal : (eye[axis] - plane) * normal;
+                if (towardsEye > 0.0)
+                    continue;  // a front face
+                const int* q = kFaceCorners[f];
+                for (const int k : {q[0], q[1], q[2], q[0], q[2], q[3]}) {
+                    vertex.position = glm::vec4(clip[k]);
+                    boxVertices_.push_back(vertex);
+                }
+                triangles += 2;
+            }
+            continue;
+        }
+        flush(boxVertices_, box_);
+        ++byKind[static_cast<int>(projected.kind)];
+        const double tau = tfHost_(cube.value).a;
+        for (int k = 0; k < projected.triangleCount; ++k)
+            for (const int i : projected.triangles[k]) {
+                raster::Vertex vertex;
+                vertex.position = glm::vec4(static_cast<float>(projected.ndc[i].x), static_cast<float>(projected.ndc[i].y), 0.0f, 1.0f);
+                const double l = projected.thickness[i];
+                const double a = options_.opacity == CubefanOptions::Opacity::Linear ? -std::expm1(-tau * l) : l / lMax;
+                vertex.attributes[0] = glm::vec4(static_cast<float>(a), cube.value, 0.0f, 0.0f);
+                fanVertices_.push_back(vertex);
+            }
+        triangles += projected.triangleCount;
+        if (fanVertices_.size() >= kBatchVertices)
+            flush(fanVertices_, fan_);
+    }
+    flush(fanVertices_, fan_);
+    flush(boxVertices_, box_);
+    const double projectMs = msSince(t0) - drawMs;
+
+    const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
+    ClSlice3dOverBackgroundParams finish{};
+    finish.background = toCl4(image_.background);
+    finish.count = static_cast<cl_int>(pixels);
+    finish_.setArg(0, fb_.color());
+    finish_.setArg(1, finish);
+    device_.launch("cubefan: over background", finish_, pixels);
+    Image4f image = readImage(device_, fb_.color(), image_.width, image_.height);
+    const raster::DrawStats drawn = rasterizer_.takeStats();
+
+    std::vector<PassTime> hostPasses = {{"cubefan: selection (host)", selectionMs},
+                                        {"cubefan: classification and projection (host)", projectMs},
+                                        {"cubefan: raster set-up and binning (host)", drawMs}};
+    if (textureMs_ > 0.0)
+        hostPasses.push_back({"cubefan: exp-opacity texture (host)", textureMs_});
+    finishFrame(device_, clock, stats, std::move(hostPasses));
+    stats.extra["resident_bytes"] = residentBytes_;
+    stats.extra["error"] = options_.error;
+    stats.extra["opacity"] = options_.exactThickness ? "exp" : opacityName(options_.opacity);
+    stats.extra["thickness"] = options_.exactThickness ? "exact" : "interpolated";
+    stats.extra["cubes_as_back_faces"] = boxCubes;
+    stats.extra["hierarchy_ms"] = hierarchyMs_;
+    stats.extra["hierarchy_levels"] = octree_->levels();
+    stats.extra["selection_ms"] = selectionMs;
+    stats.extra["selection_visited"] = selection.visited;
+    stats.extra["cubes"] = selection.selected;
+    stats.extra["cubes_transparent"] = selection.transparent;
+    stats.extra["cubes_culled"] = culled;
+    stats.extra["cubes_near_plane"] = nearCubes;
+    stats.extra["cubes_class1"] = byKind[0];
+    stats.extra["cubes_class2"] = byKind[1];
+    stats.extra["cubes_class3a"] = byKind[2];
+    stats.extra["cubes_class3b"] = byKind[3];
+    stats.extra["triangles"] = triangles;
+    stats.extra["projection_ms"] = projectMs;
+    stats.extra["l_max"] = lMax;
+    stats.extra["tau_max"] = tauMax;
+    if (options_.opacity == CubefanOptions::Opacity::Texture && !options_.exactThickness)
+        stats.extra["texture"] = std::to_string(options_.textureSize) + "x" + std::to_string(options_.textureSize);
+    stats.extra["raster_triangles"] = drawn.triangles;
+    stats.extra["raster_fragments"] = drawn.fragments;
+    return image;
+}
+
+}  // namespace
+
+TechniqueInfo cubefanTechnique()
+{
+    TechniqueInfo t;
+    t.name = "cubefan";
+    t.data = DataKind::Volume;
+    t.description = "octree cubes projected as triangle fans with an exp-opacity texture (Schussman-Max, docs/cubefan.md)";
+    t.options = {
+        {"error", 0.0, "", "error tolerance, a fraction of the data range: cubes merge while every voxel is within it"},
+        {"opacity", "texture", "",
+         "\"texture\" (the exp-opacity texture of the interpolated thickness), \"exp\" (the exponential per "
+         "fragment) or \"linear\" (per-vertex opacity interpolated, Shirley-Tuchman)"},
+        {"texture_size", 512, "", "texels per axis of the exp-opacity texture"},
+        {"thickness", "interpolated", "",
+         "\"interpolated\" (at the fans' vertices, across each triangle: seeds/002 §7) or \"exact\" (each "
+         "fragment's own chord through its cube, drawn as back faces)"},
+    };
+    t.makeForVolume = [](Device& device, const Scene& scene, const Volume& volume) -> std::unique_ptr<Renderer> {
+        return makeCubefanRenderer(device, scene, volume);
+    };
+    return t;
+}
+
+CubefanOptions parseCubefanOptions(const nlohmann::json& options)
+{
+    static const TechniqueInfo& info = technique("cubefan");
+    CubefanOptions o;
+    forEachOption(options, info, [&](const std::string& key, const nlohmann::json& value) {
+        if (key == "error") {
+            o.error = numberOption(key, value, [](double x) { return x >= 0.0 && x <= 1.0; }, "a number in [0, 1]");
+        } else if (key == "opacity") {
+            const std::string s = value.is_string() ? value.get<std::string>() : "";
+            if (s == "texture")
+                o.opacity = CubefanOptions::Opacity::Texture;
+            else if (s == "exp")
+                o.opacity = CubefanOptions::Opacity::Exp;
+            else if (s == "linear")
+                o.opacity = CubefanOptions::Opacity::Linear;
+            else
+                badOption(key, "must be \"texture\", \"exp\" or \"linear\", got " + value.dump());
+        } else if (key == "thickness") {
+            const std::string s = value.is_string() ? value.get<std::string>() : "";
+            if (s != "interpolated" && s != "exact")
+                badOption(key, "must be \"interpolated\" or \"exact\", got " + value.dump());
+            o.exactThickness = s == "exact";
+        } else if (key == "texture_size") {
+            o.textureSize = integerOption(key, value, 2, 4096);
+        } else {
+            unparsedOption(info, key);
+        }
+    });
+    return o;
+}
+
+std::unique_ptr<Renderer> makeCubefanRenderer(Device& device, const Scene& scene, const Volume& volume)
+{
+    return std::make_unique<CubefanRenderer>(device, scene, volume);
+}
+
+}  // namespace clvr

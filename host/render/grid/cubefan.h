@@ -1,0 +1,58 @@
+// host/render/grid/cubefan.h — hierarchical perspective volume rendering with triangle fans (seeds/002,
+// Schussman & Max 2001). A regular grid becomes an octree of cubes (cube_octree.h: one cube per voxel,
+// merged where the error tolerance allows); per frame the cubes within the tolerance are selected back
+// to front, each is classified and projected as its class's fans and strips with the thickness l at
+// every vertex (cube_fans.h), and all are drawn in that order through the raster stage
+// (raster/rasterizer.h) with kernels/cubefan.cl's fragment program: alpha from the exp-opacity texture
+// 1 - exp(-u v) at (l, tau) (§7), color C alpha, blended ONE, ONE_MINUS_SRC_ALPHA. docs/cubefan.md.
+#pragma once
+
+#include "host/model/transfer_function.h"
+#include "host/render/renderer.h"
+
+#include <nlohmann/json.hpp>
+
+#include <memory>
+#include <vector>
+
+namespace clvr {
+
+struct CubefanOptions {
+    // Error tolerance as a fraction of the data range: a cube of the octree is drawn whole when every
+    // voxel below it is within error * (max - min) of its mean (0: every voxel its own cube).
+    double error = 0.0;
+    // How a fragment gets its opacity: "texture" (§7: the exp-opacity texture looked up with the
+    // interpolated thickness), "exp" (1 - exp(-tau l) of the interpolated thickness per fragment: the
+    // texture without its table error) or "linear" (each vertex's opacity interpolated, Shirley-Tuchman).
+    enum class Opacity { Texture, Exp, Linear };
+    Opacity opacity = Opacity::Texture;
+    int textureSize = 512;  // texels per axis of the exp-opacity texture
+    // "interpolated" (§7): the thickness at the fans' vertices, interpolated across each triangle (exact
+    // for parallel projection); "exact": every cube drawn as its back faces, each fragment intersecting
+    // its own ray with the cube (the chord exact in perspective too; opacity 1 - exp(-tau l) per fragment,
+    // so `opacity` does not apply). Cubes at the near plane are drawn that way in either mode.
+    bool exactThickness = false;
+};
+
+const char* opacityName(CubefanOptions::Opacity opacity);
+
+// Its registry entry (host/render/renderer.h).
+TechniqueInfo cubefanTechnique();
+
+// Reads the scene's "options" for cubefan: "error" (a number in [0, 1]), "opacity" ("texture" | "exp" |
+// "linear"), "texture_size" (an integer in [2, 4096]), "thickness" ("interpolated" | "exact"). InputError naming the key otherwise.
+CubefanOptions parseCubefanOptions(const nlohmann::json& options);
+
+// The exp-opacity texture of §7, N x N floats, x fastest: texel (i, j) = 1 - exp(-k u v) with
+// u = i / (N - 1), v = j / (N - 1). With k = l_max tau_max, texel (u, v) is the opacity of a chord of
+// length u l_max through extinction v tau_max.
+std::vector<float> expOpacityTexels(int size, double k);
+
+// The largest extinction the transfer function reaches (at a control point: it is piecewise linear).
+double maxExtinction(const TransferFunction& tf);
+
+// Renderer for "cubefan". Builds the octree at set-up (its time is stats' hierarchy_ms); the volume
+// itself never goes to the device. InputError for bad options.
+std::unique_ptr<Renderer> makeCubefanRenderer(Device& device, const Scene& scene, const Volume& volume);
+
+}  // namespace clvr

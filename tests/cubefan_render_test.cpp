@@ -1,0 +1,226 @@
+// tests/cubefan_render_test.cpp — the cubefan renderer (host/render/grid/cubefan.h) against the exact
+// integral of the piecewise-constant cube field (host/reference/cube_reference.h): error 0 in
+// perspective and parallel, the eye inside the volume, the three opacity modes, and the image error of
+// the hierarchy as a function of the tolerance.
+#include "host/render/grid/cubefan.h"
+
+#include "host/io/generators.h"
+#include "host/reference/cube_reference.h"
+#include "host/runtime/errors.h"
+#include "tests/support/test_util.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+namespace clvr {
+namespace {
+
+using nlohmann::json;
+
+Scene makeScene(const Camera& camera, const TransferFunction& tf, int size, json options = json::object())
+{
+    Scene s;
+    s.technique = "cubefan";
+    s.camera = camera;
+    s.image = ImageSpec{size, size, {0.1, 0.2, 0.3}};
+    s.transferFunction = tf;
+    s.options = std::move(options);
+    return s;
+}
+
+Image4f render(const Scene& scene, const Volume& volume, FrameStats* statsOut = nullptr)
+{
+    FrameStats stats;
+    Image4f image = makeCubefanRenderer(test::device(), scene, volume)->render(stats);
+    if (statsOut)
+        *statsOut = stats;
+    return image;
+}
+
+double worst(const glm::dvec4& v) { return std::max(std::max(v.r, v.g), std::max(v.b, v.a)); }
+
+test::ImageError printError(const std::string& what, const Image4f& actual, const Image4d& expected)
+{
+    const test::ImageError e = test::imageError(actual, expected);
+    std::printf("%s: max |error| %.2e, mean %.2e\n", what.c_str(), worst(e.maxAbs), worst(e.meanAbs));
+    return e;
+}
+
+// Marschner-Lobb on 20^3 points in [-1, 1]^3 (cubes of 0.105), DESIGN.md's transfer function with tau
+// up to 8: optical depths up to 1.5 per cube, so the cubes' exponentials are far from linear.
+Volume smallVolume() { return generateVolume("marschner-lobb", {20, 20, 20}); }
+
+std::uint64_t count(const FrameStats& s, const char* key) { return s.extra[key].get<std::uint64_t>(); }
+
+TEST(CubefanOptions, ParsesAndRejects)
+{
+    const CubefanOptions o = parseCubefanOptions({{"error", 0.18}, {"opacity", "linear"}, {"texture_size", 64}});
+    EXPECT_EQ(o.error, 0.18);
+    EXPECT_EQ(o.opacity, CubefanOptions::Opacity::Linear);
+    EXPECT_EQ(o.textureSize, 64);
+    EXPECT_EQ(parseCubefanOptions({{"opacity", "exp"}}).opacity, CubefanOptions::Opacity::Exp);
+    EXPECT_TRUE(parseCubefanOptions({{"thickness", "exact"}}).exactThickness);
+    EXPECT_FALSE(parseCubefanOptions({{"thickness", "interpolated"}}).exactThickness);
+    for (const json& bad : {json{{"error", -0.1}}, json{{"error", 1.5}}, json{{"error", "0.1"}}, json{{"thickness", 1}},
+                            json{{"opacity", "gouraud"}}, json{{"texture_size", 1}}, json{{"texture_size", 1e4}}})
+        EXPECT_THROW(parseCubefanOptions(bad), InputError) << bad.dump();
+}
+
+TEST(CubefanTexture, TexelsHoldOneMinusExpOfTheProduct)
+{
+    const int n = 9;
+    const double k = 7.5;
+    const std::vector<float> t = expOpacityTexels(n, k);
+    ASSERT_EQ(t.size(), 81u);
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i)
+            EXPECT_NEAR(t[j * n + i], 1.0 - std::exp(-k * (i / 8.0) * (j / 8.0)), 1e-7) << i << "," << j;
+    EXPECT_EQ(t[0], 0.0f);
+    EXPECT_EQ(t[8], 0.0f);  // v = 0: no extinction, no opacity at any length
+}
+
+// Error 0: every voxel is its own cube (or a merged cube of equal voxels), so the image is the cube
+// field's exact integral up to the thickness's linear interpolation across each triangle (exact for
+// parallel projection, §7), the 512^2 texture's bilinear error and float rounding. The largest errors
+// (a few pixels in 4096 over 1e-3) sit on the volume's silhouette, where faces seen edge-on project to
+// slivers a small fraction of a pixel wide and the raster stage's 1/256-pixel vertex snapping moves
+// their thickness gradient by a few per cent; the mean stays at 1e-4.
+TEST(CubefanRenderer, ErrorZeroMatchesTheExactCubeFieldIntegral)
+{
+    const Volume volume = smallVolume();
+    const TransferFunction tf = test::designTransferFunction();
+    for (const bool parallel : {false, true}) {
+        const Camera camera = parallel ? test::obliqueParallelCamera(1.3) : test::obliquePerspectiveCamera(30.0);
+        const std::string view = parallel ? "parallel" : "perspective";
+        const Image4d expected = cubeFieldIntegral(volume, tf, camera, makeScene(camera, tf, 64).image);
+        double errorOf[4] = {0, 0, 0, 0};
+        int m = 0;
+        for (const char* opacity : {"texture", "exp", "linear", "exact thickness"}) {
+            const bool exact = std::string(opacity) == "exact thickness";
+            const json options = exact ? json{{"thickness", "exact"}} : json{{"opacity", opacity}};
+            FrameStats stats;
+            const Image4f image = render(makeScene(camera, tf, 64, options), volume, &stats);
+            const test::ImageError e = printError(view + ", " + opacity, image, expected);
+            errorOf[m++] = worst(e.maxAbs);
+            EXPECT_EQ(e.nanCount, 0u);
+            EXPECT_EQ(count(stats, "cubes_near_plane"), 0u);
+            EXPECT_EQ(count(stats, "cubes_class1") + count(stats, "cubes_class2") + count(stats, "cubes_class3a") +
+                          count(stats, "cubes_class3b") + count(stats, "cubes_as_back_faces") + count(stats, "cubes_culled"),
+                      count(stats, "cubes"));
+            EXPECT_EQ(count(stats, "cubes_as_back_faces") == count(stats, "cubes") - count(stats, "cubes_culled"), exact);
+            if (exact)  // the chord per fragment: float rounding only
+                EXPECT_TRUE(test::imagesNear(image, expected, {.maxAbs = 5e-4, .meanAbs = 1e-5})) << view;
+            if (std::string(opacity) != "linear")
+                EXPECT_TRUE(test::imagesNear(image, expected, {.maxAbs = 1e-2, .meanAbs = 4e-4})) << view << ", " << opacity;
+        }
+        // Linear opacity across a cube whose optical depth reaches 1.5 is visibly wrong (§7).
+        EXPECT_GT(errorOf[2], 5.0 * errorOf[0]) << view;
+        // The texture is what the fragments read: at 512^2 (k = l_max tau_max = 1.5 here) it is the
+        // exponential to 1e-5; at 4^2 its bilinear error shows.
+        const Image4f exp = render(makeScene(camera, tf, 64, {{"opacity", "exp"}}), volume);
+        Image4d expD(64, 64);
+        const Image4f texture = render(makeScene(camera, tf, 64), volume);
+        const Image4f coarse = render(makeScene(camera, tf, 64, {{"texture_size", 4}}), volume);
+        for (int y = 0; y < 64; ++y)
+            for (int x = 0; x < 64; ++x)
+                expD.at(x, y) = glm::dvec4(exp.at(x, y));
+        const double tableError = worst(test::imageError(texture, expD).maxAbs);
+        const double coarseError = worst(test::imageError(coarse, expD).maxAbs);
+        std::printf("%s: texture 512^2 vs exp %.2e, 4^2 vs exp %.2e\n", view.c_str(), tableError, coarseError);
+        EXPECT_LT(tableError, 1e-5) << view;
+        EXPECT_GT(coarseError, 1e-3) << view;
+    }
+}
+
+// The eye inside the volume: the cubes at the near plane (the one holding the eye among them) are drawn as
+// their back faces with the chord per fragment; cubes behind the eye or beside the view are culled. With
+// exact thickness every cube takes that path, so the bound is the far view's. With the fans the cubes
+// close to the eye cover many pixels, and across them the screen-linear thickness departs from the
+// perspective chord (§7's approximation: the template test prints it): a looser bound.
+TEST(CubefanRenderer, EyeInsideTheVolume)
+{
+    const Volume volume = smallVolume();
+    const TransferFunction tf = test::designTransferFunction(2.0);
+    Camera camera;
+    camera.position = {0.13, -0.07, 0.41};
+    camera.focalPoint = {0.3, 0.2, -1.0};
+    camera.viewAngle = 70.0;
+    const Image4d expected = cubeFieldIntegral(volume, tf, camera, makeScene(camera, tf, 64).image);
+    for (const bool exact : {true, false}) {
+        const Scene scene = makeScene(camera, tf, 64, {{"thickness", exact ? "exact" : "interpolated"}});
+        FrameStats stats;
+        const Image4f image = render(scene, volume, &stats);
+        const std::string what = exact ? "eye inside, exact thickness" : "eye inside, fans";
+        printError(what, image, expected);
+        std::printf("%s: %llu cubes, %llu at the near plane, %llu culled\n", what.c_str(),
+                    static_cast<unsigned long long>(count(stats, "cubes")),
+                    static_cast<unsigned long long>(count(stats, "cubes_near_plane")),
+                    static_cast<unsigned long long>(count(stats, "cubes_culled")));
+        EXPECT_GT(count(stats, "cubes_near_plane"), 0u);
+        EXPECT_GT(count(stats, "cubes_culled"), count(stats, "cubes") / 4);
+        if (exact)
+            EXPECT_TRUE(test::imagesNear(image, expected, {.maxAbs = 2e-3, .meanAbs = 2e-4})) << what;
+        else
+            EXPECT_TRUE(test::imagesNear(image, expected, {.maxAbs = 2e-2, .meanAbs = 3e-3})) << what;
+    }
+}
+
+// With a tolerance the octree merges cubes: fewer cubes and triangles, and an image error against the
+// full-resolution cube field that grows with the tolerance (printed as a table, docs/cubefan.md).
+TEST(CubefanRenderer, ToleranceTradesCubesForError)
+{
+    const Volume volume = generateVolume("marschner-lobb", {33, 33, 33});
+    const TransferFunction tf = test::designTransferFunction();
+    const Camera camera = test::obliquePerspectiveCamera(30.0);
+    const Scene base = makeScene(camera, tf, 64);
+    const Image4d expected = cubeFieldIntegral(volume, tf, camera, base.image);
+    std::uint64_t lastCubes = 0, lastTriangles = 0;
+    double errorAtZero = 0.0;
+    std::printf("error tolerance | cubes | triangles | max |error| | mean |error|\n");
+    for (const double tolerance : {0.0, 0.05, 0.1, 0.2, 0.4}) {
+        FrameStats stats;
+        const Image4f image = render(makeScene(camera, tf, 64, {{"error", tolerance}}), volume, &stats);
+        const test::ImageError e = test::imageError(image, expected);
+        const std::uint64_t cubes = count(stats, "cubes"), triangles = count(stats, "triangles");
+        std::printf("%.2f | %llu | %llu | %.3e | %.3e\n", tolerance, static_cast<unsigned long long>(cubes),
+                    static_cast<unsigned long long>(triangles), worst(e.maxAbs), worst(e.meanAbs));
+        EXPECT_EQ(e.nanCount, 0u);
+        if (tolerance == 0.0) {
+            errorAtZero = worst(e.meanAbs);
+            EXPECT_TRUE(test::imagesNear(image, expected, {.maxAbs = 1e-2, .meanAbs = 4e-4}));
+        } else {
+            EXPECT_LT(cubes, lastCubes) << tolerance;
+            EXPECT_LT(triangles, lastTriangles) << tolerance;
+            EXPECT_GT(worst(e.meanAbs), 10.0 * errorAtZero) << tolerance;  // merged cubes: visibly coarser
+        }
+        lastCubes = cubes;
+        lastTriangles = triangles;
+    }
+}
+
+TEST(CubefanRenderer, IdenticalBitsTwiceAndAfterATransferFunctionEdit)
+{
+    const Volume volume = smallVolume();
+    const Camera camera = test::obliquePerspectiveCamera(30.0);
+    const Scene scene = makeScene(camera, test::designTransferFunction(), 48, {{"error", 0.1}});
+    auto renderer = makeCubefanRenderer(test::device(), scene, volume);
+    FrameStats stats;
+    const Image4f a = renderer->render(stats);
+    const Image4f b = renderer->render(stats);
+    EXPECT_TRUE(a.pixels() == b.pixels());
+    // A new transfer function changes tau_max (the texture's k) and the transparent cubes.
+    const TransferFunction other = test::designTransferFunction(20.0);
+    renderer->setTransferFunction(other);
+    const Image4f edited = renderer->render(stats);
+    Scene fresh = scene;
+    fresh.transferFunction = other;
+    EXPECT_TRUE(edited.pixels() == render(fresh, volume).pixels());
+    EXPECT_FALSE(edited.pixels() == a.pixels());
+}
+
+}  // namespace
+}  // namespace clvr
