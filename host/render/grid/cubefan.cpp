@@ -13,6 +13,7 @@
 #include "host/render/transfer_function_upload.h"
 #include "host/runtime/embedded_kernels.h"
 #include "host/runtime/errors.h"
+#include "host/runtime/parallel.h"
 #include "kernels/cubefan_params.h"
 #include "kernels/slice3d_params.h"  // ClSlice3dOverBackgroundParams: the last pass is slice3d's
 #include "raster/framebuffer.h"
@@ -21,6 +22,7 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <future>
 #include <cmath>
 #include <string>
 
@@ -74,6 +76,129 @@ glm::dvec3 cornerOf(const glm::dvec3& lo, const glm::dvec3& hi, int v)
 // The six faces as corner quadruples (v = x + 2y + 4z), in cyclic order; face f is 0 -x, 1 +x, ... 5 +z.
 constexpr int kFaceCorners[6][4] = {{0, 2, 6, 4}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 5, 7, 6}};
 
+// What projecting a run of cubes needs, shared read-only by the worker thread.
+struct ProjectionContext {
+    cubefan::CubeView view;
+    glm::dvec3 eye, forward;
+    bool parallel;
+    CubefanOptions options;
+    glm::dvec3 shift;
+    double lMax, nearZ;
+    const TransferFunction* tf;
+};
+
+// Vertices for one fragment program, in the cubes' order.
+struct VertexRun {
+    bool box = false;  // the back-face program (CLVR_CUBEFAN_BOX), else the fans'
+    std::vector<raster::Vertex> vertices;
+};
+
+// One chunk of cubes projected: its runs (the vectors are kept and reused, runCount of them in use) and counts.
+struct ProjectedChunk {
+    std::vector<VertexRun> runs;
+    std::size_t runCount = 0;
+    std::uint64_t culled = 0, nearCubes = 0, boxCubes = 0, triangles = 0;
+    std::array<std::uint64_t, 4> byKind{};
+    double ms = 0.0;
+    void add(const ProjectedChunk& c)
+    {
+        culled += c.culled;
+        nearCubes += c.nearCubes;
+        boxCubes += c.boxCubes;
+        triangles += c.triangles;
+        for (int k = 0; k < 4; ++k)
+            byKind[k] += c.byKind[k];
+    }
+};
+
+// The vertices of cubes [begin, end): culled when wholly behind the near plane or beside the view; at the
+// near plane (or with exact thickness) the back faces in clip space with the box as attributes; else the
+// class's fans with the thickness (or, linear opacity, the opacity) at every vertex.
+void projectCubes(const ProjectionContext& c, const cubefan::Cube* begin, const cubefan::Cube* end, ProjectedChunk& out)
+{
+    out.runCount = 0;
+    out.culled = out.nearCubes = out.boxCubes = out.triangles = 0;
+    out.byKind = {};
+    auto run = [&](bool box) -> std::vector<raster::Vertex>& {
+        if (out.runCount == 0 || out.runs[out.runCount - 1].box != box) {
+            if (out.runs.size() == out.runCount)
+                out.runs.emplace_back();
+            out.runs[out.runCount].box = box;
+            out.runs[out.runCount].vertices.clear();
+            ++out.runCount;
+        }
+        return out.runs[out.runCount - 1].vertices;
+    };
+    const bool linear = c.options.opacity == CubefanOptions::Opacity::Linear;
+    for (const cubefan::Cube* cube = begin; cube != end; ++cube) {
+        std::array<glm::dvec4, 8> clip;
+        std::array<glm::dvec2, 8> ndc;
+        int behind = 0, out4[4] = {0, 0, 0, 0};
+        for (int v = 0; v < 8; ++v) {
+            const glm::dvec3 p = cornerOf(cube->lo, cube->hi, v);
+            clip[v] = c.view.viewProjection * glm::dvec4(p, 1.0);
+            behind += glm::dot(p - c.eye, c.forward) <= c.nearZ ? 1 : 0;
+            out4[0] += clip[v].x > clip[v].w;
+            out4[1] += clip[v].x < -clip[v].w;
+            out4[2] += clip[v].y > clip[v].w;
+            out4[3] += clip[v].y < -clip[v].w;
+        }
+        if (behind == 8 || (behind == 0 && (out4[0] == 8 || out4[1] == 8 || out4[2] == 8 || out4[3] == 8))) {
+            ++out.culled;  // wholly behind the near plane, or beside the view
+            continue;
+        }
+        cubefan::ProjectedCube projected;
+        if (behind == 0 && !c.options.exactThickness) {
+            for (int v = 0; v < 8; ++v)  // float, as the raster stage takes them: neighbours share the bits
+                ndc[v] = glm::dvec2(glm::vec2(static_cast<float>(clip[v].x / clip[v].w), static_cast<float>(clip[v].y / clip[v].w)));
+            projected = cubefan::projectCube(c.view, cube->lo, cube->hi, ndc);
+        }
+        if (projected.triangleCount == 0) {
+            // At the near plane (or holding the eye), or exact thickness: its back faces in clip space, the
+            // chord per fragment. Every ray through the cube in front of the eye leaves it by one back face.
+            out.nearCubes += behind > 0 ? 1 : 0;
+            ++out.boxCubes;
+            std::vector<raster::Vertex>& vertices = run(true);
+            raster::Vertex vertex;
+            vertex.attributes[0] = glm::vec4(0.0f, cube->value, 0.0f, 0.0f);
+            vertex.attributes[1] = glm::vec4(glm::vec3(cube->lo - c.shift), 0.0f);
+            vertex.attributes[2] = glm::vec4(glm::vec3(cube->hi - c.shift), 0.0f);
+            for (int f = 0; f < 6; ++f) {
+                const int axis = f / 2;
+                const double normal = (f & 1) ? 1.0 : -1.0;  // outward along the axis
+                const double plane = (f & 1) ? cube->hi[axis] : cube->lo[axis];
+                const double towardsEye = c.parallel ? -c.forward[axis] * normal : (c.eye[axis] - plane) * normal;
+                if (towardsEye > 0.0)
+                    continue;  // a front face
+                const int* q = kFaceCorners[f];
+                for (const int k : {q[0], q[1], q[2], q[0], q[2], q[3]}) {
+                    vertex.position = glm::vec4(clip[k]);
+                    vertices.push_back(vertex);
+                }
+                out.triangles += 2;
+            }
+            continue;
+        }
+        ++out.byKind[static_cast<int>(projected.kind)];
+        std::vector<raster::Vertex>& vertices = run(false);
+        const double tau = linear ? (*c.tf)(cube->value).a : 0.0;
+        std::array<glm::vec4, 10> position, attribute;
+        for (int i = 0; i < projected.vertexCount; ++i) {
+            position[i] = glm::vec4(static_cast<float>(projected.ndc[i].x), static_cast<float>(projected.ndc[i].y), 0.0f, 1.0f);
+            const double l = projected.thickness[i];
+            attribute[i] = glm::vec4(static_cast<float>(linear ? -std::expm1(-tau * l) : l / c.lMax), cube->value, 0.0f, 0.0f);
+        }
+        raster::Vertex vertex;
+        for (int k = 0; k < projected.triangleCount; ++k)
+            for (const int i : projected.triangles[k]) {
+                vertex.position = position[i];
+                vertex.attributes[0] = attribute[i];
+                vertices.push_back(vertex);
+            }
+        out.triangles += projected.triangleCount;
+    }
+}
+
 class CubefanRenderer final : public Renderer {
 public:
     CubefanRenderer(Device& device, const Scene& scene, const Volume& volume);
@@ -106,7 +231,7 @@ private:
     raster::Framebuffer fb_;
     raster::FragmentProgram fan_, box_;
     cl::Kernel finish_;
-    std::vector<raster::Vertex> fanVertices_, boxVertices_;  // kept across frames: pages touched once
+    std::array<ProjectedChunk, 2> chunks_;  // the chunk being drawn and the next; kept: pages touched once
     std::uint64_t residentBytes_ = 0;
 };
 
@@ -201,88 +326,39 @@ Image4f CubefanRenderer::render(FrameStats& stats)
     }
     fb_.clearColor(device_, glm::vec4(0.0f));
 
-    double drawMs = 0.0;
-    auto flush = [&](std::vector<raster::Vertex>& vertices, const raster::FragmentProgram& program) {
-        if (vertices.empty())
-            return;
-        const auto d0 = std::chrono::steady_clock::now();
-        rasterizer_.draw(fb_, state, raster::Topology::Triangles, vertices, program);
-        drawMs += msSince(d0);
-        vertices.clear();
+    // Projection in chunks on a worker thread, one chunk ahead of the drawing (the raster stage's set-up
+    // and binning, on this thread): chunk k + 1 is projected while chunk k is drawn. Each chunk is runs of
+    // vertices for one program (fans, or back faces), in the cubes' order.
+    ProjectionContext context{view, eye, forward, camera_.parallel, options_, shift_, lMax, nearZ, &tfHost_};
+    const std::size_t chunkCubes = kBatchVertices / 36;  // a class-1 to -3 cube has at most 36 vertices
+    const std::size_t chunkCount = (cubes.size() + chunkCubes - 1) / chunkCubes;
+    auto project = [&](std::size_t k) {
+        const auto p0 = std::chrono::steady_clock::now();
+        const std::size_t begin = k * chunkCubes, end = std::min(cubes.size(), begin + chunkCubes);
+        projectCubes(context, cubes.data() + begin, cubes.data() + end, chunks_[k % 2]);
+        chunks_[k % 2].ms = msSince(p0);
     };
-    fanVertices_.clear();
-    boxVertices_.clear();
-    std::uint64_t culled = 0, nearCubes = 0, boxCubes = 0, triangles = 0;
-    std::array<std::uint64_t, 4> byKind{};
+    const bool threaded = threadBudget() >= 2 && chunkCount > 1;
+    double drawMs = 0.0, projectMs = 0.0;
+    ProjectedChunk total;
     t0 = std::chrono::steady_clock::now();
-    for (const cubefan::Cube& cube : cubes) {
-        std::array<glm::dvec4, 8> clip;
-        std::array<glm::dvec2, 8> ndc;
-        int behind = 0, out[4] = {0, 0, 0, 0};
-        for (int v = 0; v < 8; ++v) {
-            const glm::dvec3 p = cornerOf(cube.lo, cube.hi, v);
-            clip[v] = view.viewProjection * glm::dvec4(p, 1.0);
-            behind += glm::dot(p - eye, forward) <= nearZ ? 1 : 0;
-            out[0] += clip[v].x > clip[v].w;
-            out[1] += clip[v].x < -clip[v].w;
-            out[2] += clip[v].y > clip[v].w;
-            out[3] += clip[v].y < -clip[v].w;
-        }
-        if (behind == 8 || (behind == 0 && (out[0] == 8 || out[1] == 8 || out[2] == 8 || out[3] == 8))) {
-            ++culled;  // wholly behind the near plane, or beside the view
-            continue;
-        }
-        cubefan::ProjectedCube projected;
-        if (behind == 0 && !options_.exactThickness) {
-            for (int v = 0; v < 8; ++v)  // float, as the raster stage takes them: neighbours share the bits
-                ndc[v] = glm::dvec2(glm::vec2(static_cast<float>(clip[v].x / clip[v].w), static_cast<float>(clip[v].y / clip[v].w)));
-            projected = cubefan::projectCube(view, cube.lo, cube.hi, ndc);
-        }
-        if (projected.triangleCount == 0) {
-            // At the near plane (or holding the eye), or exact thickness: its back faces in clip space, the
-            // chord per fragment. Every ray through the cube in front of the eye leaves it by one back face.
-            flush(fanVertices_, fan_);
-            nearCubes += behind > 0 ? 1 : 0;
-            ++boxCubes;
-            raster::Vertex vertex;
-            vertex.attributes[0] = glm::vec4(0.0f, cube.value, 0.0f, 0.0f);
-            vertex.attributes[1] = glm::vec4(glm::vec3(cube.lo - shift_), 0.0f);
-            vertex.attributes[2] = glm::vec4(glm::vec3(cube.hi - shift_), 0.0f);
-            for (int f = 0; f < 6; ++f) {
-                const int axis = f / 2;
-                const double normal = (f & 1) ? 1.0 : -1.0;  // outward along the axis
-                const double plane = (f & 1) ? cube.hi[axis] : cube.lo[axis];
-                const double towardsEye = camera_.parallel ? -forward[axis] * normal : (eye[axis] - plane) * normal;
-                if (towardsEye > 0.0)
-                    continue;  // a front face
-                const int* q = kFaceCorners[f];
-                for (const int k : {q[0], q[1], q[2], q[0], q[2], q[3]}) {
-                    vertex.position = glm::vec4(clip[k]);
-                    boxVertices_.push_back(vertex);
-                }
-                triangles += 2;
-            }
-            continue;
-        }
-        flush(boxVertices_, box_);
-        ++byKind[static_cast<int>(projected.kind)];
-        const double tau = tfHost_(cube.value).a;
-        for (int k = 0; k < projected.triangleCount; ++k)
-            for (const int i : projected.triangles[k]) {
-                raster::Vertex vertex;
-                vertex.position = glm::vec4(static_cast<float>(projected.ndc[i].x), static_cast<float>(projected.ndc[i].y), 0.0f, 1.0f);
-                const double l = projected.thickness[i];
-                const double a = options_.opacity == CubefanOptions::Opacity::Linear ? -std::expm1(-tau * l) : l / lMax;
-                vertex.attributes[0] = glm::vec4(static_cast<float>(a), cube.value, 0.0f, 0.0f);
-                fanVertices_.push_back(vertex);
-            }
-        triangles += projected.triangleCount;
-        if (fanVertices_.size() >= kBatchVertices)
-            flush(fanVertices_, fan_);
+    std::future<void> next;
+    if (chunkCount > 0)
+        next = std::async(threaded ? std::launch::async : std::launch::deferred, project, std::size_t(0));
+    for (std::size_t k = 0; k < chunkCount; ++k) {
+        next.get();
+        if (k + 1 < chunkCount)
+            next = std::async(threaded ? std::launch::async : std::launch::deferred, project, k + 1);
+        ProjectedChunk& chunk = chunks_[k % 2];
+        const auto d0 = std::chrono::steady_clock::now();
+        for (std::size_t r = 0; r < chunk.runCount; ++r)
+            rasterizer_.draw(fb_, state, raster::Topology::Triangles, chunk.runs[r].vertices,
+                             chunk.runs[r].box ? box_ : fan_);
+        drawMs += msSince(d0);
+        projectMs += chunk.ms;
+        total.add(chunk);
     }
-    flush(fanVertices_, fan_);
-    flush(boxVertices_, box_);
-    const double projectMs = msSince(t0) - drawMs;
+    const double loopMs = msSince(t0);
 
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
     ClSlice3dOverBackgroundParams finish{};
@@ -297,6 +373,8 @@ Image4f CubefanRenderer::render(FrameStats& stats)
     std::vector<PassTime> hostPasses = {{"cubefan: selection (host)", selectionMs},
                                         {"cubefan: classification and projection (host)", projectMs},
                                         {"cubefan: raster set-up and binning (host)", drawMs}};
+    stats.extra["projection_threaded"] = threaded;
+    stats.extra["projection_and_drawing_ms"] = loopMs;  // the two above overlapped
     if (textureMs_ > 0.0)
         hostPasses.push_back({"cubefan: exp-opacity texture (host)", textureMs_});
     finishFrame(device_, clock, stats, std::move(hostPasses));
@@ -304,20 +382,20 @@ Image4f CubefanRenderer::render(FrameStats& stats)
     stats.extra["error"] = options_.error;
     stats.extra["opacity"] = options_.exactThickness ? "exp" : opacityName(options_.opacity);
     stats.extra["thickness"] = options_.exactThickness ? "exact" : "interpolated";
-    stats.extra["cubes_as_back_faces"] = boxCubes;
+    stats.extra["cubes_as_back_faces"] = total.boxCubes;
     stats.extra["hierarchy_ms"] = hierarchyMs_;
     stats.extra["hierarchy_levels"] = octree_->levels();
     stats.extra["selection_ms"] = selectionMs;
     stats.extra["selection_visited"] = selection.visited;
     stats.extra["cubes"] = selection.selected;
     stats.extra["cubes_transparent"] = selection.transparent;
-    stats.extra["cubes_culled"] = culled;
-    stats.extra["cubes_near_plane"] = nearCubes;
-    stats.extra["cubes_class1"] = byKind[0];
-    stats.extra["cubes_class2"] = byKind[1];
-    stats.extra["cubes_class3a"] = byKind[2];
-    stats.extra["cubes_class3b"] = byKind[3];
-    stats.extra["triangles"] = triangles;
+    stats.extra["cubes_culled"] = total.culled;
+    stats.extra["cubes_near_plane"] = total.nearCubes;
+    stats.extra["cubes_class1"] = total.byKind[0];
+    stats.extra["cubes_class2"] = total.byKind[1];
+    stats.extra["cubes_class3a"] = total.byKind[2];
+    stats.extra["cubes_class3b"] = total.byKind[3];
+    stats.extra["triangles"] = total.triangles;
     stats.extra["projection_ms"] = projectMs;
     stats.extra["l_max"] = lMax;
     stats.extra["tau_max"] = tauMax;
