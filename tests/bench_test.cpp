@@ -382,3 +382,30 @@ TEST(BenchTetfaces, ScenesAreValidAndHarcTwinsDifferOnlyInTheTechnique)
         }
     }
 }
+
+// ---- cubefan bench scenes (tools/make_cubefan_bench.py, `clvr bench --suite cubefan`) ---------------------
+
+// The suite lists exactly the cubefan-* files in the order clvr bench needs (each group's full-quality scene
+// first: error 0, 1024 slices); every scene is the engine at 512x512 with one camera and transfer function.
+TEST(BenchCubefan, ScenesShareTheViewAndEachGroupStartsWithItsFullQualityScene)
+{
+    const std::vector<std::filesystem::path> files = benchScenesStartingWith("cubefan-");
+    const std::vector<std::string> listed = clvr::tools::benchSuiteScenes("cubefan");
+    std::vector<std::string> present, sorted = listed;
+    for (const auto& file : files)
+        present.push_back(file.filename().string());
+    std::sort(sorted.begin(), sorted.end());
+    EXPECT_EQ(sorted, present);
+    ASSERT_EQ(listed.size(), 10u);
+    EXPECT_EQ(listed.front(), "cubefan-engine-e0.json");
+    EXPECT_EQ(listed[5], "cubefan-slice3d-1024.json");
+    const clvr::Scene first = clvr::loadScene(files.front().parent_path() / listed.front());
+    EXPECT_EQ(first.options["error"].get<double>(), 0.0);
+    for (const std::string& name : listed) {
+        const clvr::Scene scene = clvr::loadScene(files.front().parent_path() / name);
+        EXPECT_EQ(scene.image.width, 512) << name;
+        EXPECT_EQ(scene.camera->position, first.camera->position) << name;
+        EXPECT_EQ(scene.transferFunction.points().size(), first.transferFunction.points().size()) << name;
+        EXPECT_EQ(scene.technique, name.starts_with("cubefan-engine-") ? "cubefan" : "slice3d") << name;
+    }
+}

@@ -38,6 +38,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <map>
 #include <sstream>
 #include <thread>
 #include <unistd.h>
@@ -308,6 +309,47 @@ nlohmann::json benchMeshScene(Device& device, const fs::path& scenePath, const S
     return r;
 }
 
+// The cubefan scenes as seeds/002's Figure 9 (and the paper's own rows, GeForce 2, 256x256x110), with the
+// image error against the group's first scene, and the other scenes of the run (slice3d) beside.
+void printCubefanTable(const nlohmann::json& scenes)
+{
+    bool any = false;
+    for (const nlohmann::json& r : scenes)
+        any = any || r["technique"] == "cubefan";
+    if (!any)
+        return;
+    std::ostringstream table;
+    table << std::left << std::setw(26) << "scene" << std::right << std::setw(7) << "error" << std::setw(10) << "cubes"
+          << std::setw(11) << "triangles" << std::setw(11) << "select ms" << std::setw(11) << "render ms"
+          << std::setw(10) << "frame ms" << std::setw(13) << "|diff| mean" << std::setw(12) << "|diff| max" << '\n';
+    for (const nlohmann::json& r : scenes) {
+        if (r.value("kind", std::string()) == "mesh")
+            continue;
+        const nlohmann::json& e = r["extra"];
+        const bool cubefan = r["technique"] == "cubefan";
+        const double selection = cubefan ? e["selection_ms"].get<double>() : 0.0;
+        table << std::left << std::setw(26) << r["name"].get<std::string>() << std::right << std::setw(7)
+              << (cubefan ? fixed(100.0 * e["error"].get<double>(), 0) + " %" : std::string("-")) << std::setw(10)
+              << (cubefan ? si(e["cubes"].get<double>()) : std::string("-")) << std::setw(11)
+              << (cubefan ? si(e["triangles"].get<double>()) : std::string("-")) << std::setw(11)
+              << (cubefan ? fixed(selection, 1) : std::string("-")) << std::setw(11)
+              << fixed(r["frame_ms"].get<double>() - selection, 1) << std::setw(10) << fixed(r["frame_ms"].get<double>(), 1);
+        if (r.contains("image_diff_vs_group_first"))
+            table << std::setw(13) << fixed(r["image_diff_vs_group_first"]["mean"].get<double>(), 5) << std::setw(12)
+                  << fixed(r["image_diff_vs_group_first"]["max"].get<double>(), 4);
+        else
+            table << std::setw(13) << "(first)";
+        table << '\n';
+    }
+    table << std::left << std::setw(26) << "paper (GeForce 2) 0 %" << std::right << std::setw(7) << "0 %" << std::setw(10)
+          << "5.20 M" << std::setw(11) << "-" << std::setw(11) << "850" << std::setw(11) << "37500" << '\n'
+          << std::left << std::setw(26) << "paper (GeForce 2) 18 %" << std::right << std::setw(7) << "18 %"
+          << std::setw(10) << "0.19 M" << std::setw(11) << "2.3 M" << std::setw(11) << "36" << std::setw(11) << "950" << '\n'
+          << std::left << std::setw(26) << "paper (GeForce 2) 48 %" << std::right << std::setw(7) << "48 %"
+          << std::setw(10) << "15.8 K" << std::setw(11) << "0.19 M" << std::setw(11) << "1.9" << std::setw(11) << "70" << '\n';
+    std::cout << "cubefan (seeds/002 Figure 9; render ms = frame - selection, as the paper times it)\n" << table.str() << '\n';
+}
+
 // The mesh scenes side by side: the columns of seeds/001 Tables 2-3, and VTK's when it ran.
 void printMeshTable(const nlohmann::json& scenes)
 {
@@ -447,6 +489,9 @@ int bench(const BenchOptions& options)
     report["overrides"] = options.overrides;
     report["scenes"] = nlohmann::json::array();
     bool anyVolume = false;  // the raster-stage figures go with the regular-grid scenes
+    // Suites that trade image quality for speed (cubefan): the first scene of a group (its name up to the
+    // last '-') is the group's full-quality image, and every later one is compared with it.
+    std::map<std::string, std::pair<std::string, Image4f>> groupFirst;
     std::cout << "clvr bench on " << device.description() << "\nplatform "
               << report["machine"]["platform_version"].get<std::string>() << "\nCPU " << cpuModel() << ", "
               << std::thread::hardware_concurrency() << " cores, " << utcNow() << ", load average "
@@ -572,6 +617,24 @@ int bench(const BenchOptions& options)
             }
             r["peer"] = peer;
         }
+        const std::string group = name.substr(0, name.rfind('-'));
+        if (auto it = groupFirst.find(group); it == groupFirst.end()) {
+            groupFirst.emplace(group, std::make_pair(name, image));
+        } else {
+            const ImageDiff d = imageDiff(image, it->second.second);
+            r["image_diff_vs_group_first"] = {{"first", it->second.first}, {"mean", d.mean}, {"max", d.max}};
+            std::cout << "  vs " << it->second.first << "  image |diff| mean " << fixed(d.mean, 5) << ", max "
+                      << fixed(d.max, 4) << '\n';
+        }
+        if (scene.technique == "cubefan") {
+            // seeds/002 Figure 9: rendering time excludes the selection, as the paper's does.
+            const nlohmann::json& e = stats.extra;
+            std::cout << "  figure 9     error " << fixed(100.0 * e["error"].get<double>(), 0) << " %: "
+                      << si(e["cubes"].get<double>()) << " cubes, " << si(e["triangles"].get<double>())
+                      << " triangles, selection " << fixed(e["selection_ms"].get<double>(), 1) << " ms, rendering "
+                      << fixed(s.median - e["selection_ms"].get<double>(), 1) << " ms; hierarchy built in "
+                      << fixed(e["hierarchy_ms"].get<double>(), 0) << " ms\n";
+        }
         std::cout << '\n';
         report["scenes"].push_back(r);
     }
@@ -595,6 +658,7 @@ int bench(const BenchOptions& options)
 #endif
 
     printMeshTable(report["scenes"]);
+    printCubefanTable(report["scenes"]);
     report["machine"]["load_average_end"] = loadAverage();
     std::ofstream out(outJson);
     if (!out)

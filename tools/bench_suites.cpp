@@ -50,8 +50,17 @@ std::vector<std::string> benchSuiteScenes(const std::string& suite)
             tetfaces.push_back(std::string("tetfaces-") + mesh + "-" + technique + ".json");
     for (const char* technique : {"tetiso", "tetslice", "harc"})
         tetfaces.push_back(std::string("tetfaces-automaton-") + technique + ".json");
+    // seeds/002 Figure 9 on the engine (tools/make_cubefan_bench.py): error 0, 18 %, 48 %, the same with
+    // each fragment's exact chord, then slice3d on the same view with 1024 slices (its full quality) and fewer.
+    std::vector<std::string> cubefan;
+    for (const char* run : {"e0", "e18", "e48", "x0", "x18"})
+        cubefan.push_back(std::string("cubefan-engine-") + run + ".json");
+    for (const char* slices : {"1024", "256", "128", "64", "32"})
+        cubefan.push_back(std::string("cubefan-slice3d-") + slices + ".json");
     if (suite == "slice3d")
         return slice3d;
+    if (suite == "cubefan")
+        return cubefan;
     if (suite == "harc")
         return harc;
     if (suite == "rts")
@@ -66,9 +75,10 @@ std::vector<std::string> benchSuiteScenes(const std::string& suite)
         all.insert(all.end(), rts.begin(), rts.end());
         all.insert(all.end(), regular.begin(), regular.end());
         all.insert(all.end(), tetfaces.begin(), tetfaces.end());
+        all.insert(all.end(), cubefan.begin(), cubefan.end());
         return all;
     }
-    throw InputError("--suite: unknown suite \"" + suite + "\" (known: slice3d, harc, rts, regular, tetfaces, all)");
+    throw InputError("--suite: unknown suite \"" + suite + "\" (known: slice3d, harc, rts, regular, tetfaces, cubefan, all)");
 }
 
 }  // namespace clvr::tools
