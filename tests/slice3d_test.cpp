@@ -2,6 +2,7 @@
 // CPU reference integral (error falling with the slice count), back-to-front == front-to-back,
 // early ray termination bound, fused == pass-by-pass raster path, identical bits, orientation.
 #include "host/render/grid/slice3d.h"
+#include "host/render/transfer_function_upload.h"  // tauZeroOn
 
 #include "host/runtime/errors.h"
 #include "host/io/generators.h"

@@ -1,7 +1,9 @@
 // host/render/scaffold.cpp — the renderer scaffold's checks, read-back and frame bookkeeping.
 #include "host/render/scaffold.h"
 
+#include "host/render/options_util.h"  // toCl4
 #include "host/runtime/errors.h"
+#include "kernels/slice3d_params.h"      // ClSlice3dOverBackgroundParams
 
 #include <map>
 #include <numeric>
@@ -25,6 +27,22 @@ Camera frameCamera(const Scene& scene, const glm::dvec3& lo, const glm::dvec3& h
     if (scene.image.width < 1 || scene.image.height < 1)
         throw InputError("image: width and height must be >= 1");
     return camera;
+}
+
+OverBackground::OverBackground(Device& device)
+    : device_(&device), kernel_(device.kernel("slice3d.cl", "slice3d_over_background"))
+{
+}
+
+void OverBackground::run(const cl::Buffer& rgba, std::size_t pixels, const glm::dvec3& background,
+                         const std::string& passName)
+{
+    ClSlice3dOverBackgroundParams params{};
+    params.background = toCl4(background, 0.0);
+    params.count = static_cast<cl_int>(pixels);
+    kernel_.setArg(0, rgba);
+    kernel_.setArg(1, params);
+    device_->launch(passName, kernel_, pixels);
 }
 
 double msSince(std::chrono::steady_clock::time_point t0)

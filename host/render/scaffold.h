@@ -32,6 +32,19 @@ void checkGridVolume(const Volume& volume, std::string_view technique);
 // 1..16384, a scene built in code may not). InputError for either.
 Camera frameCamera(const Scene& scene, const glm::dvec3& lo, const glm::dvec3& hi);
 
+// The last pass of every technique that blends premultiplied (I, A) into an RGBA float buffer
+// (slice3d.cl's slice3d_over_background): each of its `pixels` pixels becomes DESIGN.md's final pixel
+// I + (1 - A) background, alpha A, in place. One per renderer (it holds the kernel); run() enqueues it.
+class OverBackground {
+public:
+    explicit OverBackground(Device& device);
+    void run(const cl::Buffer& rgba, std::size_t pixels, const glm::dvec3& background, const std::string& passName);
+
+private:
+    Device* device_;
+    cl::Kernel kernel_;
+};
+
 // Wall time of one frame, host to host, from construction.
 class FrameClock {
 public:

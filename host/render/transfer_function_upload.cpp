@@ -42,4 +42,24 @@ void TransferFunctionUpload::replace(Device& device, const std::string& what, co
     residentBytes += bytes_;
 }
 
+bool tauZeroOn(const TransferFunction& tf, float lo, float hi)
+{
+    // The device compares x with the float control points: find the control points whose values
+    // clvr_tf_eval can use for some x in [lo, hi]: from the segment holding lo (point 0 when
+    // lo <= s_0) to the first point at or above hi (the last point when hi >= s_{n-1}).
+    const auto& p = tf.points();
+    const int n = static_cast<int>(p.size());
+    auto s = [&](int i) { return static_cast<float>(p[i].s); };
+    int first = 0;
+    while (first + 1 < n && s(first + 1) <= lo)
+        ++first;
+    int last = 0;
+    while (last + 1 < n && s(last) < hi)
+        ++last;
+    for (int i = first; i <= last; ++i)
+        if (p[i].tau != 0.0)  // exactly 0 in double: then the packed slopes are exactly 0 too
+            return false;
+    return true;
+}
+
 }  // namespace clvr

@@ -18,6 +18,11 @@ namespace clvr {
 // (r, g, b, tau) and the slopes of the segments, n + pad + 8n floats.
 std::vector<float> packTransferFunction(const TransferFunction& tf);
 
+// True when the device's evaluation of the packed transfer function (clvr_tf_eval, float control
+// points) gives tau exactly 0 for every x in [lo, hi]: all control points whose segments the interval
+// touches have tau 0 (then the slopes are 0 too), including the clamped ends.
+bool tauZeroOn(const TransferFunction& tf, float lo, float hi);
+
 // One packed transfer function resident on the device; upload() replaces it (a renderer's
 // setTransferFunction), keeping its buffer, control-point count and byte count together.
 class TransferFunctionUpload {

@@ -2,7 +2,7 @@
 // back to front.
 #include "host/render/grid/cube_octree.h"
 
-#include "host/render/grid/slice3d.h"  // tauZeroOn: the empty-brick test of slice3d's space skipping
+#include "host/render/transfer_function_upload.h"  // tauZeroOn: also slice3d's empty-brick test
 
 #include <algorithm>
 #include <cmath>

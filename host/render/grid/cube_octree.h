@@ -2,7 +2,7 @@
 // grid spacing centred on its grid point), merged bottom up into an octree whose cube values are the mean
 // of their leaves and whose error is the largest |value - leaf| below them; selection depth first until a
 // cube's error is within the tolerance, in back-to-front order for the eye, skipping cubes the transfer
-// function makes transparent. Part of issue 12 (cubefan); the renderer that draws the cubes is not built.
+// function makes transparent. host/render/grid/cubefan.h draws the cubes.
 #pragma once
 
 #include "host/model/transfer_function.h"
@@ -49,8 +49,9 @@ public:
 
     // Depth first from the root: a cube is taken when it is a voxel or its error <= tolerance * data
     // range, and kept when tf's extinction at its value is > 0; a subtree whose value range the transfer
-    // function makes transparent throughout (slice3d's tauZeroOn, as for its empty bricks) is skipped whole. Children are visited farthest first from
-    // the eye (perspective) or along forward (parallel: eye unused), so the result is back to front.
+    // function makes transparent throughout (tauZeroOn, as slice3d's empty bricks) is skipped whole.
+    // Children are visited farthest first from the eye (perspective) or along forward (parallel: eye
+    // unused), so the result is back to front.
     std::vector<Cube> select(double tolerance, const TransferFunction& tf, const glm::dvec3& eye,
                              const glm::dvec3& forward, bool parallel, SelectionStats* stats = nullptr) const;
 

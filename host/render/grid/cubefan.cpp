@@ -15,7 +15,6 @@
 #include "host/runtime/errors.h"
 #include "host/runtime/parallel.h"
 #include "kernels/cubefan_params.h"
-#include "kernels/slice3d_params.h"  // ClSlice3dOverBackgroundParams: the last pass is slice3d's
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
 
@@ -230,14 +229,15 @@ private:
     raster::Rasterizer rasterizer_;
     raster::Framebuffer fb_;
     raster::FragmentProgram fan_, box_;
-    cl::Kernel finish_;
+    OverBackground overBackground_;
     std::array<ProjectedChunk, 2> chunks_;  // the chunk being drawn and the next; kept: pages touched once
     std::uint64_t residentBytes_ = 0;
 };
 
 CubefanRenderer::CubefanRenderer(Device& device, const Scene& scene, const Volume& volume)
     : device_(device), options_(parseCubefanOptions(scene.options)), image_(scene.image),
-      tfHost_(scene.transferFunction), rasterizer_(device), fb_(device, scene.image.width, scene.image.height)
+      tfHost_(scene.transferFunction), rasterizer_(device), fb_(device, scene.image.width, scene.image.height),
+      overBackground_(device)
 {
     checkGridVolume(volume, "cubefan");
     if (volume.part)
@@ -255,7 +255,6 @@ CubefanRenderer::CubefanRenderer(Device& device, const Scene& scene, const Volum
     fan_.attributes = 1;  // (l / l_max or alpha, value)
     box_.source = programSource("CLVR_CUBEFAN_BOX");
     box_.attributes = 3;  // (0, value), lo, hi
-    finish_ = device_.kernel("slice3d.cl", "slice3d_over_background");
 }
 
 void CubefanRenderer::updateTexture(double k)
@@ -305,11 +304,7 @@ Image4f CubefanRenderer::render(FrameStats& stats)
     view.parallel = camera_.parallel;
 
     raster::DrawState state;
-    state.fragment.blend.enabled = true;  // back to front, premultiplied: dst = src + (1 - src.alpha) dst
-    state.fragment.blend.srcRgb = raster::BlendFactor::One;
-    state.fragment.blend.dstRgb = raster::BlendFactor::OneMinusSrcAlpha;
-    state.fragment.blend.srcAlpha = raster::BlendFactor::One;
-    state.fragment.blend.dstAlpha = raster::BlendFactor::OneMinusSrcAlpha;
+    state.fragment.blend = raster::premultipliedOver();  // back to front: dst = src + (1 - src.alpha) dst
     ClCubefanUniforms uniforms{};
     uniforms.camera = toClCamera(camera_, image_.width, image_.height, shift_);
     const int mode = options_.opacity == CubefanOptions::Opacity::Texture ? CUBEFAN_OPACITY_TEXTURE
@@ -361,12 +356,7 @@ Image4f CubefanRenderer::render(FrameStats& stats)
     const double loopMs = msSince(t0);
 
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
-    ClSlice3dOverBackgroundParams finish{};
-    finish.background = toCl4(image_.background);
-    finish.count = static_cast<cl_int>(pixels);
-    finish_.setArg(0, fb_.color());
-    finish_.setArg(1, finish);
-    device_.launch("cubefan: over background", finish_, pixels);
+    overBackground_.run(fb_.color(), pixels, image_.background, "cubefan: over background");
     Image4f image = readImage(device_, fb_.color(), image_.width, image_.height);
     const raster::DrawStats drawn = rasterizer_.takeStats();
 

@@ -67,7 +67,7 @@ private:
     ClSlice3dUniforms fragmentUniforms_{};
     raster::Rasterizer rasterizer_{device_};      // slice polygons: its stats are the frame's samples
     raster::Rasterizer clipRasterizer_{device_};  // the clip mesh's stencil passes, not counted
-    cl::Kernel overBackground_;
+    std::optional<OverBackground> overBackground_;  // the raster path's last pass
     // Clipping (raster path): the closed mesh and its farthest eye depth.
     std::optional<ClipMesh> clipMesh_;
     double clipDepthMax_ = 0.0;
@@ -159,7 +159,7 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
         residentBytes_ += flags.size();
     } else {
         framebuffer_ = std::make_unique<raster::Framebuffer>(device_, image_.width, image_.height);
-        overBackground_ = device_.kernel("slice3d.cl", "slice3d_over_background");
+        overBackground_.emplace(device_);
         const std::string_view source = embeddedKernelSource("slice3d.cl");
         fragmentProgram_.source = std::string("#define CLVR_SLICE3D_FRAGMENT 1\n") +
                                   (clipTexture_ ? "#define CLVR_SLICE3D_CLIP_TEXTURE 1\n" : "") + std::string(source);
@@ -332,9 +332,8 @@ Image4f Slice3dRenderer::renderRaster(FrameStats& stats)
     if (frontToBack) {  // "under": dst += (1 - dst.a) src
         state.fragment.blend.srcRgb = state.fragment.blend.srcAlpha = raster::BlendFactor::OneMinusDstAlpha;
         state.fragment.blend.dstRgb = state.fragment.blend.dstAlpha = raster::BlendFactor::One;
-    } else {            // "over" on premultiplied color: dst = src + (1 - src.a) dst
-        state.fragment.blend.srcRgb = state.fragment.blend.srcAlpha = raster::BlendFactor::One;
-        state.fragment.blend.dstRgb = state.fragment.blend.dstAlpha = raster::BlendFactor::OneMinusSrcAlpha;
+    } else {
+        state.fragment.blend = raster::premultipliedOver();
     }
     framebuffer_->clearColor(device_, glm::vec4(0.0f));
     raster::DrawStats drawStats;
@@ -345,12 +344,7 @@ Image4f Slice3dRenderer::renderRaster(FrameStats& stats)
         drawStats = rasterizer_.takeStats();
     }
     const std::size_t pixels = framebuffer_->pixelCount();
-    ClSlice3dOverBackgroundParams over{};
-    over.background = toCl4(image_.background, 0.0);
-    over.count = static_cast<cl_int>(pixels);
-    overBackground_.setArg(0, framebuffer_->color());
-    overBackground_.setArg(1, over);
-    device_.launch("slice3d: over background", overBackground_, pixels);
+    overBackground_->run(framebuffer_->color(), pixels, image_.background, "slice3d: over background");
     Image4f image = framebuffer_->readColor(device_);
     stats.samples = drawStats.fragments;  // fragments of slice polygons; those outside the grid are discarded
     stats.extra["triangles"] = drawStats.triangles;
@@ -594,26 +588,6 @@ BrickGrid buildBrickGrid(const Volume& volume)
                 }
         }
     return grid;
-}
-
-bool tauZeroOn(const TransferFunction& tf, float lo, float hi)
-{
-    // The device compares x with the float control points: find the control points whose values
-    // clvr_tf_eval can use for some x in [lo, hi]: from the segment holding lo (point 0 when
-    // lo <= s_0) to the first point at or above hi (the last point when hi >= s_{n-1}).
-    const auto& p = tf.points();
-    const int n = static_cast<int>(p.size());
-    auto s = [&](int i) { return static_cast<float>(p[i].s); };
-    int first = 0;
-    while (first + 1 < n && s(first + 1) <= lo)
-        ++first;
-    int last = 0;
-    while (last + 1 < n && s(last) < hi)
-        ++last;
-    for (int i = first; i <= last; ++i)
-        if (p[i].tau != 0.0)  // exactly 0 in double: then the packed slopes are exactly 0 too
-            return false;
-    return true;
 }
 
 std::vector<cl_uchar> emptyBricks(const BrickGrid& grid, const TransferFunction& tf)

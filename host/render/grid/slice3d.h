@@ -66,11 +66,6 @@ struct BrickGrid {
 };
 BrickGrid buildBrickGrid(const Volume& volume);
 
-// True when the device's evaluation of the packed transfer function (clvr_tf_eval, float control
-// points) gives tau exactly 0 for every x in [lo, hi]: all control points whose segments the interval
-// touches have tau 0 (then the slopes are 0 too), including the clamped ends.
-bool tauZeroOn(const TransferFunction& tf, float lo, float hi);
-
 // One byte per brick, 1 = empty: tauZeroOn over the brick's [min, max], widened by a few ulp so that
 // float rounding in the trilinear interpolation cannot leave the interval.
 std::vector<cl_uchar> emptyBricks(const BrickGrid& grid, const TransferFunction& tf);

@@ -7,7 +7,6 @@
 #include "host/render/camera_args.h"
 #include "host/render/options_util.h"
 #include "host/render/transfer_function_upload.h"
-#include "kernels/slice3d_params.h"  // ClSlice3dOverBackgroundParams: the last pass is slice3d's
 #include "kernels/spherical_params.h"
 #include "raster/framebuffer.h"
 #include "raster/texture.h"
@@ -210,7 +209,8 @@ raster::PixelTransfer composeTextureMap(const raster::PixelTransfer& user, const
 }
 
 SphericalRenderer::SphericalRenderer(Device& device, const Scene& scene, const Volume& volume)
-    : device_(device), options_(parseSphericalOptions(scene.options)), imageSpec_(scene.image)
+    : device_(device), options_(parseSphericalOptions(scene.options)), imageSpec_(scene.image),
+      overBackground_(device)
 {
     if (scene.lighting.shaded())
         throw InputError("lights: technique spherical renders unshaded (no \"lights\")");
@@ -238,7 +238,6 @@ SphericalRenderer::SphericalRenderer(Device& device, const Scene& scene, const V
     coords_ = std::make_unique<raster::Framebuffer>(device_, imageSpec_.width, imageSpec_.height);
     image_ = std::make_unique<raster::Framebuffer>(device_, imageSpec_.width, imageSpec_.height);
     shellKernel_ = device_.kernel("spherical.cl", "spherical_shell");
-    overBackground_ = device_.kernel("slice3d.cl", "slice3d_over_background");
 
     // Near and far planes around the outer sphere's eye-depth range, as stack2d does for its box:
     // depth is not tested, only the near plane matters (it removes what lies behind the camera).
@@ -323,12 +322,7 @@ Image4f SphericalRenderer::render(FrameStats& stats)
     for (std::size_t k = 0; k < shells_.size(); ++k)
         renderPass(k, false);
     const std::size_t pixels = image_->pixelCount();
-    ClSlice3dOverBackgroundParams over{};
-    over.background = f4(imageSpec_.background);
-    over.count = static_cast<cl_int>(pixels);
-    overBackground_.setArg(0, image_->color());
-    overBackground_.setArg(1, over);
-    device_.launch("spherical: over background", overBackground_, pixels);
+    overBackground_.run(image_->color(), pixels, imageSpec_.background, "spherical: over background");
     Image4f image = image_->readColor(device_);
     finishFrame(device_, clock, stats);
     stats.samples = drawStats_.fragments;  // one texture sample per covered pixel of a hemisphere

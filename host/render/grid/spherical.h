@@ -11,6 +11,7 @@
 
 #include "host/model/camera.h"
 #include "host/render/renderer.h"
+#include "host/render/scaffold.h"
 #include "host/render/transfer_function_upload.h"
 #include "raster/pixel_transfer.h"
 #include "raster/rasterizer.h"
@@ -105,7 +106,8 @@ private:
     std::uint64_t residentBytes_ = 0;
     std::unique_ptr<raster::Framebuffer> coords_, image_;
     glm::dmat4 viewProjection_{1.0};
-    cl::Kernel shellKernel_, overBackground_;
+    cl::Kernel shellKernel_;
+    OverBackground overBackground_;
     raster::DrawStats drawStats_;
 };
 

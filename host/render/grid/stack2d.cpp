@@ -12,7 +12,6 @@
 #include "host/optics/gradient_volume.h"
 #include "host/optics/reflectance_map.h"
 #include "host/render/transfer_function_upload.h"
-#include "kernels/slice3d_params.h"  // ClSlice3dOverBackgroundParams: the last pass is slice3d's
 #include "kernels/stack2d_params.h"
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
@@ -111,11 +110,13 @@ private:
     std::unique_ptr<raster::Framebuffer> framebuffer_;
     raster::FragmentProgram fragmentProgram_;
     ClStack2dUniforms uniforms_{};  // fragmentProgram_.uniforms, by field
-    cl::Kernel overBackground_, isoFinish_;
+    OverBackground overBackground_;
+    cl::Kernel isoFinish_;
 };
 
 Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volume& volume)
-    : device_(device), options_(parseStack2dOptions(scene.options)), image_(scene.image), lighting_(scene.lighting)
+    : device_(device), options_(parseStack2dOptions(scene.options)), image_(scene.image), lighting_(scene.lighting),
+      overBackground_(device)
 {
     checkGridVolume(volume, "stack2d");
     dims_ = volume.dims;
@@ -177,7 +178,6 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
     setTransferFunction(scene.transferFunction);
 
     framebuffer_ = std::make_unique<raster::Framebuffer>(device_, image_.width, image_.height);
-    overBackground_ = device_.kernel("slice3d.cl", "slice3d_over_background");
     const std::string_view source = embeddedKernelSource("stack2d.cl");
     fragmentProgram_.source = "#define CLVR_STACK2D_FRAGMENT 1\n" +
                               std::string(clipTexture_ ? "#define CLVR_STACK2D_CLIP_TEXTURE 1\n" : "") + std::string(source);
@@ -367,10 +367,8 @@ Image4f Stack2dRenderer::render(FrameStats& stats)
         }
     }
     raster::DrawState state;
-    if (!iso_) {  // "over" on premultiplied color: dst = src + (1 - src.a) dst
-        state.fragment.blend.enabled = true;
-        state.fragment.blend.srcRgb = state.fragment.blend.srcAlpha = raster::BlendFactor::One;
-        state.fragment.blend.dstRgb = state.fragment.blend.dstAlpha = raster::BlendFactor::OneMinusSrcAlpha;
+    if (!iso_) {
+        state.fragment.blend = raster::premultipliedOver();
     } else {
         // Alpha test on the value mapped to [0, 1] as the fragment program maps it: GEQUAL the mapped
         // iso-value (an iso-value above the data passes nothing); the stencil marks covered pixels.
@@ -399,12 +397,7 @@ Image4f Stack2dRenderer::render(FrameStats& stats)
         isoFinish_.setArg(2, finish);
         device_.launch("stack2d: iso-surface over background", isoFinish_, pixels);
     } else {
-        ClSlice3dOverBackgroundParams over{};
-        over.background = background;
-        over.count = static_cast<cl_int>(pixels);
-        overBackground_.setArg(0, framebuffer_->color());
-        overBackground_.setArg(1, over);
-        device_.launch("stack2d: over background", overBackground_, pixels);
+        overBackground_.run(framebuffer_->color(), pixels, image_.background, "stack2d: over background");
     }
     Image4f image = framebuffer_->readColor(device_);
     finishFrame(device_, clock, stats);

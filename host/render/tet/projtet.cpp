@@ -13,7 +13,6 @@
 #include "host/runtime/embedded_kernels.h"
 #include "host/runtime/errors.h"
 #include "kernels/projtet_params.h"
-#include "kernels/slice3d_params.h"  // ClSlice3dOverBackgroundParams: the last pass is slice3d's
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
 
@@ -472,7 +471,7 @@ private:
     raster::Rasterizer rasterizer_;
     raster::Framebuffer fb_;
     raster::FragmentProgram program_;
-    cl::Kernel finish_;
+    OverBackground overBackground_;
     std::vector<raster::Vertex> vertices_;  // the frame's triangles, 3 vertices each
     std::uint64_t residentBytes_ = 0;
 };
@@ -480,7 +479,8 @@ private:
 ProjtetRenderer::ProjtetRenderer(Device& device, const Scene& scene, const TetMesh& mesh, const TetTopology& topology)
     : device_(device), options_(parseProjtetOptions(scene.options)), image_(scene.image),
       shift_(0.5 * (mesh.boundsMin() + mesh.boundsMax())), points_(mesh.points), tets_(mesh.tets.begin(), mesh.tets.end()),
-      sorter_(mesh, topology), rasterizer_(device), fb_(device, scene.image.width, scene.image.height)
+      sorter_(mesh, topology), rasterizer_(device), fb_(device, scene.image.width, scene.image.height),
+      overBackground_(device)
 {
     if (mesh.tets.empty())
         throw InputError(mesh.source + ": projtet needs a mesh with at least one tetrahedron");
@@ -498,7 +498,6 @@ ProjtetRenderer::ProjtetRenderer(Device& device, const Scene& scene, const TetMe
     program_.attributes = 1;  // the cell id
     program_.buffers[0] = cells_;
     program_.buffers[2] = psi_;
-    finish_ = device_.kernel("slice3d.cl", "slice3d_over_background");
 }
 
 Image4f ProjtetRenderer::render(FrameStats& stats)
@@ -605,11 +604,7 @@ Image4f ProjtetRenderer::render(FrameStats& stats)
 
     // Back to front, premultiplied: dst = src + (1 - src.alpha) dst (GL_ONE, GL_ONE_MINUS_SRC_ALPHA).
     raster::DrawState state;
-    state.fragment.blend.enabled = true;
-    state.fragment.blend.srcRgb = raster::BlendFactor::One;
-    state.fragment.blend.dstRgb = raster::BlendFactor::OneMinusSrcAlpha;
-    state.fragment.blend.srcAlpha = raster::BlendFactor::One;
-    state.fragment.blend.dstAlpha = raster::BlendFactor::OneMinusSrcAlpha;
+    state.fragment.blend = raster::premultipliedOver();
     ClProjtetUniforms uniforms{};
     uniforms.camera = toClCamera(camera_, image_.width, image_.height, shift_);
     uniforms.counts = cl_float4{{static_cast<float>(image_.width), static_cast<float>(image_.height),
@@ -622,12 +617,7 @@ Image4f ProjtetRenderer::render(FrameStats& stats)
     const double setUpMs = msSince(t0);
 
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
-    ClSlice3dOverBackgroundParams finish{};
-    finish.background = toCl4(image_.background);
-    finish.count = static_cast<cl_int>(pixels);
-    finish_.setArg(0, fb_.color());
-    finish_.setArg(1, finish);
-    device_.launch("projtet: over background", finish_, pixels);
+    overBackground_.run(fb_.color(), pixels, image_.background, "projtet: over background");
     Image4f image = readImage(device_, fb_.color(), image_.width, image_.height);
     const raster::DrawStats drawn = rasterizer_.takeStats();
 

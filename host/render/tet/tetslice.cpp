@@ -11,7 +11,6 @@
 #include "host/render/slice_plan.h"
 #include "host/render/transfer_function_upload.h"
 #include "host/runtime/errors.h"
-#include "kernels/slice3d_params.h"  // ClSlice3dOverBackgroundParams: the last pass is slice3d's
 #include "kernels/tetslice_params.h"
 #include "raster/framebuffer.h"
 #include "raster/pixel_transfer.h"
@@ -125,14 +124,15 @@ private:
     raster::Rasterizer rasterizer_;
     raster::Framebuffer fb_;
     cl::Buffer image_buffer_;
-    cl::Kernel composite_, finish_;
+    cl::Kernel composite_;
+    OverBackground overBackground_;
     std::uint64_t residentBytes_ = 0;
 };
 
 TetsliceRenderer::TetsliceRenderer(Device& device, const Scene& scene, const TetMesh& mesh)
     : device_(device), options_(parseTetsliceOptions(scene.options)), image_(scene.image),
       shift_(0.5 * (mesh.boundsMin() + mesh.boundsMax())), cells_(mesh, shift_, "tetslice"), rasterizer_(device),
-      fb_(device, scene.image.width, scene.image.height, true)
+      fb_(device, scene.image.width, scene.image.height, true), overBackground_(device)
 {
     const glm::dvec3 lo = mesh.boundsMin(), hi = mesh.boundsMax();
     lo_ = lo - shift_;
@@ -148,7 +148,6 @@ TetsliceRenderer::TetsliceRenderer(Device& device, const Scene& scene, const Tet
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
     image_buffer_ = device_.buffer("tetslice image", pixels * sizeof(cl_float4));
     composite_ = device_.kernel("tetslice.cl", "tetslice_composite");
-    finish_ = device_.kernel("slice3d.cl", "slice3d_over_background");
     // Resident for the data: the transfer function. The mesh stays on the host; each slice's faces are
     // uploaded by the raster stage.
     residentBytes_ = tf_.bytes();
@@ -267,12 +266,7 @@ Image4f TetsliceRenderer::render(FrameStats& stats)
         device_.launch("tetslice: composite", composite_, image_.width, image_.height);
     }
 
-    ClSlice3dOverBackgroundParams finish{};
-    finish.background = toCl4(image_.background);
-    finish.count = static_cast<cl_int>(pixels);
-    finish_.setArg(0, image_buffer_);
-    finish_.setArg(1, finish);
-    device_.launch("tetslice: over background", finish_, pixels);
+    overBackground_.run(image_buffer_, pixels, image_.background, "tetslice: over background");
     Image4f image = readImage(device_, image_buffer_, image_.width, image_.height);
     const raster::DrawStats drawn = rasterizer_.takeStats();
 
