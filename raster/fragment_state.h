@@ -47,6 +47,17 @@ struct BlendState {                  // glBlendEquationSeparate + glBlendFuncSep
     glm::vec4 constant{0.0f};
 };
 
+// Back-to-front compositing of premultiplied colors, "over": dst = src + (1 - src.a) dst on every channel
+// (GL_ONE, GL_ONE_MINUS_SRC_ALPHA, enabled).
+inline BlendState premultipliedOver()
+{
+    BlendState b;
+    b.enabled = true;
+    b.srcRgb = b.srcAlpha = BlendFactor::One;
+    b.dstRgb = b.dstAlpha = BlendFactor::OneMinusSrcAlpha;
+    return b;
+}
+
 struct ColorMask {                   // glColorMask
     bool r = true, g = true, b = true, a = true;
 };
