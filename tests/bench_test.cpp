@@ -409,3 +409,31 @@ TEST(BenchCubefan, ScenesShareTheViewAndEachGroupStartsWithItsFullQualityScene)
         EXPECT_EQ(scene.technique, name.starts_with("cubefan-engine-") ? "cubefan" : "slice3d") << name;
     }
 }
+
+// ---- projtet bench scenes (`clvr bench --suite projtet`) --------------------------------------------------
+
+// Each projtet scene is its harc twin with only the technique changed, and the suite lists each pair
+// harc first; harc-post.json is data/scenes/post.json's scene.
+TEST(BenchProjtet, EveryProjtetSceneIsItsHarcTwin)
+{
+    const std::vector<std::string> listed = clvr::tools::benchSuiteScenes("projtet");
+    ASSERT_EQ(listed.size(), 6u);
+    const std::filesystem::path dir = benchScenesStartingWith("harc-").front().parent_path();
+    for (std::size_t i = 0; i < listed.size(); i += 2) {
+        ASSERT_TRUE(listed[i].starts_with("harc-")) << listed[i];
+        EXPECT_EQ("projtet-" + listed[i].substr(5), listed[i + 1]);
+        const std::string harc = clvr::test::readFile(dir / listed[i]);
+        std::string projtet = clvr::test::readFile(dir / listed[i + 1]);
+        const std::string tag = "\"technique\": \"projtet\"";
+        ASSERT_NE(projtet.find(tag), std::string::npos) << listed[i + 1];
+        projtet.replace(projtet.find(tag), tag.size(), "\"technique\": \"harc\"");
+        EXPECT_EQ(projtet, harc) << listed[i + 1];
+        EXPECT_EQ(clvr::loadScene(dir / listed[i + 1]).technique, "projtet");
+    }
+    const clvr::Scene post = clvr::loadScene(dir / "harc-post.json");
+    const clvr::Scene original = clvr::loadScene(clvr::test::repoData("scenes/post.json"));
+    EXPECT_EQ(std::filesystem::weakly_canonical(post.mesh->file), std::filesystem::weakly_canonical(original.mesh->file));
+    EXPECT_EQ(post.mesh->scalar, original.mesh->scalar);
+    EXPECT_EQ(post.transferFunction.points().size(), original.transferFunction.points().size());
+    EXPECT_EQ(post.camera->position, original.camera->position);
+}

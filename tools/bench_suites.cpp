@@ -57,8 +57,14 @@ std::vector<std::string> benchSuiteScenes(const std::string& suite)
         cubefan.push_back(std::string("cubefan-engine-") + run + ".json");
     for (const char* slices : {"1024", "256", "128", "64", "32"})
         cubefan.push_back(std::string("cubefan-slice3d-") + slices + ".json");
+    // Cell projection beside the ray caster (issue 11 part 5): each projtet scene is its harc twin with only
+    // the technique changed.
+    const std::vector<std::string> projtet = {"harc-bluntfin-10.json", "projtet-bluntfin-10.json", "harc-post.json",
+                                              "projtet-post.json",     "harc-tetgen-1m.json",      "projtet-tetgen-1m.json"};
     if (suite == "slice3d")
         return slice3d;
+    if (suite == "projtet")
+        return projtet;
     if (suite == "cubefan")
         return cubefan;
     if (suite == "harc")
@@ -76,9 +82,12 @@ std::vector<std::string> benchSuiteScenes(const std::string& suite)
         all.insert(all.end(), regular.begin(), regular.end());
         all.insert(all.end(), tetfaces.begin(), tetfaces.end());
         all.insert(all.end(), cubefan.begin(), cubefan.end());
+        for (const std::string& name : projtet)  // the harc twins are in the harc list already
+            if (name.starts_with("projtet-") || name == "harc-post.json")
+                all.push_back(name);
         return all;
     }
-    throw InputError("--suite: unknown suite \"" + suite + "\" (known: slice3d, harc, rts, regular, tetfaces, cubefan, all)");
+    throw InputError("--suite: unknown suite \"" + suite + "\" (known: slice3d, harc, rts, regular, tetfaces, cubefan, projtet, all)");
 }
 
 }  // namespace clvr::tools

@@ -183,11 +183,12 @@ int run(int argc, char** argv)
                              "harc-bluntfin-10-full, harc-tetgen-1m), rts (rts-*: planes and blend, tools/make_rts_bench.py), "
                              "regular (reg-*: iso3d, stack2d, clipping, tools/make_regular_bench.py), tetfaces (tetfaces-*: "
                              "tetslice, tetiso, tools/make_tetfaces_bench.py), cubefan (cubefan-*: seeds/002 Figure 9 and "
-                             "slice3d on its view, tools/make_cubefan_bench.py), all, or raster "
+                             "slice3d on its view, tools/make_cubefan_bench.py), projtet (projtet-* beside their harc twins: bluntfin, "
+                             "the oxygen post, the 1 M-tet TetGen torus), all, or raster "
                              "(no scenes: the raster stage on 100,000 small triangles, tools/bench_raster.h), or cluster "
                              "(mpirun -np 1, 2, 4 sort-last on reg-slice3d-ml256 and harc-bluntfin-10 or the scenes given; "
                              "docs/cluster.md)")
-        ->check(CLI::IsMember({"slice3d", "harc", "rts", "regular", "tetfaces", "cubefan", "all", "raster", "cluster"}))
+        ->check(CLI::IsMember({"slice3d", "harc", "rts", "regular", "tetfaces", "cubefan", "projtet", "all", "raster", "cluster"}))
         ->capture_default_str();
     benchCommand->add_option("-o,--output", benchOptions.outJson, "figures as JSON; images go beside it")
         ->capture_default_str();

@@ -4,7 +4,8 @@
 # exec/s, coverage and what was found. Fails on any crash, leak, timeout or out-of-memory.
 #   tools/fuzz.sh [seconds-per-target] [target ...]     (default 60 s, every target; docs/robustness.md)
 # Environment: JOBS (parallel build jobs, default: number of cores), FUZZ_WORK (where the corpus copies,
-# logs and crash artifacts go, default build-fuzz/fuzz-run). Run it with `nice -n 19` on a shared machine.
+# logs and crash artifacts go, default build-fuzz/fuzz-run), FUZZ_RUNS (also stop a target after this many
+# executions, libFuzzer's -runs; default: time only). Run it with `nice -n 19` on a shared machine.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds="${1:-60}"
@@ -35,9 +36,11 @@ for t in "${targets[@]}"; do
     [ -d "fuzz/regressions/$t" ] && inputs+=("fuzz/regressions/$t")
     dict=()
     [ -f "fuzz/$t.dict" ] && dict=(-dict="fuzz/$t.dict")
+    runs=()
+    [ -n "${FUZZ_RUNS:-}" ] && runs=(-runs="$FUZZ_RUNS")
     rc=0
     "build-fuzz/fuzz/fuzz_$t" -rss_limit_mb=2048 -malloc_limit_mb=2048 -max_len=4096 -timeout=10 \
-        -max_total_time="$seconds" -print_final_stats=1 -artifact_prefix="$dir/" "${dict[@]}" "${inputs[@]}" \
+        -max_total_time="$seconds" "${runs[@]}" -print_final_stats=1 -artifact_prefix="$dir/" "${dict[@]}" "${inputs[@]}" \
         >"$dir/log" 2>&1 || rc=$?
     stat() { sed -n "s/^stat::$1: *//p" "$dir/log" | tail -1; }
     done_line=$(grep -E '^#[0-9]+[[:space:]]+(DONE|pulse|NEW|REDUCE|INITED)' "$dir/log" | tail -1)
