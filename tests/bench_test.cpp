@@ -153,6 +153,11 @@ TEST(BenchMesh, FiguresNeedMeshStatsAndAPositiveTime)
     faces.erase("steps");
     faces["cells_drawn"] = 7;
     EXPECT_EQ(clvr::tools::meshFigures(faces, 10.0).steps, 7u);
+    // projtet: each fragment integrates one segment.
+    nlohmann::json projected = extra;
+    projected.erase("steps");
+    projected["raster_fragments"] = 9;
+    EXPECT_EQ(clvr::tools::meshFigures(projected, 10.0).steps, 9u);
 }
 
 // A small surface scene: meshed once, then read from the cache as the same mesh; another option meshes again.

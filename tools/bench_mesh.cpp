@@ -51,7 +51,11 @@ MeshFigures meshFigures(const nlohmann::json& extra, double frameMs)
         throw InputError("frame stats have no numeric \"bytes_per_tet\" (not a mesh technique?)");
     MeshFigures f;
     f.tets = count(extra, "tets_rendered");
-    f.steps = extra.contains("steps") || !extra.contains("cells_drawn") ? count(extra, "steps") : count(extra, "cells_drawn");
+    const char* unit = extra.contains("steps")            ? "steps"
+                       : extra.contains("cells_drawn")      ? "cells_drawn"
+                       : extra.contains("raster_fragments") ? "raster_fragments"
+                                                            : "steps";
+    f.steps = count(extra, unit);
     f.frameMs = frameMs;
     f.fps = 1000.0 / frameMs;
     f.tetsPerS = static_cast<double>(f.tets) * f.fps;

@@ -32,8 +32,9 @@ struct MeshFigures {
 
 // The figures of a frame with FrameStats::extra `extra` (needs tets_rendered, bytes_per_tet, and steps:
 // harc's traversal steps, or for the cell-face techniques, which have none, cells_drawn — the cells
-// drawn, summed over the frame's slices — as their unit of work) that took frameMs (the median steady
-// frame). InputError naming a missing key or a frameMs <= 0.
+// drawn, summed over the frame's slices — and for projtet raster_fragments — each fragment integrates one
+// ray segment, as a harc step does — as their unit of work) that took frameMs (the median steady frame).
+// InputError naming a missing key or a frameMs <= 0.
 MeshFigures meshFigures(const nlohmann::json& extra, double frameMs);
 
 // The scene's mesh, loaded as `clvr render` loads it (host/io/mesh_io.h loadMesh), except that a mesh

@@ -1,8 +1,12 @@
 #!/usr/bin/python3
-"""tools/peer_vtk_unstructured.py — the VTK peer of `clvr bench --peer` for tetrahedral-mesh scenes (harc):
-renders a clvr scene with vtkUnstructuredGridVolumeRayCastMapper and vtkUnstructuredGridPartialPreIntegration
-(Moreland and Angel's partial pre-integration, the integration harc does) offscreen at the scene's image
-size, times frames after a first one, and writes its image (PNG) and figures (JSON).
+"""tools/peer_vtk_unstructured.py — the VTK peer of `clvr bench --peer` for tetrahedral-mesh scenes: renders a
+clvr scene offscreen at the scene's image size, times frames after a first one, and writes its image (PNG) and
+figures (JSON). For harc (and the cell-face techniques) with vtkUnstructuredGridVolumeRayCastMapper and
+vtkUnstructuredGridPartialPreIntegration (Moreland and Angel's partial pre-integration, the integration harc
+does); for projtet (`--mapper projected`, the default when the scene's technique is projtet) with
+vtkProjectedTetrahedraMapper, VTK's Shirley-Tuchman cell projection (OpenGL, Mesa under xvfb-run): cells
+sorted by their centres' depth (vtkCellCenterDepthSort), per-vertex colour and attenuation averaged at the
+thick vertex, alpha = 1 - exp(-attenuation * thickness) per fragment.
 
 Run it as clvr bench does, on the scene clvr bench writes beside its figures (bench.<scene>.peer.json: the
 mesh clvr loaded as VTK legacy binary, the camera it used, the image and the transfer function):
@@ -23,6 +27,9 @@ The same integral as clvr (docs/benchmarks.md):
   distance is 1. (vtkFixedPointVolumeRayCastMapper, the regular-grid peer, reads the same table as an
   opacity per unit distance instead: tools/peer_vtk.py.)
 - image sample distance 1 (one ray per pixel), no automatic adjustment; composite over the background.
+The projected-tetrahedra mapper reads the opacity as an 8-bit attenuation in [0, 1] per ScalarOpacityUnitDistance
+(vtkOpenGLProjectedTetrahedraMapper: opacity / unit distance times the thickness), so it gets tau / tau_max with
+unit distance 1 / tau_max: the same extinction, quantized to 1/255 of tau_max, and colours to 8 bits.
 """
 import argparse
 import json
@@ -101,6 +108,9 @@ def main():
     ap.add_argument("--frames", type=int, default=5)
     ap.add_argument("--out-png", default="vtk.png")
     ap.add_argument("--out-json", default="vtk.json")
+    ap.add_argument("--mapper", choices=["raycast", "projected"], default=None,
+                    help="raycast (vtkUnstructuredGridVolumeRayCastMapper) or projected (vtkProjectedTetrahedraMapper); "
+                         "default: projected for a projtet scene, else raycast")
     ap.add_argument("--pixel-corners", type=int, default=0,
                     help="1: leave VTK's rays through pixel corners (default 0: shifted to clvr's pixel centres)")
     args = ap.parse_args()
@@ -119,10 +129,13 @@ def main():
     background = scene.get("image", {}).get("background", [0, 0, 0])
     points = scene["transfer_function"]["points"]
 
+    projected = (args.mapper or ("projected" if scene.get("technique") == "projtet" else "raycast")) == "projected"
     color = vtk.vtkColorTransferFunction()
     color.SetColorSpaceToRGB()
     opacity = vtk.vtkPiecewiseFunction()
     unit_distance = 1.0  # attenuation = opacity(s) / unit distance: tau per world unit
+    if projected:  # opacity in [0, 1]: tau / tau_max per 1 / tau_max
+        unit_distance = 1.0 / max(max(p[4] for p in points), 1e-30)
     for s, r, g, b, tau in points:
         color.AddRGBPoint(s, r, g, b)
         opacity.AddPoint(s, tau * unit_distance)
@@ -132,14 +145,18 @@ def main():
 
     prop = volume_property(color, opacity, unit_distance)
 
-    mapper = vtk.vtkUnstructuredGridVolumeRayCastMapper()
-    mapper.SetInputData(grid)
-    mapper.SetRayIntegrator(vtk.vtkUnstructuredGridPartialPreIntegration())
-    mapper.SetAutoAdjustSampleDistances(0)
-    mapper.SetImageSampleDistance(1.0)
+    if projected:
+        mapper = vtk.vtkProjectedTetrahedraMapper()
+        mapper.SetInputData(grid)
+    else:
+        mapper = vtk.vtkUnstructuredGridVolumeRayCastMapper()
+        mapper.SetInputData(grid)
+        mapper.SetRayIntegrator(vtk.vtkUnstructuredGridPartialPreIntegration())
+        mapper.SetAutoAdjustSampleDistances(0)
+        mapper.SetImageSampleDistance(1.0)
 
     window, camera = offscreen_view(mapper, prop, background, width, height, camera_spec)
-    if args.pixel_corners == 0:
+    if args.pixel_corners == 0 and not projected:
         # vtkUnstructuredGridBunykRayCastFunction casts the ray of pixel (i, j) through the point that
         # projects to x = i, y = j (TransformPoints: (ndc + 1) / 2 * size; ComputePixelIntersections tests
         # integer x, y): through a pixel's corner. clvr (DESIGN.md) casts through pixel centres, half a
@@ -153,15 +170,16 @@ def main():
     frame_ms = float(np.median(times))
     result = {
         "renderer": "VTK " + vtk.vtkVersion.GetVTKVersion(),
-        "mapper": "vtkUnstructuredGridVolumeRayCastMapper",
-        "integrator": "vtkUnstructuredGridPartialPreIntegration",
-        "threads": mapper.GetNumberOfThreads(),
+        "mapper": "vtkProjectedTetrahedraMapper" if projected else "vtkUnstructuredGridVolumeRayCastMapper",
+        "integrator": "per-vertex attenuation, exp per fragment" if projected else "vtkUnstructuredGridPartialPreIntegration",
+        "threads": 1 if projected else mapper.GetNumberOfThreads(),
         "points": grid.GetNumberOfPoints(),
         "tets": tets,
         "width": width,
         "height": height,
         "opacity_unit_distance": unit_distance,
-        "rays_through": "pixel corners" if args.pixel_corners else "pixel centres (window centre shifted half a pixel)",
+        "rays_through": "rasterized (pixel centres)" if projected else (
+            "pixel corners" if args.pixel_corners else "pixel centres (window centre shifted half a pixel)"),
         "load_ms": load_ms,
         **frame_figures(first_ms, times),
         "fps": 1000.0 / frame_ms,

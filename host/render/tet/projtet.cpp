@@ -648,6 +648,7 @@ Image4f ProjtetRenderer::render(FrameStats& stats)
     stats.extra["cells_near_plane"] = nearCells;
     stats.extra["raster_triangles"] = drawn.triangles;
     stats.extra["raster_fragments"] = drawn.fragments;
+    stats.extra["integration"] = "partial";  // harc's partial pre-integration, per fragment
     stats.extra["psi_table"] = std::to_string(psiTable().size) + "x" + std::to_string(psiTable().size);
     return image;
 }
