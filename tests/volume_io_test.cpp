@@ -812,3 +812,25 @@ TEST(VolumeIo, GarbageNeverCrashes)
 }
 
 }  // namespace
+
+namespace clvr {
+namespace {
+
+// The host-memory guards say what needs how much, before an allocation the OOM killer would end.
+TEST(HostMemory, MoreThanHalfOfTheMachineIsAnInputErrorNamingWhat)
+{
+    EXPECT_NO_THROW(checkHostMemory("small", 1u << 20));
+    EXPECT_NO_THROW(checkHostMemoryForVoxels("small.nrrd", 1u << 20));
+    try {
+        checkHostMemory("engine.nrrd: cubefan's octree", std::uint64_t(1) << 62);
+        ADD_FAILURE() << "no error";
+    } catch (const InputError& e) {
+        const std::string m = e.what();
+        EXPECT_EQ(m.rfind("engine.nrrd: cubefan's octree needs ", 0), 0u) << m;
+        EXPECT_NE(m.find("more than half of this machine's"), std::string::npos) << m;
+    }
+    EXPECT_THROW(checkHostMemoryForVoxels("huge.nrrd", std::uint64_t(1) << 60), InputError);
+}
+
+}  // namespace
+}  // namespace clvr

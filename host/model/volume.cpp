@@ -21,16 +21,32 @@ glm::vec3 GridPart::ownHi(const glm::ivec3& dims) const
     return hi;
 }
 
-void checkHostMemoryForVoxels(const std::string& source, std::uint64_t voxels)
+namespace {
+
+// This machine's physical memory in bytes; 0 when the system does not say.
+std::uint64_t physicalMemory()
 {
     const long pages = ::sysconf(_SC_PHYS_PAGES), pageSize = ::sysconf(_SC_PAGE_SIZE);
-    if (pages <= 0 || pageSize <= 0)
-        return;  // unknown: let the allocation decide
-    const std::uint64_t physical = static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(pageSize);
+    return pages > 0 && pageSize > 0 ? static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(pageSize) : 0;
+}
+
+}  // namespace
+
+void checkHostMemoryForVoxels(const std::string& source, std::uint64_t voxels)
+{
+    const std::uint64_t physical = physicalMemory();  // 0: unknown, let the allocation decide
     const std::uint64_t needed = voxels * sizeof(float);
-    if (needed > physical / 2)
+    if (physical > 0 && needed > physical / 2)
         throw InputError(source + ": " + std::to_string(voxels) + " grid points need " +
                          std::to_string(needed >> 20) + " MiB as float32, more than half of this machine's " +
+                         std::to_string(physical >> 20) + " MiB of memory");
+}
+
+void checkHostMemory(const std::string& what, std::uint64_t bytes)
+{
+    const std::uint64_t physical = physicalMemory();
+    if (physical > 0 && bytes > physical / 2)
+        throw InputError(what + " needs " + std::to_string(bytes >> 20) + " MiB, more than half of this machine's " +
                          std::to_string(physical >> 20) + " MiB of memory");
 }
 

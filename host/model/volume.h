@@ -16,6 +16,10 @@ namespace clvr {
 // machine's physical memory: a volume that large would be killed by the OOM killer, not reported.
 void checkHostMemoryForVoxels(const std::string& source, std::uint64_t voxels);
 
+// The same for `bytes` of host memory that `what` ("engine.nrrd: cubefan's octree") needs:
+// InputError "WHAT needs N MiB, more than half of this machine's M MiB of memory".
+void checkHostMemory(const std::string& what, std::uint64_t bytes);
+
 // Where a volume sits in the larger grid it was cut from (sort-last cluster rendering, host/cluster/):
 // its grid point (0, 0, 0) is point `offset` of that grid, whose dims and origin these are (same
 // spacing). It may hold `ghostLo`/`ghostHi` extra layers of points beyond its own on each axis (0 or 1;
