@@ -6,7 +6,12 @@
 # planes, an orbit); frames mode gives the one-process orbit frames; a failure on one rank (missing scene
 # file, kernel build failure, failed launch, technique that cannot render a part) gives one error line,
 # the same non-zero status from mpirun, within seconds, no output.
-# Inputs: CLVR, MPIEXEC, OIIOTOOL, SRC, WORK. Images are 64x64 or 96x96 to stay fast.
+# Inputs: CLVR, MPIEXEC, OIIOTOOL, SRC, WORK, PART. PART picks one part of the checks (volume, views,
+# mesh, shaded, errors): tests/CMakeLists.txt makes each part its own CTest test (cluster.PART), so that
+# ctest -j runs them side by side. Images are 64x64 or 96x96 to stay fast.
+if(NOT PART MATCHES "^(volume|views|mesh|shaded|errors)$")
+  message(FATAL_ERROR "PART \"${PART}\": want volume, views, mesh, shaded or errors")
+endif()
 file(REMOVE_RECURSE "${WORK}")
 file(MAKE_DIRECTORY "${WORK}")
 set(ENV{OMPI_ALLOW_RUN_AS_ROOT} 1)  # ../shared/CLUSTER-NOTES.md: CI runs as root
@@ -52,17 +57,6 @@ function(sort_last name ranks)
   expect_same(${WORK}/${name}-1p.png ${WORK}/${name}-${n}.png 0.0040)  # at most one 8-bit step
 endfunction()
 
-sort_last(volume "1;2;3;5;8" ${VOLUME})
-sort_last(volume-parallel "2;4" ${VOLUME} --set camera.projection=\"parallel\" --set camera.parallel_scale=1.3)
-sort_last(volume-inside "3;6" ${VOLUME} --set camera.position=[0.2,0.3,0.6] --set camera.view_angle=80)
-# planes and blend: parts with a ghost layer of points for the Sobel gradients; planes without early
-# termination (a part cannot see the opacity in front of it; with it, one process differs by <= 1 - 0.99).
-sort_last(planes "2;4" ${SRC}/data/scenes/engine-planes.json --set image.width=64 --set image.height=64
-          --set options.early_termination=1)
-sort_last(blend "3" ${SRC}/data/scenes/engine-blend.json --set image.width=64 --set image.height=64)
-sort_last(mesh "1;2;4;7" ${MESH})
-sort_last(mesh-parallel "3" ${MESH} --set camera.projection=\"parallel\" --set camera.parallel_scale=1.4)
-
 # sort_first(NAME ONE_PROCESS RANKS scene args...): every rank renders a band of rows of the whole data;
 # the EXR equals ONE_PROCESS (a one-process EXR of the same arguments, rendered here when it is not there
 # yet) bit for bit: a band takes the full image's rays (kernels/ray.h clvr_ray_window_offset).
@@ -75,51 +69,6 @@ function(sort_first name one ranks)
     expect_same(${one} ${WORK}/${name}-${n}.exr 0)
   endforeach()
 endfunction()
-
-# Sort-first for the techniques sort-last cannot take too (iso3d's raster stage, planes' shading).
-set(SMALL64 --set image.width=64 --set image.height=64)
-sort_first(first-volume ${WORK}/volume-1p.exr "2;8" ${VOLUME})
-sort_first(first-volume-inside ${WORK}/volume-inside-1p.exr "3" ${VOLUME} --set camera.position=[0.2,0.3,0.6]
-           --set camera.view_angle=80)
-sort_first(first-iso ${WORK}/first-iso-1p.exr "5" ${SRC}/data/scenes/engine-iso.json ${SMALL64})
-sort_first(first-planes ${WORK}/first-planes-1p.exr "3" ${SRC}/data/scenes/engine-planes.json ${SMALL64})
-sort_first(first-mesh ${WORK}/mesh-1p.exr "4" ${MESH})
-sort_first(first-mesh-parallel ${WORK}/mesh-parallel-1p.exr "3" ${MESH} --set camera.projection=\"parallel\"
-           --set camera.parallel_scale=1.4)
-
-# Sort-first orbit: each frame as one process renders it, the bands rebalanced from the previous frame's
-# cost (rows per rank in the stats add up to the image's height every frame).
-run_ok(${CLVR} render ${MESH} --orbit 3 -o ${WORK}/first-orbit-1p-%d.exr)
-run_ok(${MPI} -np 3 ${CLVR} render ${MESH} --orbit 3 --distribution sort-first -o ${WORK}/first-orbit-%d.exr
-       --stats ${WORK}/first-orbit.json)
-file(READ ${WORK}/first-orbit.json stats)
-foreach(k RANGE 2)
-  expect_same(${WORK}/first-orbit-1p-${k}.exr ${WORK}/first-orbit-${k}.exr 0)
-  set(sum 0)
-  foreach(r RANGE 2)
-    string(JSON rows GET "${stats}" frames ${k} rows_per_rank ${r})
-    if(rows LESS 1)
-      message(FATAL_ERROR "sort-first orbit frame ${k}: rank ${r} has ${rows} rows\n${stats}")
-    endif()
-    math(EXPR sum "${sum} + ${rows}")
-  endforeach()
-  if(NOT sum EQUAL 96)
-    message(FATAL_ERROR "sort-first orbit frame ${k}: the bands hold ${sum} rows, want 96\n${stats}")
-  endif()
-endforeach()
-
-# Frames: an orbit of 5 frames on 3 ranks, each frame as one process renders it.
-run_ok(${CLVR} render ${VOLUME} --orbit 5 -o ${WORK}/orbit-1p-%d.png)
-run_ok(${MPI} -np 3 ${CLVR} render ${VOLUME} --orbit 5 -o ${WORK}/orbit-%d.png --stats ${WORK}/orbit.json)
-foreach(k RANGE 4)
-  expect_same(${WORK}/orbit-1p-${k}.png ${WORK}/orbit-${k}.png 0)
-endforeach()
-file(READ ${WORK}/orbit.json stats)
-string(JSON ranks GET "${stats}" ranks)
-string(JSON rank4 GET "${stats}" frames 4 rank)
-if(NOT ranks EQUAL 3 OR NOT rank4 EQUAL 1)
-  message(FATAL_ERROR "orbit stats: ranks ${ranks}, frame 4 on rank ${rank4}; want 3 and 1\n${stats}")
-endif()
 
 # expect_job_error(RC PATTERN mpirun-args...): mpirun's status RC, exactly one "clvr: error:" line (rank 0
 # speaks for all) matching PATTERN, within 60 s, and no image.
@@ -146,16 +95,85 @@ function(expect_job_error expected_rc pattern)
   endif()
 endfunction()
 
-set(SMALL --set image.width=64 --set image.height=64 -o ${WORK}/fail.png)
-expect_job_error(2 "rank 1: .*missing.json: no such scene file"
-  ${MPI} -np 1 ${CLVR} render ${SRC}/data/scenes/default.json ${SMALL}
-       : -np 1 ${CLVR} render ${WORK}/missing.json ${SMALL})
-expect_job_error(3 "rank 2: building kernels/"
-  ${MPI} -np 2 ${CLVR} render ${SRC}/data/scenes/default.json ${SMALL}
-       : -np 1 -x CLVR_INJECT_FAULT=build ${CLVR} render ${SRC}/data/scenes/default.json ${SMALL})
-expect_job_error(3 "CL_OUT_OF_RESOURCES .injected"
-  ${MPI} -np 3 -x CLVR_INJECT_FAULT=launch:1 ${CLVR} render ${SRC}/data/scenes/default.json ${SMALL})
-expect_job_error(2 "iso3d does not render a part"
-  ${MPI} -np 2 ${CLVR} render ${SRC}/data/scenes/engine-iso.json ${SMALL})
-expect_job_error(2 "unknown distribution \"tiles\""
-  ${MPI} -np 2 ${CLVR} render ${SRC}/data/scenes/default.json ${SMALL} --distribution tiles)
+set(SMALL64 --set image.width=64 --set image.height=64)
+
+if(PART STREQUAL "volume")
+  sort_last(volume "1;2;3;5;8" ${VOLUME})
+  sort_first(first-volume ${WORK}/volume-1p.exr "2;8" ${VOLUME})
+
+  # Frames: an orbit of 5 frames on 3 ranks, each frame as one process renders it.
+  run_ok(${CLVR} render ${VOLUME} --orbit 5 -o ${WORK}/orbit-1p-%d.png)
+  run_ok(${MPI} -np 3 ${CLVR} render ${VOLUME} --orbit 5 -o ${WORK}/orbit-%d.png --stats ${WORK}/orbit.json)
+  foreach(k RANGE 4)
+    expect_same(${WORK}/orbit-1p-${k}.png ${WORK}/orbit-${k}.png 0)
+  endforeach()
+  file(READ ${WORK}/orbit.json stats)
+  string(JSON ranks GET "${stats}" ranks)
+  string(JSON rank4 GET "${stats}" frames 4 rank)
+  if(NOT ranks EQUAL 3 OR NOT rank4 EQUAL 1)
+    message(FATAL_ERROR "orbit stats: ranks ${ranks}, frame 4 on rank ${rank4}; want 3 and 1\n${stats}")
+  endif()
+endif()
+
+if(PART STREQUAL "views")
+  sort_last(volume-parallel "2;4" ${VOLUME} --set camera.projection=\"parallel\" --set camera.parallel_scale=1.3)
+  sort_last(volume-inside "3;6" ${VOLUME} --set camera.position=[0.2,0.3,0.6] --set camera.view_angle=80)
+  sort_first(first-volume-inside ${WORK}/volume-inside-1p.exr "3" ${VOLUME} --set camera.position=[0.2,0.3,0.6]
+             --set camera.view_angle=80)
+  sort_last(mesh-parallel "3" ${MESH} --set camera.projection=\"parallel\" --set camera.parallel_scale=1.4)
+  sort_first(first-mesh-parallel ${WORK}/mesh-parallel-1p.exr "3" ${MESH} --set camera.projection=\"parallel\"
+             --set camera.parallel_scale=1.4)
+endif()
+
+if(PART STREQUAL "mesh")
+  sort_last(mesh "1;2;4;7" ${MESH})
+  sort_first(first-mesh ${WORK}/mesh-1p.exr "4" ${MESH})
+
+  # Sort-first orbit: each frame as one process renders it, the bands rebalanced from the previous frame's
+  # cost (rows per rank in the stats add up to the image's height every frame).
+  run_ok(${CLVR} render ${MESH} --orbit 3 -o ${WORK}/first-orbit-1p-%d.exr)
+  run_ok(${MPI} -np 3 ${CLVR} render ${MESH} --orbit 3 --distribution sort-first -o ${WORK}/first-orbit-%d.exr
+         --stats ${WORK}/first-orbit.json)
+  file(READ ${WORK}/first-orbit.json stats)
+  foreach(k RANGE 2)
+    expect_same(${WORK}/first-orbit-1p-${k}.exr ${WORK}/first-orbit-${k}.exr 0)
+    set(sum 0)
+    foreach(r RANGE 2)
+      string(JSON rows GET "${stats}" frames ${k} rows_per_rank ${r})
+      if(rows LESS 1)
+        message(FATAL_ERROR "sort-first orbit frame ${k}: rank ${r} has ${rows} rows\n${stats}")
+      endif()
+      math(EXPR sum "${sum} + ${rows}")
+    endforeach()
+    if(NOT sum EQUAL 96)
+      message(FATAL_ERROR "sort-first orbit frame ${k}: the bands hold ${sum} rows, want 96\n${stats}")
+    endif()
+  endforeach()
+endif()
+
+if(PART STREQUAL "shaded")
+  # planes and blend: parts with a ghost layer of points for the Sobel gradients; planes without early
+  # termination (a part cannot see the opacity in front of it; with it, one process differs by <= 1 - 0.99).
+  sort_last(planes "2;4" ${SRC}/data/scenes/engine-planes.json --set image.width=64 --set image.height=64
+            --set options.early_termination=1)
+  sort_last(blend "3" ${SRC}/data/scenes/engine-blend.json --set image.width=64 --set image.height=64)
+  # Sort-first for the techniques sort-last cannot take too (iso3d's raster stage, planes' shading).
+  sort_first(first-iso ${WORK}/first-iso-1p.exr "5" ${SRC}/data/scenes/engine-iso.json ${SMALL64})
+  sort_first(first-planes ${WORK}/first-planes-1p.exr "3" ${SRC}/data/scenes/engine-planes.json ${SMALL64})
+endif()
+
+if(PART STREQUAL "errors")
+  set(SMALL --set image.width=64 --set image.height=64 -o ${WORK}/fail.png)
+  expect_job_error(2 "rank 1: .*missing.json: no such scene file"
+    ${MPI} -np 1 ${CLVR} render ${SRC}/data/scenes/default.json ${SMALL}
+         : -np 1 ${CLVR} render ${WORK}/missing.json ${SMALL})
+  expect_job_error(3 "rank 2: building kernels/"
+    ${MPI} -np 2 ${CLVR} render ${SRC}/data/scenes/default.json ${SMALL}
+         : -np 1 -x CLVR_INJECT_FAULT=build ${CLVR} render ${SRC}/data/scenes/default.json ${SMALL})
+  expect_job_error(3 "CL_OUT_OF_RESOURCES .injected"
+    ${MPI} -np 3 -x CLVR_INJECT_FAULT=launch:1 ${CLVR} render ${SRC}/data/scenes/default.json ${SMALL})
+  expect_job_error(2 "iso3d does not render a part"
+    ${MPI} -np 2 ${CLVR} render ${SRC}/data/scenes/engine-iso.json ${SMALL})
+  expect_job_error(2 "unknown distribution \"tiles\""
+    ${MPI} -np 2 ${CLVR} render ${SRC}/data/scenes/default.json ${SMALL} --distribution tiles)
+endif()
