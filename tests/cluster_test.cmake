@@ -29,9 +29,14 @@ function(run_ok)
   endif()
 endfunction()
 
-# expect_same(A B TOLERANCE): every channel of every pixel within TOLERANCE (oiiotool --diff).
+# expect_same(A B TOLERANCE [FROM_EXR]): every channel of every pixel within TOLERANCE (oiiotool --diff);
+# with FROM_EXR, B is a PNG (8-bit RGB) compared with the float RGB of the EXR A clamped to [0, 1].
 function(expect_same a b tolerance)
-  execute_process(COMMAND ${OIIOTOOL} --fail ${tolerance} --failpercent 0 ${a} ${b} --diff
+  set(pick)
+  if(ARGV3 STREQUAL "FROM_EXR")
+    set(pick --ch R,G,B --clamp:min=0:max=1)
+  endif()
+  execute_process(COMMAND ${OIIOTOOL} --fail ${tolerance} --failpercent 0 ${a} ${pick} ${b} --diff
                   RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(NOT rc STREQUAL "0")
     message(FATAL_ERROR "${b} differs from ${a} by more than ${tolerance}:\n${out}${err}")
@@ -43,18 +48,27 @@ function(expect_same a b tolerance)
   message(STATUS "${b}: ${worst} (tolerance ${tolerance})")
 endfunction()
 
-# sort_last(NAME RANKS scene args...): one process and N ranks, compared as EXR (float); PNG (8-bit) for the
-# last N only: within 2e-5 in float, the 8-bit values round at most one step apart anyway.
+# sort_last(NAME RANKS scene args...): one process and N ranks, compared as EXR (float); then a PNG (8-bit) of
+# the first N above 1 against the one-process EXR: within half an 8-bit step (round to nearest) plus the
+# EXR's 2e-5, so within one step of the one-process PNG, which expect_png_of checks against its EXR.
+# Rank 0 writes the composited image as one process does whatever N, so one N shows the PNG path.
 function(sort_last name ranks)
   run_ok(${CLVR} render ${ARGN} -o ${WORK}/${name}-1p.exr)
   foreach(n ${ranks})
     run_ok(${MPI} -np ${n} ${CLVR} render ${ARGN} -o ${WORK}/${name}-${n}.exr)
     expect_same(${WORK}/${name}-1p.exr ${WORK}/${name}-${n}.exr 2e-5)
   endforeach()
-  list(GET ranks -1 n)
-  run_ok(${CLVR} render ${ARGN} -o ${WORK}/${name}-1p.png)
+  list(FILTER ranks EXCLUDE REGEX "^1$")
+  list(GET ranks 0 n)
   run_ok(${MPI} -np ${n} ${CLVR} render ${ARGN} -o ${WORK}/${name}-${n}.png)
-  expect_same(${WORK}/${name}-1p.png ${WORK}/${name}-${n}.png 0.0040)  # at most one 8-bit step
+  expect_same(${WORK}/${name}-1p.exr ${WORK}/${name}-${n}.png 0.002 FROM_EXR)  # 0.5/255 + 2e-5 = 0.00198
+endfunction()
+
+# expect_png_of(NAME scene args...): one process's PNG is its EXR (${NAME}-1p.exr, from sort_last) rounded to
+# 8 bits: within half a step.
+function(expect_png_of name)
+  run_ok(${CLVR} render ${ARGN} -o ${WORK}/${name}-1p.png)
+  expect_same(${WORK}/${name}-1p.exr ${WORK}/${name}-1p.png 0.00197 FROM_EXR)  # 0.5/255 = 0.00196
 endfunction()
 
 # sort_first(NAME ONE_PROCESS RANKS scene args...): every rank renders a band of rows of the whole data;
@@ -99,6 +113,7 @@ set(SMALL64 --set image.width=64 --set image.height=64)
 
 if(PART STREQUAL "volume")
   sort_last(volume "1;2;3;5;8" ${VOLUME})
+  expect_png_of(volume ${VOLUME})
   sort_first(first-volume ${WORK}/volume-1p.exr "2;8" ${VOLUME})
 
   # Frames: an orbit of 5 frames on 3 ranks, each frame as one process renders it.
@@ -127,6 +142,7 @@ endif()
 
 if(PART STREQUAL "mesh")
   sort_last(mesh "1;2;4;7" ${MESH})
+  expect_png_of(mesh ${MESH})
   sort_first(first-mesh ${WORK}/mesh-1p.exr "4" ${MESH})
 
   # Sort-first orbit: each frame as one process renders it, the bands rebalanced from the previous frame's
