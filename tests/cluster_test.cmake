@@ -16,6 +16,11 @@ file(REMOVE_RECURSE "${WORK}")
 file(MAKE_DIRECTORY "${WORK}")
 set(ENV{OMPI_ALLOW_RUN_AS_ROOT} 1)  # ../shared/CLUSTER-NOTES.md: CI runs as root
 set(ENV{OMPI_ALLOW_RUN_AS_ROOT_CONFIRM} 1)
+# Each part's own Open MPI session directory: parts that ctest -j runs side by side would share
+# /tmp/ompi.HOST.UID, and an mpirun that ends may remove it while another one starts inside it ("orte_init
+# failed ... orte_session_dir failed", seen once with ctest -j2; open-mpi/ompi#8510).
+file(MAKE_DIRECTORY "${WORK}/mpi")
+set(ENV{OMPI_MCA_orte_tmpdir_base} "${WORK}/mpi")
 set(MPI ${MPIEXEC} --oversubscribe)
 set(VOLUME ${SRC}/data/scenes/default.json --set image={"width":96,"height":96,"background":[0.1,0.2,0.3]}
     --set options.slices=160)
