@@ -6,11 +6,21 @@
 # planes, an orbit); frames mode gives the one-process orbit frames; a failure on one rank (missing scene
 # file, kernel build failure, failed launch, technique that cannot render a part) gives one error line,
 # the same non-zero status from mpirun, within seconds, no output.
-# Inputs: CLVR, MPIEXEC, OIIOTOOL, SRC, WORK. Images are 64x64 or 96x96 to stay fast.
+# Inputs: CLVR, MPIEXEC, OIIOTOOL, SRC, WORK, PART. PART picks one part of the checks (volume, views,
+# mesh, shaded, errors): tests/CMakeLists.txt makes each part its own CTest test (cluster.PART), so that
+# ctest -j runs them side by side. Images are 64x64 or 96x96 to stay fast.
+if(NOT PART MATCHES "^(volume|views|mesh|shaded|errors)$")
+  message(FATAL_ERROR "PART \"${PART}\": want volume, views, mesh, shaded or errors")
+endif()
 file(REMOVE_RECURSE "${WORK}")
 file(MAKE_DIRECTORY "${WORK}")
 set(ENV{OMPI_ALLOW_RUN_AS_ROOT} 1)  # ../shared/CLUSTER-NOTES.md: CI runs as root
 set(ENV{OMPI_ALLOW_RUN_AS_ROOT_CONFIRM} 1)
+# Each part's own Open MPI session directory: parts that ctest -j runs side by side would share
+# /tmp/ompi.HOST.UID, and an mpirun that ends may remove it while another one starts inside it ("orte_init
+# failed ... orte_session_dir failed", seen once with ctest -j2; open-mpi/ompi#8510).
+file(MAKE_DIRECTORY "${WORK}/mpi")
+set(ENV{OMPI_MCA_orte_tmpdir_base} "${WORK}/mpi")
 set(MPI ${MPIEXEC} --oversubscribe)
 set(VOLUME ${SRC}/data/scenes/default.json --set image={"width":96,"height":96,"background":[0.1,0.2,0.3]}
     --set options.slices=160)
@@ -24,9 +34,14 @@ function(run_ok)
   endif()
 endfunction()
 
-# expect_same(A B TOLERANCE): every channel of every pixel within TOLERANCE (oiiotool --diff).
+# expect_same(A B TOLERANCE [FROM_EXR]): every channel of every pixel within TOLERANCE (oiiotool --diff);
+# with FROM_EXR, B is a PNG (8-bit RGB) compared with the float RGB of the EXR A clamped to [0, 1].
 function(expect_same a b tolerance)
-  execute_process(COMMAND ${OIIOTOOL} --fail ${tolerance} --failpercent 0 ${a} ${b} --diff
+  set(pick)
+  if(ARGV3 STREQUAL "FROM_EXR")
+    set(pick --ch R,G,B --clamp:min=0:max=1)
+  endif()
+  execute_process(COMMAND ${OIIOTOOL} --fail ${tolerance} --failpercent 0 ${a} ${pick} ${b} --diff
                   RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(NOT rc STREQUAL "0")
     message(FATAL_ERROR "${b} differs from ${a} by more than ${tolerance}:\n${out}${err}")
@@ -38,30 +53,28 @@ function(expect_same a b tolerance)
   message(STATUS "${b}: ${worst} (tolerance ${tolerance})")
 endfunction()
 
-# sort_last(NAME RANKS scene args...): one process and N ranks, compared as EXR (float); PNG (8-bit) for the
-# last N only: within 2e-5 in float, the 8-bit values round at most one step apart anyway.
+# sort_last(NAME RANKS scene args...): one process and N ranks, compared as EXR (float); then a PNG (8-bit) of
+# the first N above 1 against the one-process EXR: within half an 8-bit step (round to nearest) plus the
+# EXR's 2e-5, so within one step of the one-process PNG, which expect_png_of checks against its EXR.
+# Rank 0 writes the composited image as one process does whatever N, so one N shows the PNG path.
 function(sort_last name ranks)
   run_ok(${CLVR} render ${ARGN} -o ${WORK}/${name}-1p.exr)
   foreach(n ${ranks})
     run_ok(${MPI} -np ${n} ${CLVR} render ${ARGN} -o ${WORK}/${name}-${n}.exr)
     expect_same(${WORK}/${name}-1p.exr ${WORK}/${name}-${n}.exr 2e-5)
   endforeach()
-  list(GET ranks -1 n)
-  run_ok(${CLVR} render ${ARGN} -o ${WORK}/${name}-1p.png)
+  list(FILTER ranks EXCLUDE REGEX "^1$")
+  list(GET ranks 0 n)
   run_ok(${MPI} -np ${n} ${CLVR} render ${ARGN} -o ${WORK}/${name}-${n}.png)
-  expect_same(${WORK}/${name}-1p.png ${WORK}/${name}-${n}.png 0.0040)  # at most one 8-bit step
+  expect_same(${WORK}/${name}-1p.exr ${WORK}/${name}-${n}.png 0.002 FROM_EXR)  # 0.5/255 + 2e-5 = 0.00198
 endfunction()
 
-sort_last(volume "1;2;3;5;8" ${VOLUME})
-sort_last(volume-parallel "2;4" ${VOLUME} --set camera.projection=\"parallel\" --set camera.parallel_scale=1.3)
-sort_last(volume-inside "3;6" ${VOLUME} --set camera.position=[0.2,0.3,0.6] --set camera.view_angle=80)
-# planes and blend: parts with a ghost layer of points for the Sobel gradients; planes without early
-# termination (a part cannot see the opacity in front of it; with it, one process differs by <= 1 - 0.99).
-sort_last(planes "2;4" ${SRC}/data/scenes/engine-planes.json --set image.width=64 --set image.height=64
-          --set options.early_termination=1)
-sort_last(blend "3" ${SRC}/data/scenes/engine-blend.json --set image.width=64 --set image.height=64)
-sort_last(mesh "1;2;4;7" ${MESH})
-sort_last(mesh-parallel "3" ${MESH} --set camera.projection=\"parallel\" --set camera.parallel_scale=1.4)
+# expect_png_of(NAME scene args...): one process's PNG is its EXR (${NAME}-1p.exr, from sort_last) rounded to
+# 8 bits: within half a step.
+function(expect_png_of name)
+  run_ok(${CLVR} render ${ARGN} -o ${WORK}/${name}-1p.png)
+  expect_same(${WORK}/${name}-1p.exr ${WORK}/${name}-1p.png 0.00197 FROM_EXR)  # 0.5/255 = 0.00196
+endfunction()
 
 # sort_first(NAME ONE_PROCESS RANKS scene args...): every rank renders a band of rows of the whole data;
 # the EXR equals ONE_PROCESS (a one-process EXR of the same arguments, rendered here when it is not there
@@ -75,51 +88,6 @@ function(sort_first name one ranks)
     expect_same(${one} ${WORK}/${name}-${n}.exr 0)
   endforeach()
 endfunction()
-
-# Sort-first for the techniques sort-last cannot take too (iso3d's raster stage, planes' shading).
-set(SMALL64 --set image.width=64 --set image.height=64)
-sort_first(first-volume ${WORK}/volume-1p.exr "2;8" ${VOLUME})
-sort_first(first-volume-inside ${WORK}/volume-inside-1p.exr "3" ${VOLUME} --set camera.position=[0.2,0.3,0.6]
-           --set camera.view_angle=80)
-sort_first(first-iso ${WORK}/first-iso-1p.exr "5" ${SRC}/data/scenes/engine-iso.json ${SMALL64})
-sort_first(first-planes ${WORK}/first-planes-1p.exr "3" ${SRC}/data/scenes/engine-planes.json ${SMALL64})
-sort_first(first-mesh ${WORK}/mesh-1p.exr "4" ${MESH})
-sort_first(first-mesh-parallel ${WORK}/mesh-parallel-1p.exr "3" ${MESH} --set camera.projection=\"parallel\"
-           --set camera.parallel_scale=1.4)
-
-# Sort-first orbit: each frame as one process renders it, the bands rebalanced from the previous frame's
-# cost (rows per rank in the stats add up to the image's height every frame).
-run_ok(${CLVR} render ${MESH} --orbit 3 -o ${WORK}/first-orbit-1p-%d.exr)
-run_ok(${MPI} -np 3 ${CLVR} render ${MESH} --orbit 3 --distribution sort-first -o ${WORK}/first-orbit-%d.exr
-       --stats ${WORK}/first-orbit.json)
-file(READ ${WORK}/first-orbit.json stats)
-foreach(k RANGE 2)
-  expect_same(${WORK}/first-orbit-1p-${k}.exr ${WORK}/first-orbit-${k}.exr 0)
-  set(sum 0)
-  foreach(r RANGE 2)
-    string(JSON rows GET "${stats}" frames ${k} rows_per_rank ${r})
-    if(rows LESS 1)
-      message(FATAL_ERROR "sort-first orbit frame ${k}: rank ${r} has ${rows} rows\n${stats}")
-    endif()
-    math(EXPR sum "${sum} + ${rows}")
-  endforeach()
-  if(NOT sum EQUAL 96)
-    message(FATAL_ERROR "sort-first orbit frame ${k}: the bands hold ${sum} rows, want 96\n${stats}")
-  endif()
-endforeach()
-
-# Frames: an orbit of 5 frames on 3 ranks, each frame as one process renders it.
-run_ok(${CLVR} render ${VOLUME} --orbit 5 -o ${WORK}/orbit-1p-%d.png)
-run_ok(${MPI} -np 3 ${CLVR} render ${VOLUME} --orbit 5 -o ${WORK}/orbit-%d.png --stats ${WORK}/orbit.json)
-foreach(k RANGE 4)
-  expect_same(${WORK}/orbit-1p-${k}.png ${WORK}/orbit-${k}.png 0)
-endforeach()
-file(READ ${WORK}/orbit.json stats)
-string(JSON ranks GET "${stats}" ranks)
-string(JSON rank4 GET "${stats}" frames 4 rank)
-if(NOT ranks EQUAL 3 OR NOT rank4 EQUAL 1)
-  message(FATAL_ERROR "orbit stats: ranks ${ranks}, frame 4 on rank ${rank4}; want 3 and 1\n${stats}")
-endif()
 
 # expect_job_error(RC PATTERN mpirun-args...): mpirun's status RC, exactly one "clvr: error:" line (rank 0
 # speaks for all) matching PATTERN, within 60 s, and no image.
@@ -146,16 +114,95 @@ function(expect_job_error expected_rc pattern)
   endif()
 endfunction()
 
-set(SMALL --set image.width=64 --set image.height=64 -o ${WORK}/fail.png)
-expect_job_error(2 "rank 1: .*missing.json: no such scene file"
-  ${MPI} -np 1 ${CLVR} render ${SRC}/data/scenes/default.json ${SMALL}
-       : -np 1 ${CLVR} render ${WORK}/missing.json ${SMALL})
-expect_job_error(3 "rank 2: building kernels/"
-  ${MPI} -np 2 ${CLVR} render ${SRC}/data/scenes/default.json ${SMALL}
-       : -np 1 -x CLVR_INJECT_FAULT=build ${CLVR} render ${SRC}/data/scenes/default.json ${SMALL})
-expect_job_error(3 "CL_OUT_OF_RESOURCES .injected"
-  ${MPI} -np 3 -x CLVR_INJECT_FAULT=launch:1 ${CLVR} render ${SRC}/data/scenes/default.json ${SMALL})
-expect_job_error(2 "iso3d does not render a part"
-  ${MPI} -np 2 ${CLVR} render ${SRC}/data/scenes/engine-iso.json ${SMALL})
-expect_job_error(2 "unknown distribution \"tiles\""
-  ${MPI} -np 2 ${CLVR} render ${SRC}/data/scenes/default.json ${SMALL} --distribution tiles)
+set(SMALL64 --set image.width=64 --set image.height=64)
+
+if(PART STREQUAL "volume")
+  sort_last(volume "1;2;3;5;8" ${VOLUME})
+  expect_png_of(volume ${VOLUME})
+  sort_first(first-volume ${WORK}/volume-1p.exr "2;8" ${VOLUME})
+
+  # Frames: an orbit of 5 frames on 3 ranks, each frame as one process renders it.
+  run_ok(${CLVR} render ${VOLUME} --orbit 5 -o ${WORK}/orbit-1p-%d.png)
+  run_ok(${MPI} -np 3 ${CLVR} render ${VOLUME} --orbit 5 -o ${WORK}/orbit-%d.png --stats ${WORK}/orbit.json)
+  foreach(k RANGE 4)
+    expect_same(${WORK}/orbit-1p-${k}.png ${WORK}/orbit-${k}.png 0)
+  endforeach()
+  file(READ ${WORK}/orbit.json stats)
+  string(JSON ranks GET "${stats}" ranks)
+  string(JSON rank4 GET "${stats}" frames 4 rank)
+  if(NOT ranks EQUAL 3 OR NOT rank4 EQUAL 1)
+    message(FATAL_ERROR "orbit stats: ranks ${ranks}, frame 4 on rank ${rank4}; want 3 and 1\n${stats}")
+  endif()
+endif()
+
+if(PART STREQUAL "views")
+  sort_last(volume-parallel "2;4" ${VOLUME} --set camera.projection=\"parallel\" --set camera.parallel_scale=1.3)
+  sort_last(volume-inside "3;6" ${VOLUME} --set camera.position=[0.2,0.3,0.6] --set camera.view_angle=80)
+  sort_first(first-volume-inside ${WORK}/volume-inside-1p.exr "3" ${VOLUME} --set camera.position=[0.2,0.3,0.6]
+             --set camera.view_angle=80)
+  sort_last(mesh-parallel "3" ${MESH} --set camera.projection=\"parallel\" --set camera.parallel_scale=1.4)
+  sort_first(first-mesh-parallel ${WORK}/mesh-parallel-1p.exr "3" ${MESH} --set camera.projection=\"parallel\"
+             --set camera.parallel_scale=1.4)
+endif()
+
+if(PART STREQUAL "mesh")
+  sort_last(mesh "1;2;4;7" ${MESH})
+  expect_png_of(mesh ${MESH})
+  sort_first(first-mesh ${WORK}/mesh-1p.exr "4" ${MESH})
+
+  # Sort-first orbit: each frame as one process renders it, the bands rebalanced from the previous frame's
+  # cost (rows per rank in the stats add up to the image's height every frame).
+  run_ok(${CLVR} render ${MESH} --orbit 3 -o ${WORK}/first-orbit-1p-%d.exr)
+  run_ok(${MPI} -np 3 ${CLVR} render ${MESH} --orbit 3 --distribution sort-first -o ${WORK}/first-orbit-%d.exr
+         --stats ${WORK}/first-orbit.json)
+  file(READ ${WORK}/first-orbit.json stats)
+  foreach(k RANGE 2)
+    expect_same(${WORK}/first-orbit-1p-${k}.exr ${WORK}/first-orbit-${k}.exr 0)
+    set(sum 0)
+    foreach(r RANGE 2)
+      string(JSON rows GET "${stats}" frames ${k} rows_per_rank ${r})
+      if(rows LESS 1)
+        message(FATAL_ERROR "sort-first orbit frame ${k}: rank ${r} has ${rows} rows\n${stats}")
+      endif()
+      math(EXPR sum "${sum} + ${rows}")
+    endforeach()
+    if(NOT sum EQUAL 96)
+      message(FATAL_ERROR "sort-first orbit frame ${k}: the bands hold ${sum} rows, want 96\n${stats}")
+    endif()
+  endforeach()
+endif()
+
+if(PART STREQUAL "shaded")
+  # Shaded techniques with two lights on a small Marschner-Lobb volume: what is checked (parts, ghost layers,
+  # bands) does not depend on the volume's size, and the engine's 256x256x128 took 1-2 s to load and shade
+  # per rank.
+  set(SHADED ${SRC}/data/scenes/default.json ${SMALL64} --set volume.dims=[48,48,48]
+      --set lights=[{"direction":[1,-0.6,0.8]},{"direction":[-0.5,-1,0.2],"color":[0.35,0.35,0.45]}]
+      --set material={"ambient":0.35,"diffuse":0.75,"specular":0.4,"shininess":24})
+  # planes and blend: parts with a ghost layer of points for the Sobel gradients; planes without early
+  # termination (a part cannot see the opacity in front of it; with it, one process differs by <= 1 - 0.99).
+  sort_last(planes "2;4" ${SHADED} --set technique=planes
+            --set options={"early_termination":1,"opacity_threshold":0.002})
+  sort_last(blend "3" ${SHADED} --set technique=blend --set options={"slices":256,"opacity_threshold":0.002})
+  # Sort-first for the techniques sort-last cannot take too (iso3d's raster stage, planes' shading).
+  sort_first(first-iso ${WORK}/first-iso-1p.exr "5" ${SHADED} --set technique=iso3d --set options={"slices":512}
+             --set iso={"value":0.5,"shading":"gradient","light":[1,-0.6,0.8],"ambient":0.2,"diffuse":0.8})
+  sort_first(first-planes ${WORK}/first-planes-1p.exr "3" ${SHADED} --set technique=planes
+             --set options={"opacity_threshold":0.002})
+endif()
+
+if(PART STREQUAL "errors")
+  set(SMALL --set image.width=64 --set image.height=64 -o ${WORK}/fail.png)
+  expect_job_error(2 "rank 1: .*missing.json: no such scene file"
+    ${MPI} -np 1 ${CLVR} render ${SRC}/data/scenes/default.json ${SMALL}
+         : -np 1 ${CLVR} render ${WORK}/missing.json ${SMALL})
+  expect_job_error(3 "rank 2: building kernels/"
+    ${MPI} -np 2 ${CLVR} render ${SRC}/data/scenes/default.json ${SMALL}
+         : -np 1 -x CLVR_INJECT_FAULT=build ${CLVR} render ${SRC}/data/scenes/default.json ${SMALL})
+  expect_job_error(3 "CL_OUT_OF_RESOURCES .injected"
+    ${MPI} -np 3 -x CLVR_INJECT_FAULT=launch:1 ${CLVR} render ${SRC}/data/scenes/default.json ${SMALL})
+  expect_job_error(2 "iso3d does not render a part"
+    ${MPI} -np 2 ${CLVR} render ${SRC}/data/scenes/engine-iso.json ${SMALL})
+  expect_job_error(2 "unknown distribution \"tiles\""
+    ${MPI} -np 2 ${CLVR} render ${SRC}/data/scenes/default.json ${SMALL} --distribution tiles)
+endif()
