@@ -147,6 +147,53 @@ TEST(ProjtetOrder, MpvoncKeepsEveryFaceConstraintOnAConvexGrid)
     }
 }
 
+// Every face constraint kept in `order` (each cell before the cells its faces say are in front of it).
+std::size_t checkFaceConstraints(const TetMesh& mesh, const TetTopology& topology, const Camera& camera,
+                                 const std::vector<std::uint32_t>& order)
+{
+    std::vector<std::size_t> place(mesh.tets.size());
+    for (std::size_t i = 0; i < order.size(); ++i)
+        place[order[i]] = i;
+    std::size_t checked = 0, broken = 0;
+    for (std::uint32_t t = 0; t < mesh.tets.size(); ++t)
+        for (std::uint32_t f = 0; f < 4; ++f) {
+            const std::int32_t n = topology.neighbor[t][f];
+            if (n < 0)
+                continue;
+            const std::array<glm::dvec3, 3> p = outwardFace(mesh, t, f);
+            const glm::dvec3 normal = glm::cross(p[1] - p[0], p[2] - p[0]);
+            const double side = camera.parallel ? -glm::dot(normal, camera.forward()) : glm::dot(normal, camera.position - p[0]);
+            if (side > 1e-12 && !(place[t] < place[static_cast<std::size_t>(n)]))
+                ++broken;
+            ++checked;
+        }
+    EXPECT_EQ(broken, 0u);
+    return checked;
+}
+
+// mpvonc-boundary emits by levels (the wavefront): every face constraint kept, and, on a convex grid (no
+// boundary relation), the same image bits as plain mpvonc's one-cell-at-a-time order: any order that
+// keeps the relations draws the cells that share a pixel in the same order.
+TEST(ProjtetOrder, WavefrontKeepsEveryConstraintAndGivesMpvoncsBits)
+{
+    const TetMesh mesh = boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, 4}}, {0.6, 0.25, -0.4}, 0.35);
+    const TetTopology topology = buildTopology(mesh);
+    const VisibilitySorter sorter(mesh, topology);
+    const TransferFunction tf = test::rampTransferFunction();
+    for (const bool parallel : {false, true}) {
+        const Camera camera = boxCamera(parallel);
+        const VisibilitySorter::Result one = sorter.sort(camera, ProjtetOptions::Order::MpvoncBoundary);
+        ASSERT_EQ(one.order.size(), mesh.tets.size());
+        EXPECT_EQ(one.cyclesBroken, 0u);
+        EXPECT_GT(one.waves, 1u);
+        EXPECT_LT(one.waves, mesh.tets.size());  // levels hold several cells each
+        EXPECT_GT(checkFaceConstraints(mesh, topology, camera, one.order), mesh.tets.size());
+        const Image4f wavefront = renderProjtet(makeScene(camera, tf, 64, {{"order", "mpvonc-boundary"}}), mesh);
+        const Image4f serial = renderProjtet(makeScene(camera, tf, 64, {{"order", "mpvonc"}}), mesh);
+        EXPECT_TRUE(wavefront.pixels() == serial.pixels()) << (parallel ? "parallel" : "perspective");
+    }
+}
+
 TEST(Projtet, ConvexBoxGridMatchesExactReference)
 {
     const std::vector<Box> boxes = {{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, 4}};  // 384 tets
@@ -301,8 +348,14 @@ TEST(ProjtetMeshes, BluntfinMatchesExactReference)
                             "/");
     const TransferFunction tf = test::bluntfinTransferFunction();
     const TetTopology topology = buildTopology(mesh);
+    const VisibilitySorter sorter(mesh, topology);
     for (const bool parallel : {false, true}) {
         const Camera camera = test::meshCamera(mesh, parallel);
+        // The wavefront keeps every face constraint of the real mesh too (and its boundary relations are
+        // checked by the image below).
+        const VisibilitySorter::Result sorted = sorter.sort(camera, ProjtetOptions::Order::MpvoncBoundary, 64, 64);
+        EXPECT_EQ(sorted.order.size(), mesh.tets.size());
+        checkFaceConstraints(mesh, topology, camera, sorted.order);
         const Scene scene = makeScene(camera, tf, 64);
         const Image4d expected = tetReferenceIntegral(mesh, tf, camera, scene.image);
         FrameStats stats;

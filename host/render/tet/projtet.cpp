@@ -121,6 +121,10 @@ VisibilitySorter::Result VisibilitySorter::sort(const Camera& camera, ProjtetOpt
         }
     }
     std::vector<std::uint8_t> emitted(cells, 0);
+    if (order == ProjtetOptions::Order::MpvoncBoundary) {
+        wavefront(key, later, extraStart, extraFront, pending, emitted, result);
+        return result;
+    }
     std::priority_queue<std::pair<double, std::uint32_t>> ready;  // farthest first
     for (std::uint32_t c = 0; c < cells; ++c)
         if (pending[c] == 0)
@@ -164,6 +168,62 @@ VisibilitySorter::Result VisibilitySorter::sort(const Camera& camera, ProjtetOpt
             emit(c);
     }
     return result;
+}
+
+void VisibilitySorter::wavefront(const std::vector<double>& key, const std::vector<std::uint8_t>& later,
+                                 const std::vector<std::uint32_t>& extraStart, const std::vector<std::uint32_t>& extraFront,
+                                 std::vector<std::uint32_t>& pending, std::vector<std::uint8_t>& emitted, Result& result) const
+{
+    const std::size_t cells = centres_.size();
+    // Farthest first within a wave, then by cell number.
+    const auto farther = [&](std::uint32_t a, std::uint32_t b) { return key[a] != key[b] ? key[a] > key[b] : a < b; };
+    std::vector<std::uint32_t> wave, next, byKey;
+    for (std::uint32_t c = 0; c < cells; ++c)
+        if (pending[c] == 0)
+            wave.push_back(c);
+    std::sort(wave.begin(), wave.end(), farther);
+    std::size_t cursor = 0;
+    const auto release = [&](std::uint32_t front) {
+        if (!emitted[front] && --pending[front] == 0)
+            next.push_back(front);
+    };
+    while (result.order.size() < cells) {
+        if (wave.empty()) {
+            // A cycle: the farthest cell left goes next, alone.
+            if (byKey.empty()) {
+                byKey.resize(cells);
+                for (std::uint32_t c = 0; c < cells; ++c)
+                    byKey[c] = c;
+                std::stable_sort(byKey.begin(), byKey.end(), [&](std::uint32_t a, std::uint32_t b) { return key[a] > key[b]; });
+            }
+            while (emitted[byKey[cursor]])
+                ++cursor;
+            ++result.cyclesBroken;
+            wave.push_back(byKey[cursor]);
+        }
+        for (const std::uint32_t c : wave) {
+            emitted[c] = 1;
+            result.order.push_back(c);
+        }
+        // The wave releases the cells in front of it; a cell whose last cell behind this is joins the next.
+        next.clear();
+        for (const std::uint32_t c : wave) {
+            for (const std::int32_t f : faceOf_[c]) {
+                if (f < 0)
+                    continue;
+                const InnerFace& face = faces_[f];
+                const bool cIsA = face.a == c;
+                if (later[f] == (cIsA ? 1 : 2))
+                    release(cIsA ? face.b : face.a);
+            }
+            if (!extraStart.empty())
+                for (std::uint32_t k = extraStart[c]; k < extraStart[c + 1]; ++k)
+                    release(extraFront[k]);
+        }
+        std::sort(next.begin(), next.end(), farther);
+        wave.swap(next);
+        ++result.waves;
+    }
 }
 
 // ---- the boundary extension ------------------------------------------------------------------------
@@ -633,6 +693,8 @@ Image4f ProjtetRenderer::render(FrameStats& stats)
     stats.extra["bytes_per_tet"] = static_cast<double>(residentBytes_) / static_cast<double>(tets_.size());
     stats.extra["order"] = orderName(options_.order);
     stats.extra["order_cycles_broken"] = sorted.cyclesBroken;
+    if (options_.order == ProjtetOptions::Order::MpvoncBoundary)
+        stats.extra["order_waves"] = sorted.waves;
     stats.extra["sort_ms"] = sortMs;
     if (options_.order == ProjtetOptions::Order::MpvoncBoundary) {
         stats.extra["boundary_ms"] = boundaryMs;
