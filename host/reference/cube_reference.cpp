@@ -2,6 +2,7 @@
 #include "host/reference/cube_reference.h"
 
 #include "host/reference/reference_integral.h"  // clipRayToBox
+#include "host/render/grid/cube_octree.h"        // cubeFieldBounds: the box the renderer draws
 #include "host/runtime/parallel.h"
 
 #include <algorithm>
@@ -11,19 +12,13 @@
 
 namespace clvr {
 
-void cubeFieldBounds(const Volume& volume, glm::dvec3& lo, glm::dvec3& hi)
-{
-    lo = volume.origin - 0.5 * volume.spacing;
-    hi = volume.origin + (glm::dvec3(volume.dims) - 0.5) * volume.spacing;
-}
-
 namespace {
 
 // Front-to-back composite of the cubes along `ray` between t0 and t1 (inside the field's box).
 glm::dvec4 walkCubes(const Volume& v, const TransferFunction& tf, const Ray& ray, double t0, double t1)
 {
     glm::dvec3 lo, hi;
-    cubeFieldBounds(v, lo, hi);
+    cubefan::cubeFieldBounds(v, lo, hi);
     // The cube holding the ray's point a little past t0 (the entry point can sit on a boundary).
     const glm::dvec3 p = ray.origin + (t0 + 1e-9 * (t1 - t0)) * ray.direction;
     glm::ivec3 cell, step;
@@ -77,7 +72,7 @@ Image4d cubeFieldIntegral(const Volume& volume, const TransferFunction& tf, cons
 {
     Image4d out(image.width, image.height);
     glm::dvec3 lo, hi;
-    cubeFieldBounds(volume, lo, hi);
+    cubefan::cubeFieldBounds(volume, lo, hi);
     const PixelRays rays(camera, image.width, image.height);
     std::atomic<int> nextRow{0};
     auto worker = [&] {

@@ -14,9 +14,6 @@
 
 namespace clvr {
 
-// The box the cube field fills: the grid's bounds grown by half a spacing on every side.
-void cubeFieldBounds(const Volume& volume, glm::dvec3& lo, glm::dvec3& hi);
-
 // Integrates every pixel of an image.width x image.height image (row 0 at the top); the result pixel is
 // rgb = I + (1 - A) background, a = A. Only the ray part in front of the camera counts (t >= 0, as
 // referenceIntegral). Rows are spread over `threads` host threads (<= 0: the thread budget).

@@ -180,12 +180,12 @@ double chordThrough(const CubeView& view, const glm::dvec3& lo, const glm::dvec3
     return tOut > tIn ? (tOut - tIn) * glm::length(d) : 0.0;
 }
 
-namespace {
-
 glm::dvec3 cornerOf(const glm::dvec3& lo, const glm::dvec3& hi, int v)
 {
     return {(v & 1) ? hi.x : lo.x, (v & 2) ? hi.y : lo.y, (v & 4) ? hi.z : lo.z};
 }
+
+namespace {
 
 // The point of segment [q0, q1] that the viewing ray through the segment [p0, p1] also meets: the
 // segment cut by the plane through the eye (perspective) or along forward (parallel) holding p0 and p1.

@@ -56,6 +56,9 @@ struct CubeView {
     bool parallel = false;
 };
 
+// Corner v = x + 2y + 4z of the box [lo, hi] (bit a of v: the hi side on axis a).
+glm::dvec3 cornerOf(const glm::dvec3& lo, const glm::dvec3& hi, int v);
+
 // The length of the chord of the viewing ray through world point p with the box [lo, hi] (the part in
 // front of the eye for perspective; the whole line along forward for parallel). 0 when it misses.
 double chordThrough(const CubeView& view, const glm::dvec3& lo, const glm::dvec3& hi, const glm::dvec3& p);

@@ -20,6 +20,12 @@ int leavesAlong(int i, int k, int n)
 
 }  // namespace
 
+void cubeFieldBounds(const Volume& volume, glm::dvec3& lo, glm::dvec3& hi)
+{
+    lo = volume.origin - 0.5 * volume.spacing;
+    hi = volume.origin + (glm::dvec3(volume.dims) - 0.5) * volume.spacing;
+}
+
 CubeOctree::CubeOctree(const Volume& volume)
     : voxels_(volume.dims), origin_(volume.origin), spacing_(volume.spacing)
 {

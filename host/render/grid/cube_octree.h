@@ -23,6 +23,9 @@ struct Cube {
     float value = 0.0f;
 };
 
+// The box the cube field fills: the grid's bounds grown by half a spacing on every side (the root's box).
+void cubeFieldBounds(const Volume& volume, glm::dvec3& lo, glm::dvec3& hi);
+
 struct SelectionStats {
     std::uint64_t visited = 0;      // nodes looked at
     std::uint64_t selected = 0;     // cubes returned

@@ -67,10 +67,7 @@ std::string programSource(const char* define)
     return std::string("#define ") + define + " 1\n" + std::string(embeddedKernelSource("cubefan.cl"));
 }
 
-glm::dvec3 cornerOf(const glm::dvec3& lo, const glm::dvec3& hi, int v)
-{
-    return {(v & 1) ? hi.x : lo.x, (v & 2) ? hi.y : lo.y, (v & 4) ? hi.z : lo.z};
-}
+using cubefan::cornerOf;
 
 // The six faces as corner quadruples (v = x + 2y + 4z), in cyclic order; face f is 0 -x, 1 +x, ... 5 +z.
 constexpr int kFaceCorners[6][4] = {{0, 2, 6, 4}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 5, 7, 6}};
@@ -243,8 +240,7 @@ CubefanRenderer::CubefanRenderer(Device& device, const Scene& scene, const Volum
     if (volume.part)
         throw InputError(volume.source + ": cubefan renders whole volumes only (no sort-last parts)");
     camera_ = frameCamera(scene, volume.boundsMin(), volume.boundsMax());
-    lo_ = volume.origin - 0.5 * volume.spacing;
-    hi_ = volume.origin + (glm::dvec3(volume.dims) - 0.5) * volume.spacing;
+    cubefan::cubeFieldBounds(volume, lo_, hi_);
     shift_ = 0.5 * (lo_ + hi_);
     // The octree holds mean, min and max per cube of every level (8/7 of the voxels): 12 bytes a voxel
     // and a seventh more, beside the volume's own 4.
