@@ -113,10 +113,12 @@ TEST(CubefanRenderer, ErrorZeroMatchesTheExactCubeFieldIntegral)
                           count(stats, "cubes_class3b") + count(stats, "cubes_as_back_faces") + count(stats, "cubes_culled"),
                       count(stats, "cubes"));
             EXPECT_EQ(count(stats, "cubes_as_back_faces") == count(stats, "cubes") - count(stats, "cubes_culled"), exact);
-            if (exact)  // the chord per fragment: float rounding only
+            if (exact) {  // the chord per fragment: float rounding only
                 EXPECT_TRUE(test::imagesNear(image, expected, {.maxAbs = 5e-4, .meanAbs = 1e-5})) << view;
-            if (std::string(opacity) != "linear")
+            }
+            if (std::string(opacity) != "linear") {
                 EXPECT_TRUE(test::imagesNear(image, expected, {.maxAbs = 1e-2, .meanAbs = 4e-4})) << view << ", " << opacity;
+            }
         }
         // Linear opacity across a cube whose optical depth reaches 1.5 is visibly wrong (§7).
         EXPECT_GT(errorOf[2], 5.0 * errorOf[0]) << view;
@@ -163,13 +165,15 @@ TEST(CubefanRenderer, EyeInsideTheVolume)
                     static_cast<unsigned long long>(count(stats, "cubes_culled")));
         EXPECT_GT(count(stats, "cubes_near_plane"), 0u);
         EXPECT_GT(count(stats, "cubes_culled"), count(stats, "cubes") / 4);
-        if (!exact)  // from inside, every template is drawn: cubes in the eye's rows and columns show 1 or 2 faces
+        if (!exact) {  // from inside, every template is drawn: cubes in the eye's rows and columns show 1 or 2 faces
             for (const char* key : {"cubes_class1", "cubes_class2", "cubes_class3a", "cubes_class3b"})
                 EXPECT_GT(count(stats, key), 0u) << key;
-        if (exact)
+        }
+        if (exact) {
             EXPECT_TRUE(test::imagesNear(image, expected, {.maxAbs = 2e-3, .meanAbs = 2e-4})) << what;
-        else
+        } else {
             EXPECT_TRUE(test::imagesNear(image, expected, {.maxAbs = 2e-2, .meanAbs = 3e-3})) << what;
+        }
     }
 }
 
