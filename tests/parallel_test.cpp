@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cstring>
 #include <mutex>
 #include <set>
@@ -56,6 +57,31 @@ TEST(ThreadBudget, OneMakesRunOnThreadsUseOneThreadWithIdenticalResults)
     }), 3);
     EXPECT_EQ(ids.size(), 3u);
     EXPECT_EQ(runOnThreads(8, 2, [] {}), 2);  // maxUseful still bounds it
+}
+
+// Every thread sees every other thread's work of a phase after the barrier and none of the next
+// phase's before it; more threads than cores (the yields, then the sleeps) included.
+TEST(PhaseBarrier, SeparatesPhasesOnMoreThreadsThanCores)
+{
+    const BudgetGuard guard;
+    setThreadBudget(5);
+    constexpr int threads = 5, phases = 2000;
+    PhaseBarrier barrier(threads);
+    std::atomic<int> done{0}, wrong{0};
+    EXPECT_EQ(runOnThreads(threads, threads, [&] {
+        for (int p = 0; p < phases; ++p) {
+            done.fetch_add(1, std::memory_order_relaxed);
+            barrier.arriveAndWait();
+            if (done.load(std::memory_order_relaxed) != threads * (p + 1))
+                wrong.fetch_add(1);
+            barrier.arriveAndWait();
+        }
+    }), threads);
+    EXPECT_EQ(done.load(), threads * phases);
+    EXPECT_EQ(wrong.load(), 0);
+    EXPECT_EQ(threadsToUse(0, 100), 5);
+    EXPECT_EQ(threadsToUse(8, 3), 3);
+    EXPECT_EQ(threadsToUse(8, 0), 1);
 }
 
 TEST(ThreadBudget, BadValuesAreInputErrors)

@@ -5,6 +5,7 @@
 // boundary relations against the adjacency-only order on interleaved combs, the TetGen torus and L-block,
 // the oxygen post) and a cycle of cells (three sticks: broken, counted, its error bounded).
 #include "host/render/tet/projtet.h"
+#include "host/runtime/parallel.h"
 
 #include "host/io/mesh_io.h"
 #include "host/model/scene.h"
@@ -171,6 +172,7 @@ TEST(ProjtetOrder, WavefrontKeepsEveryConstraintAndGivesMpvoncsBits)
         EXPECT_EQ(one.cyclesBroken, 0u);
         EXPECT_GT(one.waves, 1u);
         EXPECT_LT(one.waves, mesh.tets.size());  // levels hold several cells each
+        EXPECT_TRUE(sorter.sort(camera, ProjtetOptions::Order::MpvoncBoundary, 0, 0, 2).order == one.order);
         EXPECT_GT(checkFaceConstraints(mesh, topology, camera, one.order), mesh.tets.size());
         const Image4f wavefront = renderProjtet(makeScene(camera, tf, 64, {{"order", "mpvonc-boundary"}}), mesh);
         const Image4f serial = renderProjtet(makeScene(camera, tf, 64, {{"order", "mpvonc"}}), mesh);
@@ -340,6 +342,17 @@ TEST(ProjtetMeshes, BluntfinMatchesExactReference)
         const VisibilitySorter::Result sorted = sorter.sort(camera, ProjtetOptions::Order::MpvoncBoundary, 64, 64);
         EXPECT_EQ(sorted.order.size(), mesh.tets.size());
         checkFaceConstraints(mesh, topology, camera, sorted.order);
+        // The same order on one thread and on three (more threads than this machine's cores): the
+        // waves' release does not depend on the threads' timing.
+        const int budget = threadBudget();
+        setThreadBudget(3);
+        const VisibilitySorter::Result one = sorter.sort(camera, ProjtetOptions::Order::MpvoncBoundary, 64, 64, 1);
+        const VisibilitySorter::Result three = sorter.sort(camera, ProjtetOptions::Order::MpvoncBoundary, 64, 64, 3);
+        setThreadBudget(budget);
+        EXPECT_EQ(one.threads, 1);
+        EXPECT_EQ(three.threads, 3);
+        EXPECT_TRUE(one.order == sorted.order && three.order == sorted.order);
+        EXPECT_EQ(three.waves, sorted.waves);
         const Scene scene = makeScene(camera, tf, 64);
         const Image4d expected = tetReferenceIntegral(mesh, tf, camera, scene.image);
         FrameStats stats;

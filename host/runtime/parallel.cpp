@@ -55,11 +55,16 @@ bool passThreadBudgetToPocl()
     return ::setenv("POCL_CPU_MAX_CU_NUM", n.c_str(), 0) == 0 && ::setenv("POCL_MAX_PTHREAD_COUNT", n.c_str(), 0) == 0;
 }
 
-int runOnThreads(int threads, int maxUseful, const std::function<void()>& worker)
+int threadsToUse(int threads, int maxUseful)
 {
     const int limit = threadBudget();
     threads = threads <= 0 ? limit : std::min(threads, limit);
-    threads = std::clamp(threads, 1, std::max(1, maxUseful));
+    return std::clamp(threads, 1, std::max(1, maxUseful));
+}
+
+int runOnThreads(int threads, int maxUseful, const std::function<void()>& worker)
+{
+    threads = threadsToUse(threads, maxUseful);
     std::vector<std::thread> pool;
     for (int i = 1; i < threads; ++i)
         pool.emplace_back(worker);
@@ -67,6 +72,27 @@ int runOnThreads(int threads, int maxUseful, const std::function<void()>& worker
     for (std::thread& t : pool)
         t.join();
     return threads;
+}
+
+void PhaseBarrier::arriveAndWait()
+{
+    const std::uint32_t phase = phase_.load(std::memory_order_acquire);
+    if (arrived_.fetch_add(1, std::memory_order_acq_rel) + 1 == threads_) {
+        arrived_.store(0, std::memory_order_relaxed);  // before the phase moves on: the next arrivals see 0
+        phase_.fetch_add(1, std::memory_order_release);
+        phase_.notify_all();
+        return;
+    }
+    // Yielding keeps the wait short when the other threads are about to arrive and gives the core away
+    // when the machine has more threads than cores; after that, sleep.
+    constexpr int yields = 256;
+    for (int i = 0; i < yields; ++i) {
+        if (phase_.load(std::memory_order_acquire) != phase)
+            return;
+        std::this_thread::yield();
+    }
+    while (phase_.load(std::memory_order_acquire) == phase)
+        phase_.wait(phase, std::memory_order_acquire);
 }
 
 }  // namespace clvr

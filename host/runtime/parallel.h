@@ -2,6 +2,8 @@
 // threads (CPU references, harc's face sort, the ceiling loop).
 #pragma once
 
+#include <atomic>
+#include <cstdint>
 #include <functional>
 #include <string>
 
@@ -25,10 +27,28 @@ int parseThreadCount(const std::string& text, const std::string& what);
 // docs/cli.md says what was measured.
 bool passThreadBudgetToPocl();
 
+// The number of threads runOnThreads(threads, maxUseful, ...) runs its worker on.
+int threadsToUse(int threads, int maxUseful);
+
 // Runs `worker` on `threads` threads (<= 0: the thread budget), at most the budget, at most
 // `maxUseful` of them and at least one, the calling thread included; returns when all have returned.
 // Workers share their work through their own means (an atomic row counter, say). Returns the number
 // of threads it used.
 int runOnThreads(int threads, int maxUseful, const std::function<void()>& worker);
+
+// A reusable barrier for a fixed number of threads that yields a short while before it sleeps, for
+// phases of a hundred microseconds or so (projtet's sort waves), where std::barrier's futex wake-up
+// costs about as much as the phase itself (measured: docs/projtet.md).
+class PhaseBarrier {
+public:
+    explicit PhaseBarrier(int threads) : threads_(threads) {}
+    // Returns once all `threads` threads have called it for this phase.
+    void arriveAndWait();
+
+private:
+    const int threads_;
+    std::atomic<int> arrived_{0};
+    std::atomic<std::uint32_t> phase_{0};
+};
 
 }  // namespace clvr

@@ -12,11 +12,13 @@
 #include "host/render/transfer_function_upload.h"
 #include "host/runtime/embedded_kernels.h"
 #include "host/runtime/errors.h"
+#include "host/runtime/parallel.h"
 #include "kernels/projtet_params.h"
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -34,6 +36,8 @@ VisibilitySorter::VisibilitySorter(const TetMesh& mesh, const TetTopology& topol
 {
     const std::size_t cells = mesh.tets.size();
     faceOf_.assign(cells, {-1, -1, -1, -1});
+    sideA_.assign(cells, 0);
+    adjacent_ = topology.neighbor;
     centres_.resize(cells);
     for (std::uint32_t t = 0; t < cells; ++t) {
         glm::dvec3 c(0.0);
@@ -55,6 +59,7 @@ VisibilitySorter::VisibilitySorter(const TetMesh& mesh, const TetTopology& topol
             const std::int32_t index = static_cast<std::int32_t>(faces_.size());
             faces_.push_back({t, static_cast<std::uint32_t>(n), normal, glm::dot(normal, p[0])});
             faceOf_[t][f] = index;
+            sideA_[t] |= static_cast<std::uint8_t>(1u << f);
             for (int g = 0; g < 4; ++g)
                 if (topology.neighbor[n][g] == static_cast<std::int32_t>(t) && faceOf_[n][g] < 0) {
                     faceOf_[n][g] = index;
@@ -64,65 +69,55 @@ VisibilitySorter::VisibilitySorter(const TetMesh& mesh, const TetTopology& topol
     }
 }
 
+namespace {
+
+// Every cell, the largest key (the farthest) first; equal keys by cell number.
+std::vector<std::uint32_t> farthestFirst(const std::vector<double>& key)
+{
+    std::vector<std::uint32_t> cells(key.size());
+    for (std::uint32_t c = 0; c < cells.size(); ++c)
+        cells[c] = c;
+    std::stable_sort(cells.begin(), cells.end(), [&](std::uint32_t a, std::uint32_t b) { return key[a] > key[b]; });
+    return cells;
+}
+
+}  // namespace
+
 VisibilitySorter::Result VisibilitySorter::sort(const Camera& camera, ProjtetOptions::Order order, int width,
-                                                int height) const
+                                                int height, int threads) const
 {
     const std::size_t cells = centres_.size();
-    const glm::dvec3 eye = camera.position, forward = camera.forward();
-    // Larger key = farther from the eye.
-    std::vector<double> key(cells);
-    for (std::size_t c = 0; c < cells; ++c)
-        key[c] = camera.parallel ? glm::dot(centres_[c], forward) : glm::dot(centres_[c] - eye, centres_[c] - eye);
     Result result;
+    result.threads = threadsToUse(threads, threads > 0 ? threads : static_cast<int>(cells / kCellsPerThread));
+    Relations relations = classify(camera, order != ProjtetOptions::Order::Centroid, result.threads);
+    const std::vector<double>& key = relations.key;
     result.order.reserve(cells);
     std::vector<std::uint32_t> byKey;
-    auto farthestFirst = [&] {
-        byKey.resize(cells);
-        for (std::uint32_t c = 0; c < cells; ++c)
-            byKey[c] = c;
-        std::stable_sort(byKey.begin(), byKey.end(), [&](std::uint32_t a, std::uint32_t b) { return key[a] > key[b]; });
-    };
     if (order == ProjtetOptions::Order::Centroid) {
-        farthestFirst();
-        result.order = std::move(byKey);
+        result.order = farthestFirst(key);
         return result;
     }
 
-    // later[f]: 1 if faces_[f].b is drawn after a (a is behind it), 2 if a after b, 0 no constraint
-    // (the eye in the face's plane).
-    std::vector<std::uint8_t> later(faces_.size());
-    std::vector<std::uint32_t> pending(cells, 0);  // cells behind c not yet emitted
-    for (std::size_t f = 0; f < faces_.size(); ++f) {
-        const InnerFace& face = faces_[f];
-        // > 0: the eye (or, parallel, the direction towards it) is on b's side of the face, outside a.
-        const double side = camera.parallel ? -glm::dot(face.normal, forward) : glm::dot(face.normal, eye) - face.offset;
-        if (side > 0.0) {
-            later[f] = 1;
-            ++pending[face.b];
-        } else if (side < 0.0) {
-            later[f] = 2;
-            ++pending[face.a];
-        }
-    }
     // The boundary relations as lists per back cell (CSR), each one more cell behind its front cell.
-    std::vector<std::uint32_t> extraStart, extraFront;
+    std::vector<std::uint32_t>& pending = relations.pending;
+    Extra extra;
     if (order == ProjtetOptions::Order::MpvoncBoundary) {
-        const std::vector<Behind> extra = boundaryOrder(camera, result.boundary, width, height);
-        extraStart.assign(cells + 1, 0);
-        for (const Behind& r : extra)
-            ++extraStart[r.back + 1];
+        const std::vector<Behind> behind = boundaryOrder(camera, result.boundary, width, height);
+        extra.start.assign(cells + 1, 0);
+        for (const Behind& r : behind)
+            ++extra.start[r.back + 1];
         for (std::size_t c = 0; c < cells; ++c)
-            extraStart[c + 1] += extraStart[c];
-        extraFront.resize(extra.size());
-        std::vector<std::uint32_t> fill(extraStart.begin(), extraStart.end() - 1);
-        for (const Behind& r : extra) {
-            extraFront[fill[r.back]++] = r.front;
+            extra.start[c + 1] += extra.start[c];
+        extra.front.resize(behind.size());
+        std::vector<std::uint32_t> fill(extra.start.begin(), extra.start.end() - 1);
+        for (const Behind& r : behind) {
+            extra.front[fill[r.back]++] = r.front;
             ++pending[r.front];
         }
     }
     std::vector<std::uint8_t> emitted(cells, 0);
     if (order == ProjtetOptions::Order::MpvoncBoundary) {
-        wavefront(key, later, extraStart, extraFront, pending, emitted, result);
+        wavefront(relations, extra, emitted, result);
         return result;
     }
     std::priority_queue<std::pair<double, std::uint32_t>> ready;  // farthest first
@@ -132,30 +127,18 @@ VisibilitySorter::Result VisibilitySorter::sort(const Camera& camera, ProjtetOpt
     auto emit = [&](std::uint32_t c) {
         emitted[c] = 1;
         result.order.push_back(c);
-        for (const std::int32_t f : faceOf_[c]) {
-            if (f < 0)
-                continue;
-            const InnerFace& face = faces_[f];
-            const bool cIsA = face.a == c;
-            if (later[f] != (cIsA ? 1 : 2))
-                continue;  // c is not the one behind
-            const std::uint32_t next = cIsA ? face.b : face.a;
-            if (!emitted[next] && --pending[next] == 0)
+        for (int i = 0; i < 4; ++i) {
+            const std::uint32_t next = static_cast<std::uint32_t>(adjacent_[c][i]);
+            if ((relations.inFront[c] >> i & 1) && !emitted[next] && --pending[next] == 0)
                 ready.push({key[next], next});
         }
-        if (!extraStart.empty())
-            for (std::uint32_t k = extraStart[c]; k < extraStart[c + 1]; ++k) {
-                const std::uint32_t next = extraFront[k];
-                if (!emitted[next] && --pending[next] == 0)
-                    ready.push({key[next], next});
-            }
     };
     std::size_t cursor = 0;
     while (result.order.size() < cells) {
         if (ready.empty()) {
             // A cycle: the farthest cell left goes next.
             if (byKey.empty())
-                farthestFirst();
+                byKey = farthestFirst(key);
             while (emitted[byKey[cursor]])
                 ++cursor;
             ++result.cyclesBroken;
@@ -170,32 +153,94 @@ VisibilitySorter::Result VisibilitySorter::sort(const Camera& camera, ProjtetOpt
     return result;
 }
 
-void VisibilitySorter::wavefront(const std::vector<double>& key, const std::vector<std::uint8_t>& later,
-                                 const std::vector<std::uint32_t>& extraStart, const std::vector<std::uint32_t>& extraFront,
-                                 std::vector<std::uint32_t>& pending, std::vector<std::uint8_t>& emitted, Result& result) const
+VisibilitySorter::Relations VisibilitySorter::classify(const Camera& camera, bool faces, int threads) const
 {
     const std::size_t cells = centres_.size();
-    // Farthest first within a wave, then by cell number.
-    const auto farther = [&](std::uint32_t a, std::uint32_t b) { return key[a] != key[b] ? key[a] > key[b] : a < b; };
-    std::vector<std::uint32_t> wave, next, byKey;
-    for (std::uint32_t c = 0; c < cells; ++c)
-        if (pending[c] == 0)
-            wave.push_back(c);
-    std::sort(wave.begin(), wave.end(), farther);
-    std::size_t cursor = 0;
-    const auto release = [&](std::uint32_t front) {
-        if (!emitted[front] && --pending[front] == 0)
-            next.push_back(front);
+    const glm::dvec3 eye = camera.position, forward = camera.forward();
+    Relations r;
+    r.key.resize(cells);
+    // later[f]: 1 if faces_[f].b is drawn after a (a is behind it), 2 if a after b, 0 no constraint (the
+    // eye in the face's plane). Each pass in chunks taken in turn by the threads, every entry written by
+    // one thread; the cells read their faces' entries, so the two cells of a face agree.
+    std::vector<std::uint8_t> later(faces ? faces_.size() : 0);
+    const auto inChunks = [threads](std::size_t count, const auto& body) {
+        constexpr std::size_t chunk = 16384;
+        std::atomic<std::size_t> next{0};
+        runOnThreads(threads, threads, [&] {
+            for (std::size_t first; (first = next.fetch_add(chunk)) < count;)
+                for (std::size_t k = first; k < std::min(count, first + chunk); ++k)
+                    body(k);
+        });
     };
-    while (result.order.size() < cells) {
+    inChunks(later.size(), [&](std::size_t f) {
+        const InnerFace& face = faces_[f];
+        // > 0: the eye (or, parallel, the direction towards it) is on b's side of the face, outside a.
+        const double side = camera.parallel ? -glm::dot(face.normal, forward) : glm::dot(face.normal, eye) - face.offset;
+        later[f] = side > 0.0 ? 1 : side < 0.0 ? 2 : 0;
+    });
+    if (faces) {
+        r.inFront.resize(cells);
+        r.pending.resize(cells);
+    }
+    inChunks(cells, [&](std::size_t c) {
+        const glm::dvec3& centre = centres_[c];
+        r.key[c] = camera.parallel ? glm::dot(centre, forward) : glm::dot(centre - eye, centre - eye);
+        if (!faces)
+            return;
+        std::uint8_t inFront = 0;
+        std::uint32_t behind = 0;
+        for (int i = 0; i < 4; ++i) {
+            const std::int32_t f = faceOf_[c][i];
+            if (f < 0 || later[f] == 0)
+                continue;
+            const bool cIsA = sideA_[c] >> i & 1;
+            if (later[f] == (cIsA ? 1 : 2))
+                inFront |= static_cast<std::uint8_t>(1u << i);  // c is behind its neighbour i
+            else
+                ++behind;
+        }
+        r.inFront[c] = inFront;
+        r.pending[c] = behind;
+    });
+    return r;
+}
+
+void VisibilitySorter::wavefront(Relations& relations, const Extra& extra, std::vector<std::uint8_t>& emitted,
+                                 Result& result) const
+{
+    const std::size_t cells = centres_.size();
+    const std::vector<double>& key = relations.key;
+    const int threads = result.threads;
+    // Per thread, the cells its part of the wave released, sorted. Reserved for every cell so that no
+    // worker allocates (and so throws) while the others wait at the barrier.
+    std::vector<std::vector<std::uint32_t>> released(threads);
+    for (std::vector<std::uint32_t>& r : released)
+        r.reserve(cells);
+    for (std::uint32_t c = 0; c < cells; ++c)
+        if (relations.pending[c] == 0)
+            released[0].push_back(c);
+    
+
+    std::vector<std::uint32_t> wave, byKey;
+    wave.reserve(cells);
+    std::size_t cursor = 0;
+    bool done = false;
+    // One thread between the barriers: the released cells merged into the next wave, emitted.
+    const auto nextWave = [&] {
+        wave.clear();
+        for (const std::vector<std::uint32_t>& r : released) {
+            const std::size_t middle = wave.size();
+            wave.insert(wave.end(), r.begin(), r.end());
+            std::inplace_merge(wave.begin(), wave.begin() + static_cast<std::ptrdiff_t>(middle), wave.end());
+        }
+        if (result.order.size() == cells) {
+            done = true;
+            return;
+        }
         if (wave.empty()) {
             // A cycle: the farthest cell left goes next, alone.
-            if (byKey.empty()) {
-                byKey.resize(cells);
-                for (std::uint32_t c = 0; c < cells; ++c)
-                    byKey[c] = c;
-                std::stable_sort(byKey.begin(), byKey.end(), [&](std::uint32_t a, std::uint32_t b) { return key[a] > key[b]; });
-            }
+            if (byKey.empty())
+                byKey = farthestFirst(key);
             while (emitted[byKey[cursor]])
                 ++cursor;
             ++result.cyclesBroken;
@@ -205,25 +250,48 @@ void VisibilitySorter::wavefront(const std::vector<double>& key, const std::vect
             emitted[c] = 1;
             result.order.push_back(c);
         }
-        // The wave releases the cells in front of it; a cell whose last cell behind this is joins the next.
-        next.clear();
-        for (const std::uint32_t c : wave) {
-            for (const std::int32_t f : faceOf_[c]) {
-                if (f < 0)
-                    continue;
-                const InnerFace& face = faces_[f];
-                const bool cIsA = face.a == c;
-                if (later[f] == (cIsA ? 1 : 2))
-                    release(cIsA ? face.b : face.a);
-            }
-            if (!extraStart.empty())
-                for (std::uint32_t k = extraStart[c]; k < extraStart[c + 1]; ++k)
-                    release(extraFront[k]);
-        }
-        std::sort(next.begin(), next.end(), farther);
-        wave.swap(next);
         ++result.waves;
+    };
+    // Every thread: its share of the wave releases the cells in front of it; the thread whose
+    // decrement takes a cell's count of cells behind it to zero puts it in its list for the next wave.
+    const auto release = [&](int part) {
+        std::vector<std::uint32_t>& out = released[part];
+        out.clear();
+        const std::size_t first = wave.size() * part / threads, last = wave.size() * (part + 1) / threads;
+        const auto drop = [&](std::uint32_t front) {
+            if (!emitted[front] && std::atomic_ref<std::uint32_t>(relations.pending[front]).fetch_sub(1, std::memory_order_relaxed) == 1)
+                out.push_back(front);
+        };
+        for (std::size_t k = first; k < last; ++k) {
+            const std::uint32_t c = wave[k];
+            for (int i = 0; i < 4; ++i)
+                if (relations.inFront[c] >> i & 1)
+                    drop(static_cast<std::uint32_t>(adjacent_[c][i]));
+            if (!extra.start.empty())
+                for (std::uint32_t e = extra.start[c]; e < extra.start[c + 1]; ++e)
+                    drop(extra.front[e]);
+        }
+        std::sort(out.begin(), out.end());
+    };
+    if (threads == 1) {
+        for (nextWave(); !done; nextWave())
+            release(0);
+        return;
     }
+    PhaseBarrier sync(threads);
+    std::atomic<int> parts{0};
+    runOnThreads(threads, threads, [&] {
+        const int part = parts.fetch_add(1);
+        for (;;) {
+            if (part == 0)
+                nextWave();
+            sync.arriveAndWait();
+            if (done)
+                break;
+            release(part);
+            sync.arriveAndWait();
+        }
+    });
 }
 
 // ---- the boundary extension ------------------------------------------------------------------------
@@ -696,6 +764,7 @@ Image4f ProjtetRenderer::render(FrameStats& stats)
     if (options_.order == ProjtetOptions::Order::MpvoncBoundary)
         stats.extra["order_waves"] = sorted.waves;
     stats.extra["sort_ms"] = sortMs;
+    stats.extra["sort_threads"] = sorted.threads;
     if (options_.order == ProjtetOptions::Order::MpvoncBoundary) {
         stats.extra["boundary_ms"] = boundaryMs;
         stats.extra["boundary_exit_faces"] = sorted.boundary.exitFaces;
