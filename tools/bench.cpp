@@ -14,6 +14,7 @@
 #include "host/model/scene.h"
 #include "host/session.h"
 #include "host/io/volume_io.h"
+#include "host/render/scaffold.h"
 #include "tools/bench_machine.h"
 #include "tools/bench_mesh.h"
 #include "tools/bench_raster.h"
@@ -48,11 +49,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
-
-double msSince(Clock::time_point t0)
-{
-    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 struct Spread {
     double median = 0.0, min = 0.0, max = 0.0;

@@ -10,6 +10,7 @@
 
 #include "tools/bench_machine.h"
 
+#include "host/render/scaffold.h"
 #include "host/runtime/device.h"
 #include "raster/framebuffer.h"
 #include "raster/rasterizer.h"
@@ -40,8 +41,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 constexpr int kSize = 512, kTriangles = 100000, kDraws = 1000, kFrames = 7;
-
-double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 // CPU time of the calling thread: the host part of a frame, which other processes on a shared machine
 // delay but do not lengthen (the launch's wall time they do).

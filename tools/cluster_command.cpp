@@ -68,11 +68,6 @@ std::string distributionOf(const RenderOptions& options, const Scene& scene)
     return options.orbit > 0 ? "frames" : "sort-last";
 }
 
-double msSince(std::chrono::steady_clock::time_point t0)
-{
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
 struct Job {
     Scene scene;
     std::string sceneLabel;

@@ -12,6 +12,7 @@
 #include "host/io/image_io.h"
 #include "host/render/renderer.h"
 #include "host/model/scene.h"
+#include "host/render/scaffold.h"
 #include "host/session.h"
 
 #include <nlohmann/json.hpp>
@@ -43,11 +44,6 @@ namespace fs = std::filesystem;
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double msSince(Clock::time_point t0)
-{
-    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 }  // namespace
 

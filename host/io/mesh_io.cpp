@@ -37,12 +37,6 @@ constexpr std::uint64_t kMaxTets = std::numeric_limits<std::int32_t>::max();
 // ---------------------------------------------------------------------------------------------------
 // Small helpers.
 
-std::string num(double v)
-{
-    std::ostringstream s;
-    s << v;
-    return s.str();
-}
 
 std::string shown(std::string_view s)
 {
@@ -517,7 +511,7 @@ TetMesh readVtkUnstructured(const fs::path& path, const std::string& scalar)
                                          std::to_string(nCells) + " (the size " + std::to_string(size) + " is wrong)");
                     const std::int64_t k = asIndex(cells[at]);
                     if (k < 0 || static_cast<std::uint64_t>(k) > cells.size() - at - 1)
-                        throw InputError(in.file() + ": cell " + std::to_string(c) + " has " + num(cells[at]) +
+                        throw InputError(in.file() + ": cell " + std::to_string(c) + " has " + numberText(cells[at]) +
                                          " points, more than the CELLS list holds");
                     offsets[c] = static_cast<double>(at + 1);
                     at += 1 + static_cast<std::uint64_t>(k);
@@ -647,7 +641,7 @@ TetMesh readVtkUnstructured(const fs::path& path, const std::string& scalar)
         const std::int64_t type = asIndex(types[c]);
         const std::uint64_t need = type == 10 ? 4 : type == 12 ? 8 : type == 13 ? 6 : 0;
         if (need == 0)
-            throw InputError(in.file() + ": cell " + std::to_string(c) + " has type " + num(types[c]) +
+            throw InputError(in.file() + ": cell " + std::to_string(c) + " has type " + numberText(types[c]) +
                              ", only tetra (10), hexahedron (12) and wedge (13) are supported");
         if (k != need)
             throw InputError(in.file() + ": cell " + std::to_string(c) + " of type " + std::to_string(type) + " has " +
@@ -656,7 +650,7 @@ TetMesh readVtkUnstructured(const fs::path& path, const std::string& scalar)
         for (std::uint64_t i = 0; i < k; ++i) {
             const std::int64_t id = asIndex(cells[b + i]);
             if (id < 0 || static_cast<std::uint64_t>(id) >= nPoints)
-                throw InputError(in.file() + ": cell " + std::to_string(c) + " has point index " + num(cells[b + i]) +
+                throw InputError(in.file() + ": cell " + std::to_string(c) + " has point index " + numberText(cells[b + i]) +
                                  ", out of range (the mesh has " + std::to_string(nPoints) + " points)");
             v[i] = static_cast<std::uint32_t>(id);
         }

@@ -94,13 +94,6 @@ std::optional<double> parseDouble(const std::string& s)
     return v;
 }
 
-// A number as a person would write it: 0.5, -1, nan (std::to_string gives 0.500000).
-std::string num(double v)
-{
-    std::ostringstream s;
-    s << v;
-    return s.str();
-}
 
 std::string dimsText(const std::vector<long long>& sizes)
 {
@@ -818,7 +811,7 @@ Volume readNrrd(const fs::path& path)
         for (int a = 0; a < 3; ++a) {
             const double s = (*h.spacings)[skipAxes + static_cast<std::size_t>(a)];
             if (!(s > 0.0) || !std::isfinite(s))
-                throw InputError(source + ": spacing of axis " + std::to_string(a) + " is " + num(s) +
+                throw InputError(source + ": spacing of axis " + std::to_string(a) + " is " + numberText(s) +
                                  ", must be a positive finite number");
             v.spacing[a] = s;
         }
@@ -1025,7 +1018,7 @@ Volume readVtkStructuredPoints(const fs::path& path)
                          dimsText(*dims) + " = " + std::to_string(count));
     for (int a = 0; a < 3; ++a)
         if (!(spacing[a] > 0.0))
-            throw InputError(source + ": spacing of axis " + std::to_string(a) + " is " + num(spacing[a]) +
+            throw InputError(source + ": spacing of axis " + std::to_string(a) + " is " + numberText(spacing[a]) +
                              ", must be positive");
 
     t = nextTokens();

@@ -43,32 +43,32 @@ fs::path resolve(const fs::path& baseDir, const std::string& file)
 // ---------------------------------------------------------------------------------------------------
 // "volume"
 
-[[noreturn]] void badKey(const std::string& key, const std::string& what)
+[[noreturn]] void badVolumeKey(const std::string& key, const std::string& what)
 {
     throw InputError("volume: \"" + key + "\" " + what);
 }
 
-glm::dvec3 jsonVec3(const json& spec, const std::string& key)
+glm::dvec3 volumeVec3(const json& spec, const std::string& key)
 {
     const json& v = spec.at(key);
     if (!v.is_array() || v.size() != 3 || !std::all_of(v.begin(), v.end(), [](const auto& x) { return x.is_number(); }))
-        badKey(key, "must be an array of 3 numbers");
+        badVolumeKey(key, "must be an array of 3 numbers");
     return {v[0].get<double>(), v[1].get<double>(), v[2].get<double>()};
 }
 
 glm::ivec3 jsonDims(const json& spec)
 {
     if (!spec.contains("dims"))
-        badKey("dims", "is missing");
+        badVolumeKey("dims", "is missing");
     const json& v = spec.at("dims");
     if (!v.is_array() || v.size() != 3 ||
         !std::all_of(v.begin(), v.end(), [](const auto& x) { return x.is_number_integer(); }))
-        badKey("dims", "must be an array of 3 integers");
+        badVolumeKey("dims", "must be an array of 3 integers");
     glm::ivec3 d;
     for (int a = 0; a < 3; ++a) {
         const long long n = v[static_cast<std::size_t>(a)].get<long long>();
         if (n < 1 || n > INT_MAX)
-            badKey("dims", "[" + std::to_string(a) + "] is " + std::to_string(n) + ", must be a positive int");
+            badVolumeKey("dims", "[" + std::to_string(a) + "] is " + std::to_string(n) + ", must be a positive int");
         d[a] = static_cast<int>(n);
     }
     return d;
@@ -78,7 +78,7 @@ std::string jsonString(const json& spec, const std::string& key)
 {
     const json& v = spec.at(key);
     if (!v.is_string())
-        badKey(key, "must be a string");
+        badVolumeKey(key, "must be a string");
     return v.get<std::string>();
 }
 
@@ -97,7 +97,7 @@ void checkKeys(const json& spec, std::initializer_list<const char*> allowed, con
 ScalarType parseRawType(const json& spec)
 {
     if (!spec.contains("type"))
-        badKey("type", "is missing (uint8, int8, int16, uint16, int32, uint32, float32 or float64)");
+        badVolumeKey("type", "is missing (uint8, int8, int16, uint16, int32, uint32, float32 or float64)");
     const std::string type = jsonString(spec, "type");
     static const std::array<std::pair<const char*, ScalarType>, 8> kTypes{{
         {"uint8", ScalarType::UInt8},   {"int8", ScalarType::Int8},     {"int16", ScalarType::Int16},
@@ -106,7 +106,7 @@ ScalarType parseRawType(const json& spec)
     }};
     const auto it = std::find_if(kTypes.begin(), kTypes.end(), [&](const auto& p) { return type == p.first; });
     if (it == kTypes.end())
-        badKey("type", "is " + shown(type, 60) + " (uint8, int8, int16, uint16, int32, uint32, float32 or float64)");
+        badVolumeKey("type", "is " + shown(type, 60) + " (uint8, int8, int16, uint16, int32, uint32, float32 or float64)");
     return it->second;
 }
 
@@ -120,19 +120,19 @@ RawLayout parseRawLayout(const json& spec)
     if (spec.contains("endian")) {
         const std::string e = jsonString(spec, "endian");
         if (e != "little" && e != "big")
-            badKey("endian", "is " + shown(e, 60) + ", must be little or big");
+            badVolumeKey("endian", "is " + shown(e, 60) + ", must be little or big");
         layout.endian = e == "big" ? Endian::Big : Endian::Little;
     } else if (multiByte) {
-        badKey("endian", "is missing (little or big)");
+        badVolumeKey("endian", "is missing (little or big)");
     }
     if (spec.contains("spacing"))
-        layout.spacing = jsonVec3(spec, "spacing");
+        layout.spacing = volumeVec3(spec, "spacing");
     if (spec.contains("origin"))
-        layout.origin = jsonVec3(spec, "origin");
+        layout.origin = volumeVec3(spec, "origin");
     if (spec.contains("header_bytes")) {
         const json& hb = spec.at("header_bytes");
         if (!hb.is_number_integer() || hb.get<long long>() < 0)
-            badKey("header_bytes", "must be a non-negative integer");
+            badVolumeKey("header_bytes", "must be a non-negative integer");
         layout.headerBytes = hb.get<std::uint64_t>();
     }
     return layout;

@@ -17,13 +17,6 @@ namespace clvr {
 
 namespace {
 
-std::string num(double v)
-{
-    std::ostringstream s;
-    s << v;
-    return s.str();
-}
-
 std::string cellName(const TetMesh& mesh, std::size_t t)
 {
     return (mesh.source.empty() ? std::string("mesh") : mesh.source) + ": tetrahedron " + std::to_string(t);
@@ -90,10 +83,10 @@ void checkMesh(TetMesh& mesh)
             const glm::dvec3& p = mesh.points[c[k]];
             if (!finite3(p))
                 throw InputError(cellName(mesh, t) + " has point " + std::to_string(c[k]) + " with a non-finite coordinate (" +
-                                 num(p.x) + " " + num(p.y) + " " + num(p.z) + ")");
+                                 numberText(p.x) + " " + numberText(p.y) + " " + numberText(p.z) + ")");
             if (!std::isfinite(mesh.scalars[c[k]]))
                 throw InputError(cellName(mesh, t) + " has point " + std::to_string(c[k]) + " with a non-finite scalar (" +
-                                 num(mesh.scalars[c[k]]) + ")");
+                                 numberText(mesh.scalars[c[k]]) + ")");
             used[c[k]] = 1;
         }
     }

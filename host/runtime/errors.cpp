@@ -80,6 +80,13 @@ std::string clErrorName(int code)
     }
 }
 
+std::string numberText(double v)
+{
+    std::ostringstream s;
+    s << v;
+    return s.str();
+}
+
 std::string indent(const std::string& text)
 {
     std::istringstream in(text);

@@ -33,6 +33,9 @@ struct InternalError : std::logic_error {
 // The symbolic name of an OpenCL error code ("CL_OUT_OF_RESOURCES"), or "CL error N".
 std::string clErrorName(int code);
 
+// A number as a person would write it in a message: 0.5, -1, nan (std::to_string gives 0.500000).
+std::string numberText(double v);
+
 // Every line of text prefixed with four spaces (used to print build logs under the error line).
 std::string indent(const std::string& text);
 

@@ -20,7 +20,7 @@ namespace {
 
 constexpr float kNoLayerYet = -1e30f;  // the peel threshold before the first layer (finite: no NaN margins)
 
-std::string fragmentSource()
+std::string entryFragmentSource()
 {
     return "#define CLVR_HARC_ENTRY_FRAGMENT 1\n" + std::string(embeddedKernelSource("harc_entry.cl"));
 }
@@ -54,7 +54,7 @@ HarcRasterEntries::HarcRasterEntries(Device& device, const TetMesh& mesh, const 
     }
     framebuffer_ = std::make_unique<raster::Framebuffer>(device_, width_, height_);
     previous_ = device_.buffer("harc entry peel threshold", static_cast<std::size_t>(width_) * height_ * sizeof(float));
-    program_.source = fragmentSource();
+    program_.source = entryFragmentSource();
     program_.attributes = 2;  // position, face code
     program_.buffers[0] = previous_;
     program_.buffers[1] = tets;

@@ -569,7 +569,7 @@ namespace {
 constexpr double kGrowPixels = 1.0 / 16.0;
 constexpr double kMaxMiterPixels = 1.0;
 
-std::string fragmentSource()
+std::string projtetFragmentSource()
 {
     return "#define CLVR_PROJTET_FRAGMENT 1\n" + std::string(embeddedKernelSource("projtet.cl"));
 }
@@ -622,7 +622,7 @@ ProjtetRenderer::ProjtetRenderer(Device& device, const Scene& scene, const TetMe
     const PsiTable& psi = psiTable();
     psi_ = device_.upload("projtet psi table", psi.values);
     residentBytes_ = cells.size() * sizeof(cl_float4) + tf_.bytes() + psi.values.size() * sizeof(float);
-    program_.source = fragmentSource();
+    program_.source = projtetFragmentSource();
     program_.attributes = 1;  // the cell id
     program_.buffers[0] = cells_;
     program_.buffers[2] = psi_;

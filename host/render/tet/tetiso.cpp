@@ -137,7 +137,7 @@ std::vector<glm::dvec3> averagedVertexGradients(const TetMesh& mesh)
 namespace {
 
 
-std::string fragmentSource()
+std::string tetisoFragmentSource()
 {
     return "#define CLVR_TETISO_FRAGMENT 1\n" + std::string(embeddedKernelSource("tetiso.cl"));
 }
@@ -245,7 +245,7 @@ Tetiso::Tetiso(Device& device, const Scene& scene, const TetMesh& mesh)
                                     pixels * sizeof(cl_float4));
         weights_[dir] = device_.buffer(dir ? "tetiso weights (downwards)" : "tetiso weights (upwards)",
                                        pixels * sizeof(cl_float4));
-        frontProgram_[dir].source = fragmentSource();
+        frontProgram_[dir].source = tetisoFragmentSource();
         frontProgram_[dir].attributes = 2;  // the color, the cell id
         frontProgram_[dir].buffers[0] = kept_[dir];
         frontProgram_[dir].uniforms = fragmentUniforms(uniforms);
