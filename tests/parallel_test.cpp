@@ -65,7 +65,7 @@ TEST(PhaseBarrier, SeparatesPhasesOnMoreThreadsThanCores)
 {
     const BudgetGuard guard;
     setThreadBudget(5);
-    constexpr int threads = 5, phases = 2000;
+    constexpr int threads = 5, phases = 500;
     PhaseBarrier barrier(threads);
     std::atomic<int> done{0}, wrong{0};
     EXPECT_EQ(runOnThreads(threads, threads, [&] {
