@@ -37,7 +37,6 @@ constexpr std::uint64_t kMaxTets = std::numeric_limits<std::int32_t>::max();
 // ---------------------------------------------------------------------------------------------------
 // Small helpers.
 
-
 std::string shown(std::string_view s)
 {
     std::string out = "\"";

@@ -94,7 +94,6 @@ std::optional<double> parseDouble(const std::string& s)
     return v;
 }
 
-
 std::string dimsText(const std::vector<long long>& sizes)
 {
     std::string s;

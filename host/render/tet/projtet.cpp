@@ -172,13 +172,13 @@ VisibilitySorter::Relations VisibilitySorter::classify(const Camera& camera, boo
                     body(k);
         });
     };
-    inChunks(later.size(), [&](std::size_t f) {
-        const InnerFace& face = faces_[f];
-        // > 0: the eye (or, parallel, the direction towards it) is on b's side of the face, outside a.
-        const double side = camera.parallel ? -glm::dot(face.normal, forward) : glm::dot(face.normal, eye) - face.offset;
-        later[f] = side > 0.0 ? 1 : side < 0.0 ? 2 : 0;
-    });
     if (faces) {
+        inChunks(later.size(), [&](std::size_t f) {
+            const InnerFace& face = faces_[f];
+            // > 0: the eye (or, parallel, the direction towards it) is on b's side of the face, outside a.
+            const double side = camera.parallel ? -glm::dot(face.normal, forward) : glm::dot(face.normal, eye) - face.offset;
+            later[f] = side > 0.0 ? 1 : side < 0.0 ? 2 : 0;
+        });
         r.inFront.resize(cells);
         r.pending.resize(cells);
     }
@@ -219,7 +219,6 @@ void VisibilitySorter::wavefront(Relations& relations, const Extra& extra, std::
     for (std::uint32_t c = 0; c < cells; ++c)
         if (relations.pending[c] == 0)
             released[0].push_back(c);
-    
 
     std::vector<std::uint32_t> wave, byKey;
     wave.reserve(cells);
