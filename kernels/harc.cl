@@ -124,6 +124,11 @@ kernel void harc_render(global float4* out, global uint* stats, global const flo
         /* tet * 4 + entry face; -1 - tet for a perspective eye inside tet (no entry face) */
         int t = entry.y >= 0 ? entry.y >> 2 : -1 - entry.y;
         int entry_face = entry.y >= 0 ? entry.y & 3 : -1;
+        /* Partial integration: the last segment's back end, which is this cell's front when the walk goes
+         * on through a face without a cut (the field is continuous across faces: one scalar per point),
+         * so its transfer-function search is not repeated. */
+        HarcTfPoint carried;
+        int carry = 0;
         for (;;) {
             if (steps >= max_steps) {
                 bounded = 1;
@@ -135,16 +140,19 @@ kernel void harc_render(global float4* out, global uint* stats, global const flo
             const int4 adj = as_int4(tet[4]);
             const float4 p3 = (float4)(-(p0.xyz + p1.xyz + p2.xyz), 1.0f - (p0.w + p1.w + p2.w));
             const float3 pos = e + lambda * d;
-            /* Exit: the nearest face ahead, not the one the ray came in through (Figure 6 lines 3–8). */
-            float step = INFINITY;
+            /* Exit: the nearest face ahead, not the one the ray came in through (Figure 6 lines 3–8). Face i
+             * is num_i / den_i ahead; the fractions are compared by cross-multiplication (denominators > 0),
+             * so a step takes one division, not one per face. */
+            float best_num = 0.0f, best_den = 0.0f;
             int exit_face = -1;
             const float4 planes[4] = {p0, p1, p2, p3};
             for (int i = 0; i < 4; ++i) {
-                const float hd = dot(planes[i].xyz, d);
-                if (i != entry_face && hd < 0.0f) {
-                    const float s = fmax(dot(planes[i].xyz, pos) + planes[i].w, 0.0f) / -hd;
-                    if (s < step) {
-                        step = s;
+                const float den = -dot(planes[i].xyz, d);
+                if (i != entry_face && den > 0.0f) {
+                    const float num = fmax(dot(planes[i].xyz, pos) + planes[i].w, 0.0f);
+                    if (exit_face < 0 || num * best_den < best_num * den) {
+                        best_num = num;
+                        best_den = den;
                         exit_face = i;
                     }
                 }
@@ -153,26 +161,35 @@ kernel void harc_render(global float4* out, global uint* stats, global const flo
                 lambda_done = lambda;
                 break;
             }
+            const float step = best_num / best_den;
             const float lambda_exit = lambda + step;
             /* The segment [lambda, lambda_exit], cut to the part's box (unchanged without one). */
             const float seg_f = fmax(lambda, clip_lo), seg_b = fmin(lambda_exit, clip_hi);
             if (seg_f < seg_b || (seg_f == lambda && seg_b == lambda_exit)) {
                 const float length = seg_f == lambda && seg_b == lambda_exit ? step : seg_b - seg_f;
-                const float s_f = dot(grad.xyz, e + seg_f * d) + grad.w;                       /* Eq. 6 */
-                const float s_b = dot(grad.xyz, e + seg_b * d) + grad.w;
-                if (integration == HARC_INTEGRATION_FULL) {
-                    /* The whole segment at once: no split at control points (the table has them inside). */
-                    const float4 c = harc_full_lookup(full_table, params.full_ns, params.full_nl, params.full_params,
-                                                      s_f, s_b, length);
-                    color += transmittance * c.xyz;
-                    transmittance *= 1.0f - c.w;
-                    ++pieces;
-                } else if (integration == HARC_INTEGRATION_AVERAGE) {
-                    harc_segment_average(tf, tf_count, s_f, s_b, length, &color, &transmittance);
-                    ++pieces;
+                const float s_b = dot(grad.xyz, e + seg_b * d) + grad.w;                       /* Eq. 6 */
+                if (integration == HARC_INTEGRATION_PARTIAL) {
+                    const HarcTfPoint front = carry && seg_f == lambda
+                                                  ? carried
+                                                  : harc_tf_point(tf, tf_count, dot(grad.xyz, e + seg_f * d) + grad.w);
+                    pieces += (uint)harc_segment_from(tf, tf_count, psi, psi_n, front, s_b, length, &color,
+                                                      &transmittance, &carried);
+                    carry = seg_b == lambda_exit;
                 } else {
-                    pieces += (uint)harc_segment(tf, tf_count, psi, psi_n, s_f, s_b, length, &color, &transmittance);
+                    const float s_f = dot(grad.xyz, e + seg_f * d) + grad.w;
+                    if (integration == HARC_INTEGRATION_FULL) {
+                        /* The whole segment at once: no split at control points (the table has them inside). */
+                        const float4 c = harc_full_lookup(full_table, params.full_ns, params.full_nl,
+                                                          params.full_params, s_f, s_b, length);
+                        color += transmittance * c.xyz;
+                        transmittance *= 1.0f - c.w;
+                    } else {  /* HARC_INTEGRATION_AVERAGE */
+                        harc_segment_average(tf, tf_count, s_f, s_b, length, &color, &transmittance);
+                    }
+                    ++pieces;
                 }
+            } else {
+                carry = 0;
             }
             if (1.0f - transmittance >= ert_alpha || lambda_exit >= clip_hi) {  /* early ray termination (off:
                                                                                  * ert_alpha = 2), or past the box */

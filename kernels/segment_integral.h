@@ -60,26 +60,47 @@ int harc_upper(global const float* tf, const int n, const float x)
     return lo;
 }
 
-/* The segment from s_f (front, ray parameter 0) to s_b (back, length l) inside one tetrahedron,
- * split at every control point strictly between s_f and s_b (Figure 5's s_iso / next_s_iso: the
- * first control point past the current s in the direction of travel; searching with a strict
- * inequality from the current s returns next_s_iso exactly where Figure 6 has to step past
- * s_f == s_iso). Returns the number of pieces. */
-int harc_segment(global const float* tf, const int n, global const float* psi, const int psi_n, const float s_f,
-                 const float s_b, const float l, float3* color, float* transmittance)
+/* One end of a segment: the scalar s, k = the number of control points <= s, and the transfer function
+ * there (harc_tf_at(tf, n, k, s)). */
+typedef struct {
+    float s;
+    int k;
+    float4 c;
+} HarcTfPoint;
+
+HarcTfPoint harc_tf_point(global const float* tf, const int n, const float s)
 {
-    const int k_f = harc_upper(tf, n, s_f);
-    float4 c_front = harc_tf_at(tf, n, k_f, s_f);
+    HarcTfPoint q;
+    q.s = s;
+    q.k = harc_upper(tf, n, s);
+    q.c = harc_tf_at(tf, n, q.k, s);
+    return q;
+}
+
+/* The segment from front.s (ray parameter 0) to s_b (length l) inside one tetrahedron, split at every
+ * control point strictly between them (Figure 5's s_iso / next_s_iso: the first control point past the
+ * current s in the direction of travel; searching with a strict inequality from the current s returns
+ * next_s_iso exactly where Figure 6 has to step past s_f == s_iso). Returns the number of pieces, and in
+ * *back the segment's back end: its k comes from the split's own walk over the control points (no second
+ * search), so a ray walk can hand it to the next cell as that segment's front (kernels/harc.cl). */
+int harc_segment_from(global const float* tf, const int n, global const float* psi, const int psi_n,
+                      const HarcTfPoint front, const float s_b, const float l, float3* color, float* transmittance,
+                      HarcTfPoint* back)
+{
+    const float s_f = front.s;
+    float4 c_front = front.c;
     if (!(s_b != s_f)) {  /* s constant along the ray: one piece with constant C and τ */
         harc_piece(psi, psi_n, c_front, c_front, l, color, transmittance);
+        *back = front;
         return 1;
     }
     const float inv_ds = 1.0f / (s_b - s_f);
     global const float* value = tf + ((n + 3) & ~3);
     float lambda_front = 0.0f;
-    int pieces = 0;
+    int pieces = 0, k_b;
     if (s_b > s_f) {
-        for (int k = k_f; k < n && tf[k] < s_b; ++k) {  /* tf[k] > s_f: the next iso-surface ahead */
+        int k = front.k;
+        for (; k < n && tf[k] < s_b; ++k) {  /* tf[k] > s_f: the next iso-surface ahead */
             const float lambda = l * ((tf[k] - s_f) * inv_ds);
             const float4 c_iso = vload4(k, value);
             harc_piece(psi, psi_n, c_front, c_iso, lambda - lambda_front, color, transmittance);
@@ -87,9 +108,12 @@ int harc_segment(global const float* tf, const int n, global const float* psi, c
             lambda_front = lambda;
             ++pieces;
         }
+        /* tf[k] >= s_b (or k == n): the points <= s_b are those before k, and tf[k] if it equals s_b
+         * (the points increase strictly, so at most one does). */
+        k_b = k < n && tf[k] <= s_b ? k + 1 : k;
     } else {
         /* Points equal to s_f are at the front end, not ahead: start below them. */
-        int k = k_f - 1;
+        int k = front.k - 1;
         while (k >= 0 && tf[k] >= s_f)
             --k;
         for (; k >= 0 && tf[k] > s_b; --k) {
@@ -100,10 +124,21 @@ int harc_segment(global const float* tf, const int n, global const float* psi, c
             lambda_front = lambda;
             ++pieces;
         }
+        k_b = k + 1;  /* tf[0 .. k] <= s_b < tf[k + 1] */
     }
-    const float4 c_back = harc_tf_at(tf, n, harc_upper(tf, n, s_b), s_b);
-    harc_piece(psi, psi_n, c_front, c_back, l - lambda_front, color, transmittance);
+    back->s = s_b;
+    back->k = k_b;
+    back->c = harc_tf_at(tf, n, k_b, s_b);
+    harc_piece(psi, psi_n, c_front, back->c, l - lambda_front, color, transmittance);
     return pieces + 1;
+}
+
+/* The same from the scalars at both ends (kernels/projtet.cl: one fragment's segment). */
+int harc_segment(global const float* tf, const int n, global const float* psi, const int psi_n, const float s_f,
+                 const float s_b, const float l, float3* color, float* transmittance)
+{
+    HarcTfPoint back;
+    return harc_segment_from(tf, n, psi, psi_n, harc_tf_point(tf, n, s_f), s_b, l, color, transmittance, &back);
 }
 
 #endif
