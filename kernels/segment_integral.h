@@ -26,6 +26,8 @@ void harc_piece(global const float* psi, const int psi_n, const float4 cf, const
                 float3* color, float* transmittance)
 {
     const float tf = cf.w * l, tb = cb.w * l;
+    if (tf == 0.0f && tb == 0.0f)  /* τ is linear along the piece, so 0 all along it: ζ = ψ = 1, nothing to add */
+        return;
     const float zeta = exp(-0.5f * (tf + tb));          /* Eq. 3 */
     const float p = harc_psi(psi, psi_n, tf, tb);        /* Eq. 4 */
     const float3 c = cb.xyz * (p - zeta) + cf.xyz * (1.0f - p);  /* Eq. 2 */

@@ -12,6 +12,9 @@
 #include "texture.h"
 #include "transfer_function.h"
 #include "volume_sampling.h"
+#ifdef SLICE3D_PREINTEGRATED
+#include "segment_integral.h"
+#endif
 
 #include "slice3d_params.h"
 
@@ -103,6 +106,29 @@ int slice3d_space(global const uchar* space, const int4 bdims, const int4 b)
     return space[((uint)b.z * (uint)bdims.y + (uint)b.y) * (uint)bdims.x + (uint)b.x];
 }
 
+#ifdef SLICE3D_PREINTEGRATED
+/* The value at eye depth z where the ray enters or leaves the grid: the slab test's depth rounds, so the
+ * point is clamped into [0, n - 1] first (the whole grid: pre-integration renders no parts). */
+float slice3d_value_at_depth(global const SLICE3D_VOXEL* volume, const int4 dims, const float3 go, const float3 gd,
+                             const float z)
+{
+    const float3 top = convert_float3(dims.xyz - 1);
+    return SLICE3D_TRILINEAR(volume, dims, clamp(go + z * gd, (float3)(0.0f), top));
+}
+
+/* One slab of the pre-integrated chain: from *front (the scalar at the slab's near end) to s_b over ray
+ * length l, composited front to back under (c, transmittance) by kernels/segment_integral.h (the scalar
+ * linear in between, the transfer function split at its control points, ψ from the table); *front
+ * becomes the slab's back end, the next slab's front. */
+void slice3d_slab(global const float* tf, const int n, global const float* psi, const int psi_n,
+                  HarcTfPoint* front, const float s_b, const float l, float3* c, float* transmittance)
+{
+    HarcTfPoint back;
+    harc_segment_from(tf, n, psi, psi_n, *front, s_b, l, c, transmittance, &back);
+    *front = back;
+}
+#endif
+
 /* One work-item per pixel: slices k = 0 .. slice_count-1 at eye depth depth0 + k * delta_s. Only the
  * slices whose ray point lies in the grid bounds (the part's own box, for a part) are sampled (the rest are empty, DESIGN.md); their
  * number goes to samples[pixel]. With skip != 0, runs of slices in empty bricks are stepped over
@@ -114,6 +140,9 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
                           global const SLICE3D_VOXEL* volume, global const float* tf, global const uchar* space,
 #ifdef SLICE3D_CLIP_TEXTURE
                           global const float* clip_texels,
+#endif
+#ifdef SLICE3D_PREINTEGRATED
+                          global const float* psi,
 #endif
                           const ClSlice3dParams p)
 {
@@ -172,6 +201,54 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
     float3 c = (float3)(0.0f);
     float alpha_acc = 0.0f;
     uint taken = 0, stepped_over = 0;
+#ifdef SLICE3D_PREINTEGRATED
+    /* Pre-integrated slabs (docs/slice3d.md, "integration"): the chain of ray points entry, the samples
+     * inside the grid, exit; between two consecutive points the scalar is taken as linear and the slab is
+     * integrated exactly for that (partial pre-integration, seeds/001 §3–4), front to back whatever the
+     * order option says (the same integral). A run of samples in empty bricks is stepped over: the slab
+     * into its first sample is integrated, the chain goes on from its last. The ray starts at depth 0
+     * (the eye, or the image plane of a parallel camera). */
+    float transmittance = 1.0f;
+    const float z_begin = fmax(zin, 0.0f);
+    if (z_begin < zout) {
+        const float stretch = clvr_ray_stretch(s, p.camera);  /* ray length per unit of eye depth */
+        HarcTfPoint front = harc_tf_point(tf, tf_count, slice3d_value_at_depth(volume, dims, go, gd, z_begin));
+        float z_front = z_begin;
+        for (int k = k_lo; k <= k_hi; ++k) {
+            const float3 g = slice3d_point(go, gd, depth0, delta_s, k);
+            if (!clvr_grid_owned(g, own_lo, own_hi))
+                continue;
+            const float z = depth0 + (float)k * delta_s;
+            if (!(z > z_front))  /* a sample at or before the chain's last point (the entry's rounding) */
+                continue;
+            ++taken;
+            slice3d_slab(tf, tf_count, psi, p.psi_n, &front, SLICE3D_TRILINEAR(volume, dims, g), (z - z_front) * stretch,
+                         &c, &transmittance);
+            z_front = z;
+            if (1.0f - transmittance >= ert_alpha)
+                break;
+            if (skip) {
+                const int4 b = slice3d_brick(g, dims);
+                const int space_b = slice3d_space(space, bdims, b);
+                if (space_b != 0) {
+                    const int run_end = slice3d_empty_run(go, gd, inv_gd, depth0, delta_s, k, 1, k_hi, &p, b,
+                                                          space_b - 1);
+                    if (run_end > k) {
+                        stepped_over += (uint)(run_end - k);
+                        k = run_end;
+                        z_front = depth0 + (float)k * delta_s;
+                        front = harc_tf_point(tf, tf_count,
+                                              SLICE3D_TRILINEAR(volume, dims, slice3d_point(go, gd, depth0, delta_s, k)));
+                    }
+                }
+            }
+        }
+        if (1.0f - transmittance < ert_alpha && zout > z_front)
+            slice3d_slab(tf, tf_count, psi, p.psi_n, &front, slice3d_value_at_depth(volume, dims, go, gd, zout),
+                         (zout - z_front) * stretch, &c, &transmittance);
+    }
+    alpha_acc = 1.0f - transmittance;
+#else
     if (p.front_to_back) {
         float transmittance = 1.0f;
         for (int k = k_lo; k <= k_hi; ++k) {
@@ -231,6 +308,7 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
             alpha_acc = alpha + (1.0f - alpha) * alpha_acc;
         }
     }
+#endif
     const int i = y * p.width + x;
     out[i] = (float4)(c + (1.0f - alpha_acc) * p.background.xyz, alpha_acc);
     samples[i] = taken + stepped_over;

@@ -27,7 +27,8 @@ typedef struct {
     cl_int front_to_back;    /* 1: front to back with early termination, 0: back to front */
     cl_float ert_alpha;      /* front to back: stop once the opacity reaches this (2: off) */
     cl_int clip_inverse;     /* clip texture: 1 keeps the outside */
-    cl_int pad0, pad1;
+    cl_int psi_n;            /* SLICE3D_PREINTEGRATED builds: the psi table is psi_n x psi_n */
+    cl_int pad1;
     ClTexture clip_tex;      /* clip texture (SLICE3D_CLIP_TEXTURE builds only) */
     cl_float4 clip_row[3];   /* rows of the affine world -> clip-texture coordinates map */
     /* The part of the grid this volume is (sort-last, host/model/volume.h's GridPart; the whole grid

@@ -415,6 +415,37 @@ TEST(BenchCubefan, ScenesShareTheViewAndEachGroupStartsWithItsFullQualityScene)
     }
 }
 
+// ---- accuracy bench scenes (tools/make_accuracy_bench.py, `clvr bench --suite accuracy --reference`) ------
+
+// The suite lists exactly the acc-* files; each is slice3d with the view and transfer function of its
+// original bench scene (reg-slice3d-ml256, slice3d-engine), only the slice count and integration changed.
+TEST(BenchAccuracy, ScenesAreTheBenchViewsWithOnlySlicesAndIntegrationChanged)
+{
+    const std::vector<std::filesystem::path> files = benchScenesStartingWith("acc-");
+    const std::vector<std::string> listed = clvr::tools::benchSuiteScenes("accuracy");
+    std::vector<std::string> present, sorted = listed;
+    for (const auto& file : files)
+        present.push_back(file.filename().string());
+    std::sort(sorted.begin(), sorted.end());
+    EXPECT_EQ(sorted, present);
+    ASSERT_EQ(listed.size(), 16u);
+    const std::filesystem::path dir = files.front().parent_path();
+    for (const std::string& name : listed) {
+        const clvr::Scene scene = clvr::loadScene(dir / name);
+        const clvr::Scene original =
+            clvr::loadScene(dir / (name.starts_with("acc-ml256-") ? "reg-slice3d-ml256.json" : "slice3d-engine.json"));
+        EXPECT_EQ(scene.technique, "slice3d") << name;
+        EXPECT_EQ(scene.camera->position, original.camera->position) << name;
+        EXPECT_EQ(scene.image.width, original.image.width) << name;
+        ASSERT_EQ(scene.transferFunction.points().size(), original.transferFunction.points().size()) << name;
+        for (std::size_t i = 0; i < scene.transferFunction.points().size(); ++i)
+            EXPECT_EQ(scene.transferFunction.points()[i].tau, original.transferFunction.points()[i].tau) << name;
+        const clvr::Slice3dOptions o = clvr::parseSlice3dOptions(scene.options);
+        EXPECT_EQ(o.preintegrated, name.find("-pre-") != std::string::npos) << name;
+        EXPECT_EQ(std::to_string(o.slices) + ".json", name.substr(name.rfind('-') + 1)) << name;
+    }
+}
+
 // ---- projtet bench scenes (`clvr bench --suite projtet`) --------------------------------------------------
 
 // Each projtet scene is its harc twin with only the technique changed, and the suite lists each pair

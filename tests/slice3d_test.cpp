@@ -170,7 +170,7 @@ void expectInputError(const json& options, const std::string& fragment)
 TEST(Slice3dOptions, BadOptionsThrowInputErrorNamingTheKey)
 {
     expectInputError({{"foo", 1}},
-                     "options.foo: unknown option for slice3d (known: slices, slice_spacing, order, early_termination, path, empty_space_skipping, voxel_type, clip, clip_texture)");
+                     "options.foo: unknown option for slice3d (known: slices, slice_spacing, order, early_termination, path, empty_space_skipping, voxel_type, integration, clip, clip_texture)");
     expectInputError({{"slices", 0}}, "options.slices");
     expectInputError({{"slices", 65537}}, "options.slices");
     expectInputError({{"slices", 2.5}}, "options.slices");

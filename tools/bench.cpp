@@ -5,6 +5,8 @@
 // meshes) on the same scene in the same run.
 #include "tools/bench.h"
 
+#include "host/reference/reference_integral.h"
+
 #include "host/runtime/device.h"
 #include "host/runtime/errors.h"
 #include "host/io/image_io.h"
@@ -34,6 +36,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -103,6 +106,64 @@ std::string si(double v)  // 1.23e+08 -> "123.0 M"
         ++u;
     }
     return fixed(v, 1) + unit[u];
+}
+
+// Image error against the reference integral, as the tests measure it: per channel (R, G, B and A where
+// both have it) |image - reference|, the mean and the max of the worst channel.
+nlohmann::json referenceError(const Image4f& image, const Image4d& want, bool withAlpha)
+{
+    if (image.width() != want.width() || image.height() != want.height())
+        throw InputError("bench --reference: image and reference differ in size");
+    const int channels = withAlpha ? 4 : 3;
+    glm::dvec4 sum(0.0), worst(0.0);
+    for (std::size_t i = 0; i < image.pixelCount(); ++i)
+        for (int c = 0; c < channels; ++c) {
+            const double e = std::abs(static_cast<double>(image.pixels()[i][c]) - want.pixels()[i][c]);
+            sum[c] += e;
+            worst[c] = std::max(worst[c], e);
+        }
+    const double n = static_cast<double>(std::max<std::size_t>(image.pixelCount(), 1));
+    double mean = 0.0, max = 0.0;
+    for (int c = 0; c < channels; ++c) {
+        mean = std::max(mean, sum[c] / n);
+        max = std::max(max, worst[c]);
+    }
+    return {{"mean", mean}, {"max", max}, {"channels", withAlpha ? "rgba" : "rgb"}};
+}
+
+// The reference integral of a scene (host/reference/reference_integral.h; tolerance 1e-4: its own error
+// is about a third of that, well below the errors it judges), kept per (volume, camera, transfer
+// function, image) so that a suite of slice counts and integrations computes it once.
+const Image4d& referenceImage(std::map<std::string, Image4d>& cache, const Scene& scene, const Volume& volume,
+                              const Camera& camera, double& ms)
+{
+    std::uint64_t hash = 1469598103934665603ull;  // FNV-1a over the values' bits: the volume's identity
+    for (const float v : volume.values) {
+        std::uint32_t bits;
+        std::memcpy(&bits, &v, sizeof bits);
+        hash = (hash ^ bits) * 1099511628211ull;
+    }
+    nlohmann::json key = {{"volume", {volume.dims.x, volume.dims.y, volume.dims.z, volume.origin.x, volume.origin.y,
+                                      volume.origin.z, volume.spacing.x, volume.spacing.y, volume.spacing.z, hash}},
+                          {"camera", {camera.position.x, camera.position.y, camera.position.z, camera.focalPoint.x,
+                                      camera.focalPoint.y, camera.focalPoint.z, camera.viewUp.x, camera.viewUp.y,
+                                      camera.viewUp.z, camera.viewAngle, camera.parallel, camera.parallelScale}},
+                          {"image", {scene.image.width, scene.image.height, scene.image.background.x,
+                                     scene.image.background.y, scene.image.background.z}},
+                          {"tf", nlohmann::json::array()}};
+    for (const ControlPoint& p : scene.transferFunction.points())
+        key["tf"].push_back({p.s, p.color.r, p.color.g, p.color.b, p.tau});
+    const std::string k = key.dump();
+    ms = 0.0;
+    if (auto it = cache.find(k); it != cache.end())
+        return it->second;
+    const auto t0 = Clock::now();
+    ReferenceOptions options;
+    options.tolerance = 1e-4;
+    options.threads = 0;  // the thread budget
+    Image4d image = referenceIntegral(volume, scene.transferFunction, camera, scene.image, options);
+    ms = msSince(t0);
+    return cache.emplace(k, std::move(image)).first->second;
 }
 
 // The plain C++ ceiling loop on the same scene (slice3d only). Its frames are interleaved with clvr's
@@ -488,6 +549,7 @@ int bench(const BenchOptions& options)
     // Suites that trade image quality for speed (cubefan): the first scene of a group (its name up to the
     // last '-') is the group's full-quality image, and every later one is compared with it.
     std::map<std::string, std::pair<std::string, Image4f>> groupFirst;
+    std::map<std::string, Image4d> references;  // --reference, by scene content
     std::cout << "clvr bench on " << device.description() << "\nplatform "
               << report["machine"]["platform_version"].get<std::string>() << "\nCPU " << cpuModel() << ", "
               << std::thread::hardware_concurrency() << " cores, " << utcNow() << ", load average "
@@ -512,11 +574,12 @@ int bench(const BenchOptions& options)
         const double compileMs = device.compileMs() - compile0;
 
         // The ceiling's first frame warms its caches; then clvr and ceiling frames alternate.
-        // The ceiling mirrors slice3d's fused path only (the raster path counts fragments, not samples).
-        const std::unique_ptr<Ceiling> ceiling =
-            scene.technique == slice3dTechnique().name && parseSlice3dOptions(scene.options).path == Slice3dOptions::Path::Fused
-                ? makeCeiling(scene, volume, camera)
-                : nullptr;
+        // The ceiling mirrors slice3d's fused path with per-sample classification only (the raster path
+        // counts fragments, not samples; pre-integrated slabs are another loop).
+        const bool ceilingFits = scene.technique == slice3dTechnique().name &&
+                                 parseSlice3dOptions(scene.options).path == Slice3dOptions::Path::Fused &&
+                                 !parseSlice3dOptions(scene.options).preintegrated;
+        const std::unique_ptr<Ceiling> ceiling = ceilingFits ? makeCeiling(scene, volume, camera) : nullptr;
         const int threads = threadBudget();
         CeilingResult ceilingResult;
         if (ceiling)
@@ -612,6 +675,24 @@ int bench(const BenchOptions& options)
                 std::cout << "  VTK          " << peer.value("error", std::string("failed")) << '\n';
             }
             r["peer"] = peer;
+        }
+        if (options.reference && scene.technique == slice3dTechnique().name) {
+            double referenceMs = 0.0;
+            const Image4d& want = referenceImage(references, scene, volume, camera, referenceMs);
+            r["error_vs_reference"] = referenceError(image, want, true);
+            r["error_vs_reference_png"] = referenceError(readImage(clvrPng.string()), want, false);
+            r["reference_ms"] = referenceMs;
+            std::cout << "  reference    |image - exact integral| mean " << std::scientific << std::setprecision(2)
+                      << r["error_vs_reference"]["mean"].get<double>() << ", max "
+                      << r["error_vs_reference"]["max"].get<double>() << " (8-bit PNG: mean "
+                      << r["error_vs_reference_png"]["mean"].get<double>() << ")" << std::defaultfloat;
+            if (r.contains("peer") && r["peer"].contains("image")) {
+                r["peer"]["error_vs_reference_png"] =
+                    referenceError(readImage(r["peer"]["image"].get<std::string>()), want, false);
+                std::cout << "; VTK's PNG: mean " << std::scientific << std::setprecision(2)
+                          << r["peer"]["error_vs_reference_png"]["mean"].get<double>() << std::defaultfloat;
+            }
+            std::cout << (referenceMs > 0.0 ? "; computed in " + fixed(referenceMs / 1000.0, 1) + " s" : "") << '\n';
         }
         const std::string group = name.substr(0, name.rfind('-'));
         if (auto it = groupFirst.find(group); it == groupFirst.end()) {

@@ -23,6 +23,8 @@ struct BenchOptions {
     std::vector<std::string> overrides;  // --set path=json, applied to every scene (as clvr render --set),
                                          // e.g. options.integration="full" on the harc suite
     std::vector<std::string> unsets;     // --unset path, removed from every scene before the overrides
+    bool reference = false;            // regular-grid emission-absorption scenes: each image (and the peer's)
+                                       // against the CPU reference integral (host/reference/reference_integral.h)
 };
 
 // The scene files (under data/scenes/bench/) a suite runs: "slice3d" -> slice3d-{ml256,engine}.json,

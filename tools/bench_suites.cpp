@@ -61,6 +61,17 @@ std::vector<std::string> benchSuiteScenes(const std::string& suite)
     // the technique changed.
     const std::vector<std::string> projtet = {"harc-bluntfin-10.json", "projtet-bluntfin-10.json", "harc-post.json",
                                               "projtet-post.json",     "harc-tetgen-1m.json",      "projtet-tetgen-1m.json"};
+    // Time against image error (issue 14 goal 1; tools/make_accuracy_bench.py): slice3d per sample and
+    // pre-integrated over slice counts, for --reference (and --peer: VTK at each scene's spacing).
+    std::vector<std::string> accuracy;
+    for (const char* volume : {"ml256", "engine"}) {
+        for (const char* slices : {"256", "512", "1024", "2048"})
+            accuracy.push_back(std::string("acc-") + volume + "-sample-" + slices + ".json");
+        for (const char* slices : {"64", "128", "256", "512"})
+            accuracy.push_back(std::string("acc-") + volume + "-pre-" + slices + ".json");
+    }
+    if (suite == "accuracy")
+        return accuracy;
     if (suite == "slice3d")
         return slice3d;
     if (suite == "projtet")
@@ -87,7 +98,7 @@ std::vector<std::string> benchSuiteScenes(const std::string& suite)
                 all.push_back(name);
         return all;
     }
-    throw InputError("--suite: unknown suite \"" + suite + "\" (known: slice3d, harc, rts, regular, tetfaces, cubefan, projtet, all)");
+    throw InputError("--suite: unknown suite \"" + suite + "\" (known: slice3d, harc, rts, regular, tetfaces, cubefan, projtet, accuracy, all)");
 }
 
 }  // namespace clvr::tools

@@ -184,11 +184,13 @@ int run(int argc, char** argv)
                              "regular (reg-*: iso3d, stack2d, clipping, tools/make_regular_bench.py), tetfaces (tetfaces-*: "
                              "tetslice, tetiso, tools/make_tetfaces_bench.py), cubefan (cubefan-*: seeds/002 Figure 9 and "
                              "slice3d on its view, tools/make_cubefan_bench.py), projtet (projtet-* beside their harc twins: bluntfin, "
-                             "the oxygen post, the 1 M-tet TetGen torus), all, or raster "
+                             "the oxygen post, the 1 M-tet TetGen torus), accuracy (acc-*: slice3d per sample and pre-integrated over "
+                             "slice counts, for --reference; tools/make_accuracy_bench.py), all, or raster "
                              "(no scenes: the raster stage on 100,000 small triangles, tools/bench_raster.h), or cluster "
                              "(mpirun -np 1, 2, 4 sort-last on reg-slice3d-ml256 and harc-bluntfin-10 or the scenes given; "
                              "docs/cluster.md)")
-        ->check(CLI::IsMember({"slice3d", "harc", "rts", "regular", "tetfaces", "cubefan", "projtet", "all", "raster", "cluster"}))
+        ->check(CLI::IsMember({"slice3d", "harc", "rts", "regular", "tetfaces", "cubefan", "projtet", "accuracy", "all", "raster",
+                                      "cluster"}))
         ->capture_default_str();
     benchCommand->add_option("-o,--output", benchOptions.outJson, "figures as JSON; images go beside it")
         ->capture_default_str();
@@ -198,6 +200,9 @@ int run(int argc, char** argv)
         ->capture_default_str();
     benchCommand->add_flag("--peer", benchOptions.peer,
                            "also render each scene with VTK (tools/peer_vtk.py; meshes: tools/peer_vtk_unstructured.py)");
+    benchCommand->add_flag("--reference", benchOptions.reference,
+                           "also compute each slice3d scene's CPU reference integral (once per volume, camera, transfer "
+                           "function and size) and report the image error against it, the peer's too");
     benchCommand->add_option("--peer-frames", benchOptions.peerFrames, "the peer's steady frames (0: as --frames)")
         ->check(CLI::Range(0, 100000))
         ->capture_default_str();

@@ -8,6 +8,7 @@
 #include "host/runtime/errors.h"
 #include "host/render/camera_args.h"
 #include "host/render/fragment_uniforms.h"
+#include "host/optics/psi_table.h"
 #include "host/render/options_util.h"
 #include "host/render/transfer_function_upload.h"
 #include "kernels/slice3d_params.h"
@@ -55,6 +56,7 @@ private:
     glm::ivec3 brickDims_{0};
     BrickGrid brickGrid_;  // min-max per brick, kept to classify the bricks again for a new transfer function
     cl::Buffer emptyBricks_;
+    cl::Buffer psi_;  // integration "preintegrated": the ψ table of host/optics/psi_table.h
     std::uint64_t emptyBrickCount_ = 0;
     double brickSetupMs_ = 0.0;
     std::string voxelType_ = "float32";  // on the device
@@ -140,6 +142,15 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
         residentBytes_ += clipTexels_->bytes();
         trilinearOptions += " -DSLICE3D_CLIP_TEXTURE=1";
     }
+    if (options_.preintegrated) {
+        if (volume.part)
+            throw InputError("slice3d: \"integration\": \"preintegrated\" renders the whole grid, not a part of it "
+                             "(its slabs cross the parts' borders); use --distribution sort-first or frames");
+        const PsiTable& psi = psiTable();
+        psi_ = device_.upload("slice3d psi table", psi.values);
+        residentBytes_ += psi.values.size() * sizeof(float);
+        trilinearOptions += " -DSLICE3D_PREINTEGRATED=1";
+    }
 
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
     if (options_.path == Slice3dOptions::Path::Fused) {
@@ -205,6 +216,7 @@ Image4f Slice3dRenderer::render(FrameStats& stats)
     stats.extra["depth_range"] = {plan_.depthMin, plan_.depthMax};
     stats.extra["order"] = options_.order == Slice3dOptions::Order::BackToFront ? "back-to-front" : "front-to-back";
     stats.extra["path"] = options_.path == Slice3dOptions::Path::Fused ? "fused" : "raster";
+    stats.extra["integration"] = options_.preintegrated ? "preintegrated" : "sample";
     stats.extra["early_termination"] = options_.earlyTermination;
     stats.extra["voxels"] = static_cast<std::uint64_t>(dims_.x) * dims_.y * dims_.z;
     stats.extra["resident_bytes"] = residentBytes_;
@@ -275,6 +287,10 @@ Image4f Slice3dRenderer::renderFused(FrameStats& stats)
             params.clip_row[r] = toCl4(glm::dvec3(clipCoordinates_[0][r], clipCoordinates_[1][r], clipCoordinates_[2][r]),
                                        clipCoordinates_[3][r]);
         params.clip_inverse = options_.clipTexture->inverse ? 1 : 0;
+    }
+    if (options_.preintegrated) {
+        fused_.setArg(a++, psi_);
+        params.psi_n = static_cast<cl_int>(psiTable().size);
     }
     fused_.setArg(a++, params);
     device_.launch("slice3d: fused", fused_, image_.width, image_.height);
@@ -485,6 +501,9 @@ TechniqueInfo slice3dTechnique()
         {"path", "fused", "", "\"fused\" (all slices of a pixel in one kernel) or \"raster\" (pass by pass)"},
         {"empty_space_skipping", true, "", "fused path: step over bricks where tau is 0 (same image)"},
         {"voxel_type", "auto", "", "\"auto\" (uint8/uint16 on the device when the values fit) or \"float32\""},
+        {"integration", "sample", "",
+         "\"sample\" (alpha = 1 - exp(-tau delta) per slice sample) or \"preintegrated\" (fused path: each slab "
+         "between samples integrated exactly for a linear scalar)"},
         {"clip", nullptr, "none", "clip by a closed mesh through the stencil buffer: {\"mesh\": ..., \"inverse\", \"method\"}"},
         clipTextureInfo(),
     };
@@ -527,6 +546,14 @@ Slice3dOptions parseSlice3dOptions(const nlohmann::json& options)
                 o.nativeVoxels = false;
             else
                 badOption(key, "must be \"auto\" or \"float32\", got " + value.dump());
+        } else if (key == "integration") {
+            const std::string s = value.is_string() ? value.get<std::string>() : "";
+            if (s == "sample")
+                o.preintegrated = false;
+            else if (s == "preintegrated")
+                o.preintegrated = true;
+            else
+                badOption(key, "must be \"sample\" or \"preintegrated\", got " + value.dump());
         } else if (key == "empty_space_skipping") {
             if (!value.is_boolean())
                 badOption(key, "must be true or false, got " + value.dump());
@@ -547,6 +574,19 @@ Slice3dOptions parseSlice3dOptions(const nlohmann::json& options)
         o.path = Slice3dOptions::Path::Raster;
     }
     checkSlicesOrSpacing(options);
+    if (o.preintegrated && o.path == Slice3dOptions::Path::Raster)
+        badOption("integration", "\"preintegrated\" is only available on the fused path (a fragment sees one "
+                                 "slice, not the slab behind it); clip meshes need the raster path");
+    if (o.preintegrated && o.clipTexture)
+        badOption("integration", "\"preintegrated\" does not combine with clip_texture yet (a slab would be cut "
+                                 "inside; docs/slice3d.md)");
+    if (o.preintegrated) {
+        // The chain of slabs is walked from the eye (kernels/slice3d.cl); back to front would be the same integral.
+        if (o.order == Slice3dOptions::Order::BackToFront && options.contains("order"))
+            badOption("order", "must be \"front-to-back\" with \"integration\": \"preintegrated\" (the slabs are "
+                               "composited from the eye), got \"back-to-front\"");
+        o.order = Slice3dOptions::Order::FrontToBack;
+    }
     if (o.earlyTermination < 1.0 && o.order != Slice3dOptions::Order::FrontToBack)
         badOption("early_termination", "needs \"order\": \"front-to-back\" (back to front cannot stop early)");
     if (o.earlyTermination < 1.0 && o.path == Slice3dOptions::Path::Raster)

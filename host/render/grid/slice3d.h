@@ -39,6 +39,9 @@ struct Slice3dOptions {
     Path path = Path::Fused;
     bool emptySpaceSkipping = true;  // fused path: step over bricks where tau is 0 (bit-identical image)
     bool nativeVoxels = true;  // fused path: uint8/uint16 on the device when every value fits (same bits)
+    // Fused path: integrate each slab between consecutive samples with the scalar linear in between (partial
+    // pre-integration, kernels/segment_integral.h) instead of one classified sample per slice.
+    bool preintegrated = false;
     std::optional<Slice3dClip> clip;  // needs the raster path (chosen by default when clip is given)
     // Clipping with a second "stencil" texture (seeds/003; host/optics/clip_texture.h): both paths.
     std::optional<ClipTextureSpec> clipTexture;
