@@ -18,6 +18,47 @@
 
 #include "slice3d_params.h"
 
+/* Shared by both paths: the slabs at the box faces. Slice k stands for the slab [z - ds/2, z + ds/2] of
+ * eye depth around it (z = depth0 + k ds), except where that slab reaches past the ray's chord through the
+ * grid box [chord_in, chord_out]: the first slice inside the chord (the one before it lies outside)
+ * reaches back to chord_in, the last forward to chord_out, so that the slabs cover the chord exactly once.
+ * Without it a ray gains or loses up to one slab's opacity at each face: first order in ds (DESIGN's
+ * midpoint rule is second order only inside). Returns -(its ray length) * log2(e), so that
+ * alpha = 1 - exp2(tau * it); neg_delta_log2e is the full slab's, neg_stretch_log2e per unit of depth. */
+float slice3d_slab_log2e(const float z, const float delta_s, const float chord_in, const float chord_out,
+                         const float neg_delta_log2e, const float neg_stretch_log2e)
+{
+    const int first = z - delta_s < chord_in, last = z + delta_s > chord_out;
+    if (!first && !last)
+        return neg_delta_log2e;
+    const float lo = first ? chord_in : z - 0.5f * delta_s;
+    const float hi = last ? chord_out : z + 0.5f * delta_s;
+    return fmax(hi - lo, 0.0f) * neg_stretch_log2e;
+}
+
+/* The eye-depth interval [*zin, *zout] of the ray go + z gd (grid coordinates) inside the box [lo, hi]
+ * (slab test); empty (*zin > *zout) when it misses. */
+void slice3d_chord(const float3 go, const float3 gd, const float3 lo, const float3 hi, float* zin, float* zout)
+{
+    float z0 = -INFINITY, z1 = INFINITY;
+    for (int a = 0; a < 3; ++a) {
+        const float g0 = a == 0 ? go.x : (a == 1 ? go.y : go.z);
+        const float gs = a == 0 ? gd.x : (a == 1 ? gd.y : gd.z);
+        const float l = a == 0 ? lo.x : (a == 1 ? lo.y : lo.z);
+        const float h = a == 0 ? hi.x : (a == 1 ? hi.y : hi.z);
+        if (gs == 0.0f) {
+            if (g0 < l || g0 >= h)
+                z1 = -INFINITY;
+            continue;
+        }
+        const float t0 = (l - g0) / gs, t1 = (h - g0) / gs;
+        z0 = fmax(z0, fmin(t0, t1));
+        z1 = fmin(z1, fmax(t0, t1));
+    }
+    *zin = z0;
+    *zout = z1;
+}
+
 #ifndef CLVR_SLICE3D_FRAGMENT
 
 /* The volume's type on the device for the fused kernel: float by default; the host builds with
@@ -176,21 +217,8 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
      * sample is still checked, so this only limits the loop. */
     const float3 own_lo = p.own_lo.xyz, own_hi = p.own_hi.xyz;
     const int4 offset = p.part_offset;
-    float zin = -INFINITY, zout = INFINITY;
-    for (int a = 0; a < 3; ++a) {
-        const float g0 = a == 0 ? go.x : (a == 1 ? go.y : go.z);
-        const float gs = a == 0 ? gd.x : (a == 1 ? gd.y : gd.z);
-        const float lo = a == 0 ? own_lo.x : (a == 1 ? own_lo.y : own_lo.z);
-        const float hi = a == 0 ? own_hi.x : (a == 1 ? own_hi.y : own_hi.z);
-        if (gs == 0.0f) {
-            if (g0 < lo || g0 >= hi)
-                zout = -INFINITY;
-            continue;
-        }
-        const float t0 = (lo - g0) / gs, t1 = (hi - g0) / gs;
-        zin = fmax(zin, fmin(t0, t1));
-        zout = fmin(zout, fmax(t0, t1));
-    }
+    float zin, zout;
+    slice3d_chord(go, gd, own_lo, own_hi, &zin, &zout);
     int k_lo = 0, k_hi = -1;
     if (zin <= zout) {
         const float n = (float)p.slice_count;
@@ -201,6 +229,14 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
     float3 c = (float3)(0.0f);
     float alpha_acc = 0.0f;
     uint taken = 0, stepped_over = 0;
+#ifndef SLICE3D_PREINTEGRATED
+    /* The chord through the whole grid (not only this part's box: a sort-last part's slices weigh as the
+     * whole grid's, so the parts composite to one process's image), from depth 0 on. */
+    float chord_in, chord_out;
+    slice3d_chord(go, gd, (float3)(0.0f), p.grid_hi.xyz, &chord_in, &chord_out);
+    chord_in = fmax(chord_in, 0.0f);
+    const float neg_stretch_log2e = -clvr_ray_stretch(s, p.camera) * M_LOG2E_F;
+#endif
 #ifdef SLICE3D_PREINTEGRATED
     /* Pre-integrated slabs (docs/slice3d.md, "integration"): the chain of ray points entry, the samples
      * inside the grid, exit; between two consecutive points the scalar is taken as linear and the slab is
@@ -273,7 +309,7 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
                 continue;
 #endif
             const float4 ct = clvr_tf_eval(tf, tf_count, SLICE3D_TRILINEAR(volume, dims, gl));
-            const float alpha = 1.0f - exp2(ct.w * neg_delta_log2e);
+            const float alpha = 1.0f - exp2(ct.w * slice3d_slab_log2e(depth0 + (float)k * delta_s, delta_s, chord_in, chord_out, neg_delta_log2e, neg_stretch_log2e));
             c += (transmittance * alpha) * ct.xyz;
             transmittance *= 1.0f - alpha;
             if (1.0f - transmittance >= ert_alpha)
@@ -303,7 +339,7 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
                 continue;
 #endif
             const float4 ct = clvr_tf_eval(tf, tf_count, SLICE3D_TRILINEAR(volume, dims, gl));
-            const float alpha = 1.0f - exp2(ct.w * neg_delta_log2e);
+            const float alpha = 1.0f - exp2(ct.w * slice3d_slab_log2e(depth0 + (float)k * delta_s, delta_s, chord_in, chord_out, neg_delta_log2e, neg_stretch_log2e));
             c = ct.xyz * alpha + (1.0f - alpha) * c;
             alpha_acc = alpha + (1.0f - alpha) * alpha_acc;
         }
@@ -346,9 +382,20 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
 #endif
     const ClCamera cam = u->camera;
     const float2 s = clvr_ray_window_offset(f->window, u->frame.xy, cam);
-    const float delta = u->frame.z * clvr_ray_stretch(s, cam);
+    const float stretch = clvr_ray_stretch(s, cam), delta_s = u->slab.y;
+    /* The slab at the box faces as the fused kernel weighs it: the pixel ray's chord through the grid, and
+     * this fragment's slice (its eye depth rounded to the slice it lies on). */
+    float3 o, d;
+    clvr_ray_depth(s, cam, &o, &d);
+    float chord_in, chord_out;
+    slice3d_chord((o - u->grid_origin.xyz) * u->inv_spacing.xyz, d * u->inv_spacing.xyz, (float3)(0.0f),
+                  u->dims.xyz - 1.0f, &chord_in, &chord_out);
+    chord_in = fmax(chord_in, 0.0f);
+    const float k = rint((dot(f->attr[0].xyz - o, cam.forward.xyz) - u->slab.x) / delta_s);
+    const float slab = slice3d_slab_log2e(u->slab.x + k * delta_s, delta_s, chord_in, chord_out,
+                                          -(delta_s * stretch) * M_LOG2E_F, -stretch * M_LOG2E_F);
     const float4 ct = clvr_tf_eval(r->buffer[1], (int)u->frame.w, clvr_trilinear(r->buffer[0], dims, g));
-    const float alpha = 1.0f - exp(-ct.w * delta);
+    const float alpha = 1.0f - exp2(ct.w * slab);
     *color = (float4)(ct.xyz * alpha, alpha);
     return 1;
 }

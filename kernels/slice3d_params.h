@@ -39,7 +39,9 @@ typedef struct {
     cl_int4 part_offset;     /* w = 0 */
     cl_float4 own_lo;        /* w = 0 */
     cl_float4 own_hi;        /* w = 0 */
-} ClSlice3dParams;           /* 352 bytes */
+    cl_float4 grid_hi;       /* the full grid's last point, (n - 1) per axis in full-grid coordinates: the box
+                              * whose chord the slabs at its faces are clipped to (kernels/slice3d.cl), w = 0 */
+} ClSlice3dParams;           /* 368 bytes */
 
 typedef struct {
     cl_float4 background;    /* image background, w = 0 */
@@ -54,6 +56,7 @@ typedef struct {
     cl_float4 inv_spacing;   /* w = 0 */
     cl_float4 dims;          /* grid points per axis, w = 0 */
     cl_float4 clip_tex;      /* CLVR_SLICE3D_CLIP_TEXTURE: (width, height, depth, 1 if inverse) */
-} ClSlice3dUniforms;         /* 160 bytes */
+    cl_float4 slab;          /* (depth0, delta_s, 0, 0): slice k at eye depth depth0 + k delta_s */
+} ClSlice3dUniforms;         /* 176 bytes */
 
 #endif

@@ -133,7 +133,7 @@ TEST(Layout, EveryParamsStructFitsTheKernelArgumentSpace)
     }
     // The sizes the headers document (a field added without its padding shows here first).
     EXPECT_EQ(sizeof(ClCamera), 80u);
-    EXPECT_EQ(sizeof(ClSlice3dParams), 352u);
+    EXPECT_EQ(sizeof(ClSlice3dParams), 368u);
     EXPECT_EQ(sizeof(ClPlanesParams), 288u);
     EXPECT_EQ(sizeof(ClBlendParams), 256u);
     EXPECT_EQ(sizeof(ClHarcParams), 192u);
@@ -149,7 +149,7 @@ TEST(Layout, EveryParamsStructFitsTheKernelArgumentSpace)
     EXPECT_EQ(sizeof(ClPixelTextureParams), 64u);
     EXPECT_EQ(sizeof(ClAccumParams), 12u);
     // Fragment-program uniforms: float4s only, within the raster stage's uniform count.
-    EXPECT_EQ(sizeof(ClSlice3dUniforms), 160u);
+    EXPECT_EQ(sizeof(ClSlice3dUniforms), 176u);
     EXPECT_EQ(sizeof(ClIso3dUniforms), 112u);
     EXPECT_EQ(sizeof(ClHarcEntryUniforms), 96u);
     EXPECT_EQ(sizeof(ClStack2dUniforms), 368u);

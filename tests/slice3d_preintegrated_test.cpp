@@ -1,7 +1,7 @@
 // tests/slice3d_preintegrated_test.cpp — slice3d's "integration": "preintegrated" (the fused kernel's slabs
 // between consecutive samples integrated exactly for a scalar linear along the ray, kernels/segment_integral.h)
-// against the CPU reference integral: more accurate than per-sample classification at every slice count and
-// second order (the error falls ~4x per doubling); skipping empty bricks changes it by float rounding only;
+// against the CPU reference integral: second order (the error falls ~4x per doubling) without per-sample
+// classification's outliers, and far ahead of it on a thin shell of the transfer function; skipping empty bricks changes it by float rounding only;
 // the kernel equals a host mirror of its chain of slabs in double (closed-form pieces, no ψ table); the
 // options that do not combine with it are refused.
 #include "host/render/grid/slice3d.h"
@@ -137,11 +137,12 @@ TEST(Slice3dPreintegrated, KernelEqualsTheHostMirrorOfItsChain)
 }
 
 // Marschner-Lobb 41^3 with DESIGN's transfer function (tau up to 8 per unit; the box is 2 units wide), seen
-// from outside. Per-sample classification is first order here: a ray's first and last slabs reach past
-// the box (docs/slice3d.md); the chain of slabs starts and ends on the box. Measured (mean, worst channel,
-// 32/64/128/256 slices): perspective 0.32/0.32/0.19/0.11 of the per-sample error, parallel
-// 0.57/0.42/0.34/0.23; max 0.02-0.2 of it; 32 -> 256 slices 29x less (second order: 64; at 32 slices a
-// slab is two cells long). Asserted: mean below 0.7 and max below 0.25 of the per-sample error at every
+// from outside. Both are second order now that per-sample slabs are clipped to the chord at the box faces
+// (kernels/slice3d.cl); the chain of slabs is the trapezoid rule to the samples' midpoint rule, about as
+// accurate in the mean (measured 0.85-1.4x per-sample's at 32/64/128/256 slices, both cameras), and it has
+// no outliers: its max error is 0.02-0.24 of per-sample's (rays that cross the box between two slices, or
+// graze an edge, which per-sample classification misses). 32 -> 256 slices: 29x less (second order: 64;
+// at 32 slices a slab is two cells long). Asserted: mean below 1.5x, max below 0.3x per-sample's at every
 // count, and at least 12x from 32 to 256 slices.
 void checkConvergence(const Camera& camera, const char* name)
 {
@@ -155,8 +156,8 @@ void checkConvergence(const Camera& camera, const char* name)
         const std::string label = std::string(name) + ", slices " + std::to_string(n);
         const Errors s = errorsOf(sample, marschnerLobb41(), want, (label + ", sample").c_str());
         const Errors p = errorsOf(slabs, marschnerLobb41(), want, (label + ", preintegrated").c_str());
-        EXPECT_LT(p.mean, 0.7 * s.mean) << label;
-        EXPECT_LT(p.max, 0.25 * s.max) << label;
+        EXPECT_LT(p.mean, 1.5 * s.mean) << label;
+        EXPECT_LT(p.max, 0.3 * s.max) << label;
         pre.push_back(p.mean);
     }
     for (std::size_t i = 1; i < pre.size(); ++i)
@@ -164,12 +165,12 @@ void checkConvergence(const Camera& camera, const char* name)
     EXPECT_GT(pre.front() / pre.back(), 12.0) << name;
 }
 
-TEST(Slice3dPreintegrated, SecondOrderAndBelowPerSampleErrorPerspective)
+TEST(Slice3dPreintegrated, SecondOrderWithoutOutliersPerspective)
 {
     checkConvergence(test::obliquePerspectiveCamera(40.0), "ml41 perspective 48x48");
 }
 
-TEST(Slice3dPreintegrated, SecondOrderAndBelowPerSampleErrorParallel)
+TEST(Slice3dPreintegrated, SecondOrderWithoutOutliersParallel)
 {
     checkConvergence(test::obliqueParallelCamera(1.8), "ml41 parallel 48x48");
 }

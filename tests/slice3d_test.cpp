@@ -411,11 +411,11 @@ double maxSliceLength(const Scene& scene, const Volume& volume)
     return plan.deltaS / glm::dot(corner.direction, c.forward());
 }
 
-// Slicing error against the converged integral. Per pixel the dominant error is first order: the
-// slabs at both ends of a chord lie partly outside the box, so a ray can gain or lose up to one
-// slice's opacity at each end: max <= 2 (1 - exp(-tauMax Delta)). Averaged over the image the error
-// is first order too, c tauMax deltaS with c ~ 0.01 measured on Marschner-Lobb (32..512 slices,
-// both cameras; headsq is lower); the mean tolerance is 0.02 tauMax deltaS.
+// Slicing error against the converged integral. The slabs at the two ends of a chord are clipped to it
+// (kernels/slice3d.cl's slice3d_slab_log2e), so the mean error is second order; a ray that crosses the box
+// between two slices (or grazes an edge) still loses its whole chord: max <= 2 (1 - exp(-tauMax Delta)).
+// The mean tolerance is the first-order bound the unclipped slabs needed, 0.02 tauMax deltaS (c ~ 0.01
+// measured then on Marschner-Lobb; now 1e-3-4e-3 of it at 256 slices).
 void checkAgainstReference(const Scene& scene, const Volume& volume, double tauMax, const char* label)
 {
     FrameStats stats;
@@ -465,9 +465,10 @@ TEST(Slice3dFused, HeadsqMatchesReference)
     checkAgainstReference(scene, volume, 0.1, "headsq_parallel");
 }
 
-// First-order convergence: the mean error halves (roughly) with each doubling of the slice count.
-// Asserted: strictly decreasing over 32..256 and at least a factor 4 from 32 to 256 (first order
-// gives 8; measured ~9).
+// Second-order convergence (the slabs at the box faces clipped to the chord; first order before, when a
+// ray gained or lost up to a slab at each face): the mean error falls about 4x with each doubling of the
+// slice count. Asserted: strictly decreasing over 32..256 and at least a factor 20 from 32 to 256 slices
+// (second order gives 64; measured 46, against ~9 before the clipping).
 TEST(Slice3dFused, ErrorFallsWithSliceCount)
 {
     const Scene base = makeScene(perspectiveCamera(), test::designTransferFunction(), 48);
@@ -482,7 +483,7 @@ TEST(Slice3dFused, ErrorFallsWithSliceCount)
     }
     for (std::size_t i = 1; i < meanErrors.size(); ++i)
         EXPECT_LT(meanErrors[i], meanErrors[i - 1]);
-    EXPECT_GT(meanErrors.front() / meanErrors.back(), 4.0);
+    EXPECT_GT(meanErrors.front() / meanErrors.back(), 20.0);
 }
 
 // The same sum composited in the other order: only float rounding differs. ~256 blends of values

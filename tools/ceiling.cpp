@@ -126,6 +126,18 @@ std::uint64_t Ceiling::renderRow(int y, Image4f& image) const
             kHi = static_cast<int>(std::clamp(std::floor((zout - depth0) / deltaS) + 1.0f, -1.0f, cnt - 1.0f));
         }
 
+        // The slabs at the box faces (kernels/slice3d.cl's slice3d_slab_log2e): the first slice inside the
+        // chord reaches back to its entry (from depth 0 on), the last forward to its exit.
+        const float chordIn = std::max(zin, 0.0f), chordOut = zout;
+        auto slabLength = [&](int k) {
+            const float z = depth0 + k * deltaS;
+            const bool first = z - deltaS < chordIn, last = z + deltaS > chordOut;
+            if (!first && !last)
+                return delta;
+            const float lo = first ? chordIn : z - 0.5f * deltaS, hi = last ? chordOut : z + 0.5f * deltaS;
+            return std::max(hi - lo, 0.0f) * stretch;
+        };
+
         glm::vec3 c(0.0f);
         float alphaAcc = 0.0f;
         if (frontToBack) {
@@ -136,7 +148,7 @@ std::uint64_t Ceiling::renderRow(int y, Image4f& image) const
                     continue;
                 ++taken;
                 const glm::vec4 ct = sample(g);
-                const float alpha = 1.0f - std::exp(-ct.w * delta);  // Eq. 1 of seeds/001 per slab
+                const float alpha = 1.0f - std::exp(-ct.w * slabLength(k));  // Eq. 1 of seeds/001 per slab
                 c += (transmittance * alpha) * glm::vec3(ct);
                 transmittance *= 1.0f - alpha;
                 if (1.0f - transmittance >= ertAlpha)
@@ -150,7 +162,7 @@ std::uint64_t Ceiling::renderRow(int y, Image4f& image) const
                     continue;
                 ++taken;
                 const glm::vec4 ct = sample(g);
-                const float alpha = 1.0f - std::exp(-ct.w * delta);
+                const float alpha = 1.0f - std::exp(-ct.w * slabLength(k));
                 c = glm::vec3(ct) * alpha + (1.0f - alpha) * c;
                 alphaAcc = alpha + (1.0f - alpha) * alphaAcc;
             }
