@@ -90,5 +90,5 @@ if [ "${CLVR_SKIP_ASAN:-0}" != 1 ]; then
     # they drive (clip meshes and textures, gradients, shells) runs under ASan in the smaller tests of the
     # same files (ClipMesh.*, Stack2dClip.*, Spherical.*, Planes.* and the rest).
     ctest --test-dir build-asan --output-on-failure -j "$jobs" --timeout 900 -LE portable \
-        -E '^(TetsliceMeshes|ProjtetMeshes|HarcMeshes)\.|^CubefanRenderer\.Engine|ErrorFalls|Converges|ShadedMatchesReferenceBothCameras|^ClipTexture\.(Shapes|Sphere|VoxelMasks|Offset)|^SphericalRender\.(CameraInside|RadialOpacity|ParallelCameraFullBall|AtmosphereSceneFile)|^Slice3dClip\.|^Techniques\.ListedDefaultsRenderTheSameImage|^Slice3dFused\.HeadsqMatchesReference'
+        -E '^(TetsliceMeshes|ProjtetMeshes|HarcMeshes)\.|^CubefanRenderer\.Engine|ErrorFalls|Converges|ShadedMatchesReferenceBothCameras|^ClipTexture\.(Shapes|Sphere|VoxelMasks|Offset)|^SphericalRender\.(CameraInside|RadialOpacity|ParallelCameraFullBall|AtmosphereSceneFile)|^Slice3dClip\.|^Techniques\.ListedDefaultsRenderTheSameImage|^Slice3dFused\.HeadsqMatchesReference|^Slice3dPreintegrated\.(SecondOrder|CameraInside|ThinShell)'
 fi
