@@ -5,6 +5,8 @@
 #ifndef CLVR_SEGMENT_INTEGRAL_H
 #define CLVR_SEGMENT_INTEGRAL_H
 
+#include "clvr_common.h"
+
 /* ψ of Eq. 4 from the γ-table of host/optics/psi_table.h (bilinear; same arithmetic as PsiTable::lookup). */
 float harc_psi(global const float* psi, const int n, float tau_l_front, float tau_l_back)
 {
@@ -28,7 +30,7 @@ void harc_piece(global const float* psi, const int psi_n, const float4 cf, const
     const float tf = cf.w * l, tb = cb.w * l;
     if (tf == 0.0f && tb == 0.0f)  /* τ is linear along the piece, so 0 all along it: ζ = ψ = 1, nothing to add */
         return;
-    const float zeta = exp(-0.5f * (tf + tb));          /* Eq. 3 */
+    const float zeta = clvr_exp2(-0.5f * M_LOG2E_F * (tf + tb));  /* Eq. 3 */
     const float p = harc_psi(psi, psi_n, tf, tb);        /* Eq. 4 */
     const float3 c = cb.xyz * (p - zeta) + cf.xyz * (1.0f - p);  /* Eq. 2 */
     *color += *transmittance * c;

@@ -24,7 +24,7 @@
  * reaches back to chord_in, the last forward to chord_out, so that the slabs cover the chord exactly once.
  * Without it a ray gains or loses up to one slab's opacity at each face: first order in ds (DESIGN's
  * midpoint rule is second order only inside). Returns -(its ray length) * log2(e), so that
- * alpha = 1 - exp2(tau * it); neg_delta_log2e is the full slab's, neg_stretch_log2e per unit of depth. */
+ * alpha = 1 - clvr_exp2(tau * it); neg_delta_log2e is the full slab's, neg_stretch_log2e per unit of depth. */
 float slice3d_slab_log2e(const float z, const float delta_s, const float chord_in, const float chord_out,
                          const float neg_delta_log2e, const float neg_stretch_log2e)
 {
@@ -74,7 +74,7 @@ void slice3d_chord(const float3 go, const float3 gd, const float3 lo, const floa
  * [Bb, Bb + B), i.e. the grid points [Bb, Bb + B] (one point of overlap with its neighbour), so every
  * trilinear footprint lies in the brick of its lower corner. A brick is empty when the transfer function's tau is exactly 0 for
  * every value the trilinear interpolation can produce in it (host: min-max of its points); a sample
- * there has alpha = 1 - exp2(0) = 0 and leaves the pixel unchanged bit for bit.
+ * there has alpha = 1 - clvr_exp2(0) = 0 and leaves the pixel unchanged bit for bit.
  * space[brick] = 0 for a brick that is not empty, else r + 1 where every brick within Chebyshev
  * distance r (bricks outside the grid count as empty) is empty: one run steps over that cube. */
 #define SLICE3D_BRICK_SHIFT 2
@@ -176,7 +176,7 @@ void slice3d_slab(global const float* tf, const int n, global const float* psi, 
  * (their number goes to skipped[pixel]; they are counted in samples[pixel] too). Back to front:
  * c = C alpha + (1 - alpha) c (the paper's blending); front to back: c += T alpha C, T *= 1 - alpha,
  * stopping once 1 - T >= ert_alpha. alpha = 1 - exp(-tau Delta), computed as
- * 1 - exp2(tau * (-Delta log2 e)). The pixel is c + (1 - A) background, A. */
+ * 1 - clvr_exp2(tau * (-Delta log2 e)) (kernels/clvr_common.h). The pixel is c + (1 - A) background, A. */
 kernel void slice3d_fused(global float4* out, global uint* samples, global uint* skipped,
                           global const SLICE3D_VOXEL* volume, global const float* tf, global const uchar* space,
 #ifdef SLICE3D_CLIP_TEXTURE
@@ -309,7 +309,7 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
                 continue;
 #endif
             const float4 ct = clvr_tf_eval(tf, tf_count, SLICE3D_TRILINEAR(volume, dims, gl));
-            const float alpha = 1.0f - exp2(ct.w * slice3d_slab_log2e(depth0 + (float)k * delta_s, delta_s, chord_in, chord_out, neg_delta_log2e, neg_stretch_log2e));
+            const float alpha = 1.0f - clvr_exp2(ct.w * slice3d_slab_log2e(depth0 + (float)k * delta_s, delta_s, chord_in, chord_out, neg_delta_log2e, neg_stretch_log2e));
             c += (transmittance * alpha) * ct.xyz;
             transmittance *= 1.0f - alpha;
             if (1.0f - transmittance >= ert_alpha)
@@ -339,7 +339,7 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
                 continue;
 #endif
             const float4 ct = clvr_tf_eval(tf, tf_count, SLICE3D_TRILINEAR(volume, dims, gl));
-            const float alpha = 1.0f - exp2(ct.w * slice3d_slab_log2e(depth0 + (float)k * delta_s, delta_s, chord_in, chord_out, neg_delta_log2e, neg_stretch_log2e));
+            const float alpha = 1.0f - clvr_exp2(ct.w * slice3d_slab_log2e(depth0 + (float)k * delta_s, delta_s, chord_in, chord_out, neg_delta_log2e, neg_stretch_log2e));
             c = ct.xyz * alpha + (1.0f - alpha) * c;
             alpha_acc = alpha + (1.0f - alpha) * alpha_acc;
         }
@@ -395,7 +395,7 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
     const float slab = slice3d_slab_log2e(u->slab.x + k * delta_s, delta_s, chord_in, chord_out,
                                           -(delta_s * stretch) * M_LOG2E_F, -stretch * M_LOG2E_F);
     const float4 ct = clvr_tf_eval(r->buffer[1], (int)u->frame.w, clvr_trilinear(r->buffer[0], dims, g));
-    const float alpha = 1.0f - exp2(ct.w * slab);
+    const float alpha = 1.0f - clvr_exp2(ct.w * slab);
     *color = (float4)(ct.xyz * alpha, alpha);
     return 1;
 }

@@ -1,4 +1,4 @@
-// kernels/util.cl — buffer fills used by clears and tests.
+// kernels/util.cl — buffer fills used by clears and tests, and a probe of clvr_exp2 for its test.
 #include "clvr_common.h"
 
 kernel void fill_float4(global float4* dst, const float4 value, const uint n)
@@ -29,4 +29,11 @@ kernel void loop_iterations(global uint* out, global const uint* ones, const uin
     for (uint i = 0u; i < n; ++i)
         k += ones[i & 15u];
     out[0] = k;
+}
+
+/* out[i] = clvr_exp2(x[i]) (tests/device_test.cpp against the host's exp2). */
+kernel void exp2_values(global float* out, global const float* x, const uint n)
+{
+    CLVR_GUARD_1D(n);
+    out[get_global_id(0)] = clvr_exp2(x[get_global_id(0)]);
 }
