@@ -432,6 +432,11 @@ HarcEntryLists buildHarcEntryLists(const TetMesh& mesh, const TetTopology& topol
                 const TetTopology::BoundaryFace& bf = topology.boundary[i];
                 const std::array<glm::dvec3, 3> p = outwardFace(mesh, bf.tet, bf.face);
                 const glm::dvec3 normal = glm::cross(p[1] - p[0], p[2] - p[0]);
+                // A face turned away from the eye is a back face for every ray that meets its plane ahead
+                // (t dot(n, d) = dot(n, p0 - eye) for the hit at e + t d, t >= 0), and for a parallel camera
+                // dot(n, d) = dot(n, forward) for every ray: the per-pixel test below would reject each pixel.
+                if (camera.parallel ? !(glm::dot(normal, f) < 0.0) : glm::dot(normal, p[0] - camera.position) > 0.0)
+                    continue;
                 // Pixel bounding box of the face (whole image if a corner is at or behind the eye plane).
                 double x0 = 0.0, x1 = width - 1.0, y0 = 0.0, y1 = height - 1.0;
                 bool clipped = false;
