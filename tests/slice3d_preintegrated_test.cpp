@@ -39,15 +39,7 @@ const Volume& marschnerLobb41()
     return v;
 }
 
-Image4d reference(const Scene& scene, const Volume& volume)
-{
-    ReferenceStats stats;
-    ReferenceOptions options;
-    options.stats = &stats;
-    Image4d image = referenceIntegral(volume, scene.transferFunction, *scene.camera, scene.image, options);
-    EXPECT_EQ(stats.raysNotConverged, 0u);
-    return image;
-}
+Image4d reference(const Scene& scene, const Volume& volume) { return test::referenceImage(scene, volume); }
 
 double maxChannel(const glm::dvec4& v) { return std::max({v.r, v.g, v.b, v.a}); }
 

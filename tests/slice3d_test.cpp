@@ -47,19 +47,7 @@ Scene makeScene(const Camera& camera, const TransferFunction& tf, int size, json
     return s;
 }
 
-Image4d reference(const Scene& scene, const Volume& volume)
-{
-    ReferenceStats stats;
-    ReferenceOptions options;
-    options.stats = &stats;
-    Image4d image = referenceIntegral(volume, scene.transferFunction, *scene.camera, scene.image, options);
-    std::printf("[ measured ] reference: %llu rays, %llu samples, up to %d segments per ray, last change %.2g, "
-                "%llu rays not converged\n",
-                static_cast<unsigned long long>(stats.rays), static_cast<unsigned long long>(stats.samples),
-                stats.maxSegments, stats.maxResidual, static_cast<unsigned long long>(stats.raysNotConverged));
-    EXPECT_EQ(stats.raysNotConverged, 0u);
-    return image;
-}
+Image4d reference(const Scene& scene, const Volume& volume) { return test::referenceImage(scene, volume); }
 
 const Volume& marschnerLobb41()
 {

@@ -2,8 +2,10 @@
 #include "tests/support/test_util.h"
 
 #include "host/io/image_io.h"
+#include "host/reference/reference_integral.h"
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -24,6 +26,20 @@ Image4f renderScene(const Scene& scene, const Volume& volume, FrameStats* stats)
     Image4f image = renderer->render(frame);
     if (stats)
         *stats = frame;
+    return image;
+}
+
+Image4d referenceImage(const Scene& scene, const Volume& volume)
+{
+    ReferenceStats stats;
+    ReferenceOptions options;
+    options.stats = &stats;
+    Image4d image = referenceIntegral(volume, scene.transferFunction, *scene.camera, scene.image, options);
+    std::printf("[ measured ] reference: %llu rays, %llu samples, up to %d segments per ray, last change %.2g, "
+                "%llu rays not converged\n",
+                static_cast<unsigned long long>(stats.rays), static_cast<unsigned long long>(stats.samples),
+                stats.maxSegments, stats.maxResidual, static_cast<unsigned long long>(stats.raysNotConverged));
+    EXPECT_EQ(stats.raysNotConverged, 0u);
     return image;
 }
 

@@ -31,6 +31,10 @@ TransferFunction designTransferFunction(double tauAtOne = 8.0);
 // the frame's FrameStats.
 Image4f renderScene(const Scene& scene, const Volume& volume, FrameStats* stats = nullptr);
 
+// The CPU reference integral of `scene` on `volume` (host/reference/reference_integral.h, default tolerance),
+// its statistics printed as "[ measured ] reference: ..."; a test failure when a ray did not converge.
+Image4d referenceImage(const Scene& scene, const Volume& volume);
+
 // ../shared/data/<relative>, and the repository's own data/<relative>.
 std::string sharedData(const std::string& relative);
 std::string repoData(const std::string& relative);
