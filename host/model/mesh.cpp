@@ -182,8 +182,10 @@ TetTopology buildTopology(const TetMesh& mesh)
     const std::size_t n = mesh.points.size();
     const std::size_t nt = mesh.tets.size();
     const std::string source = mesh.source.empty() ? std::string("mesh") : mesh.source;
-    if (nt > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
-        throw InputError(source + ": " + std::to_string(nt) + " tetrahedra, the limit is 2^31 - 1");
+    // Faces are numbered 4 * tet + face in 32 bits below: at most 2^30 tetrahedra (the readers allow 2^31 - 1).
+    if (nt > (std::size_t{1} << 30))
+        throw InputError(source + ": " + std::to_string(nt) + " tetrahedra, the limit for cell adjacency is 2^30 "
+                                                              "(faces are numbered 4 tet + face in 32 bits)");
     if (!mesh.neighbors.empty() && mesh.neighbors.size() == nt)
         return topologyFromNeighbors(mesh, source);
 
