@@ -36,8 +36,9 @@ float slice3d_slab_log2e(const float z, const float delta_s, const float chord_i
     return fmax(hi - lo, 0.0f) * neg_stretch_log2e;
 }
 
-/* The eye-depth interval [*zin, *zout] of the ray go + z gd (grid coordinates) inside the box [lo, hi]
- * (slab test); empty (*zin > *zout) when it misses. */
+/* The eye-depth interval [*zin, *zout] of the ray go + z gd (grid coordinates) inside the box [lo, hi)
+ * (slab test; a ray parallel to an axis is inside for lo <= g < hi, so hi is the next float above the last
+ * grid point); empty (*zin > *zout) when it misses. */
 void slice3d_chord(const float3 go, const float3 gd, const float3 lo, const float3 hi, float* zin, float* zout)
 {
     float z0 = -INFINITY, z1 = INFINITY;
@@ -389,7 +390,7 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
     clvr_ray_depth(s, cam, &o, &d);
     float chord_in, chord_out;
     slice3d_chord((o - u->grid_origin.xyz) * u->inv_spacing.xyz, d * u->inv_spacing.xyz, (float3)(0.0f),
-                  u->dims.xyz - 1.0f, &chord_in, &chord_out);
+                  nextafter(u->dims.xyz - 1.0f, (float3)(INFINITY)), &chord_in, &chord_out);
     chord_in = fmax(chord_in, 0.0f);
     const float k = rint((dot(f->attr[0].xyz - o, cam.forward.xyz) - u->slab.x) / delta_s);
     const float slab = slice3d_slab_log2e(u->slab.x + k * delta_s, delta_s, chord_in, chord_out,

@@ -39,8 +39,9 @@ typedef struct {
     cl_int4 part_offset;     /* w = 0 */
     cl_float4 own_lo;        /* w = 0 */
     cl_float4 own_hi;        /* w = 0 */
-    cl_float4 grid_hi;       /* the full grid's last point, (n - 1) per axis in full-grid coordinates: the box
-                              * whose chord the slabs at its faces are clipped to (kernels/slice3d.cl), w = 0 */
+    cl_float4 grid_hi;       /* the next float above the full grid's last point, n - 1 per axis in full-grid
+                              * coordinates: the box whose chord the slabs at its faces are clipped to
+                              * (kernels/slice3d.cl), w = 0 */
 } ClSlice3dParams;           /* 368 bytes */
 
 typedef struct {

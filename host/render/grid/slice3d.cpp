@@ -274,7 +274,11 @@ Image4f Slice3dRenderer::renderFused(FrameStats& stats)
     params.front_to_back = frontToBack ? 1 : 0;
     params.ert_alpha = ert;
     setGridPartParams(params, part_, dims_);
-    params.grid_hi = toCl4(glm::dvec3(part_.fullDims - 1));
+    // The whole grid's box, [0, n - 1] per axis, half open above as own_hi is (the next float above n - 1), so
+    // that a ray lying in the last grid plane counts as inside, as its samples do.
+    const glm::vec3 last = glm::vec3(part_.fullDims - 1);
+    params.grid_hi = cl_float4{{std::nextafter(last.x, INFINITY), std::nextafter(last.y, INFINITY),
+                                std::nextafter(last.z, INFINITY), 0.0f}};
     int a = 0;
     fused_.setArg(a++, out_);
     fused_.setArg(a++, samples_);
