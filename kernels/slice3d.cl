@@ -157,18 +157,6 @@ float slice3d_value_at_depth(global const SLICE3D_VOXEL* volume, const int4 dims
     const float3 top = convert_float3(dims.xyz - 1);
     return SLICE3D_TRILINEAR(volume, dims, clamp(go + z * gd, (float3)(0.0f), top));
 }
-
-/* One slab of the pre-integrated chain: from *front (the scalar at the slab's near end) to s_b over ray
- * length l, composited front to back under (c, transmittance) by kernels/segment_integral.h (the scalar
- * linear in between, the transfer function split at its control points, ψ from the table); *front
- * becomes the slab's back end, the next slab's front. */
-void slice3d_slab(global const float* tf, const int n, global const float* psi, const int psi_n,
-                  HarcTfPoint* front, const float s_b, const float l, float3* c, float* transmittance)
-{
-    HarcTfPoint back;
-    harc_segment_from(tf, n, psi, psi_n, *front, s_b, l, c, transmittance, &back);
-    *front = back;
-}
 #endif
 
 /* One work-item per pixel: slices k = 0 .. slice_count-1 at eye depth depth0 + k * delta_s. Only the
@@ -230,14 +218,6 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
     float3 c = (float3)(0.0f);
     float alpha_acc = 0.0f;
     uint taken = 0, stepped_over = 0;
-#ifndef SLICE3D_PREINTEGRATED
-    /* The chord through the whole grid (not only this part's box: a sort-last part's slices weigh as the
-     * whole grid's, so the parts composite to one process's image), from depth 0 on. */
-    float chord_in, chord_out;
-    slice3d_chord(go, gd, (float3)(0.0f), p.grid_hi.xyz, &chord_in, &chord_out);
-    chord_in = fmax(chord_in, 0.0f);
-    const float neg_stretch_log2e = -clvr_ray_stretch(s, p.camera) * M_LOG2E_F;
-#endif
 #ifdef SLICE3D_PREINTEGRATED
     /* Pre-integrated slabs (docs/slice3d.md, "integration"): the chain of ray points entry, the samples
      * inside the grid, exit; between two consecutive points the scalar is taken as linear and the slab is
@@ -259,8 +239,9 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
             if (!(z > z_front))  /* a sample at or before the chain's last point (the entry's rounding) */
                 continue;
             ++taken;
-            slice3d_slab(tf, tf_count, psi, p.psi_n, &front, SLICE3D_TRILINEAR(volume, dims, g), (z - z_front) * stretch,
-                         &c, &transmittance);
+            /* front becomes this slab's back end, the next slab's front (kernels/segment_integral.h) */
+            harc_segment_from(tf, tf_count, psi, p.psi_n, front, SLICE3D_TRILINEAR(volume, dims, g),
+                              (z - z_front) * stretch, &c, &transmittance, &front);
             z_front = z;
             if (1.0f - transmittance >= ert_alpha)
                 break;
@@ -281,11 +262,17 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
             }
         }
         if (1.0f - transmittance < ert_alpha && zout > z_front)
-            slice3d_slab(tf, tf_count, psi, p.psi_n, &front, slice3d_value_at_depth(volume, dims, go, gd, zout),
-                         (zout - z_front) * stretch, &c, &transmittance);
+            harc_segment_from(tf, tf_count, psi, p.psi_n, front, slice3d_value_at_depth(volume, dims, go, gd, zout),
+                              (zout - z_front) * stretch, &c, &transmittance, &front);
     }
     alpha_acc = 1.0f - transmittance;
 #else
+    /* The chord through the whole grid (not only this part's box: a sort-last part's slices weigh as the
+     * whole grid's, so the parts composite to one process's image), from depth 0 on. */
+    float chord_in, chord_out;
+    slice3d_chord(go, gd, (float3)(0.0f), p.grid_hi.xyz, &chord_in, &chord_out);
+    chord_in = fmax(chord_in, 0.0f);
+    const float neg_stretch_log2e = -clvr_ray_stretch(s, p.camera) * M_LOG2E_F;
     if (p.front_to_back) {
         float transmittance = 1.0f;
         for (int k = k_lo; k <= k_hi; ++k) {
@@ -310,7 +297,9 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
                 continue;
 #endif
             const float4 ct = clvr_tf_eval(tf, tf_count, SLICE3D_TRILINEAR(volume, dims, gl));
-            const float alpha = 1.0f - clvr_exp2(ct.w * slice3d_slab_log2e(depth0 + (float)k * delta_s, delta_s, chord_in, chord_out, neg_delta_log2e, neg_stretch_log2e));
+            const float slab = slice3d_slab_log2e(depth0 + (float)k * delta_s, delta_s, chord_in, chord_out,
+                                                  neg_delta_log2e, neg_stretch_log2e);
+            const float alpha = 1.0f - clvr_exp2(ct.w * slab);
             c += (transmittance * alpha) * ct.xyz;
             transmittance *= 1.0f - alpha;
             if (1.0f - transmittance >= ert_alpha)
@@ -340,7 +329,9 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
                 continue;
 #endif
             const float4 ct = clvr_tf_eval(tf, tf_count, SLICE3D_TRILINEAR(volume, dims, gl));
-            const float alpha = 1.0f - clvr_exp2(ct.w * slice3d_slab_log2e(depth0 + (float)k * delta_s, delta_s, chord_in, chord_out, neg_delta_log2e, neg_stretch_log2e));
+            const float slab = slice3d_slab_log2e(depth0 + (float)k * delta_s, delta_s, chord_in, chord_out,
+                                                  neg_delta_log2e, neg_stretch_log2e);
+            const float alpha = 1.0f - clvr_exp2(ct.w * slab);
             c = ct.xyz * alpha + (1.0f - alpha) * c;
             alpha_acc = alpha + (1.0f - alpha) * alpha_acc;
         }
@@ -383,7 +374,7 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
 #endif
     const ClCamera cam = u->camera;
     const float2 s = clvr_ray_window_offset(f->window, u->frame.xy, cam);
-    const float stretch = clvr_ray_stretch(s, cam), delta_s = u->slab.y;
+    const float stretch = clvr_ray_stretch(s, cam), delta_s = u->frame.z;
     /* The slab at the box faces as the fused kernel weighs it: the pixel ray's chord through the grid, and
      * this fragment's slice (its eye depth rounded to the slice it lies on). */
     float3 o, d;

@@ -57,7 +57,7 @@ typedef struct {
     cl_float4 inv_spacing;   /* w = 0 */
     cl_float4 dims;          /* grid points per axis, w = 0 */
     cl_float4 clip_tex;      /* CLVR_SLICE3D_CLIP_TEXTURE: (width, height, depth, 1 if inverse) */
-    cl_float4 slab;          /* (depth0, delta_s, 0, 0): slice k at eye depth depth0 + k delta_s */
+    cl_float4 slab;          /* (depth0, 0, 0, 0): slice k at eye depth depth0 + k delta_s (frame.z) */
 } ClSlice3dUniforms;         /* 176 bytes */
 
 #endif

@@ -576,9 +576,9 @@ int bench(const BenchOptions& options)
         // The ceiling's first frame warms its caches; then clvr and ceiling frames alternate.
         // The ceiling mirrors slice3d's fused path with per-sample classification only (the raster path
         // counts fragments, not samples; pre-integrated slabs are another loop).
-        const bool ceilingFits = scene.technique == slice3dTechnique().name &&
-                                 parseSlice3dOptions(scene.options).path == Slice3dOptions::Path::Fused &&
-                                 !parseSlice3dOptions(scene.options).preintegrated;
+        const bool isSlice3d = scene.technique == slice3dTechnique().name;
+        const Slice3dOptions sliceOptions = isSlice3d ? parseSlice3dOptions(scene.options) : Slice3dOptions{};
+        const bool ceilingFits = isSlice3d && sliceOptions.path == Slice3dOptions::Path::Fused && !sliceOptions.preintegrated;
         const std::unique_ptr<Ceiling> ceiling = ceilingFits ? makeCeiling(scene, volume, camera) : nullptr;
         const int threads = threadBudget();
         CeilingResult ceilingResult;

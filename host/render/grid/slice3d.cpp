@@ -185,7 +185,7 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
         fragmentUniforms_.inv_spacing = toCl4(invSpacing);
         fragmentUniforms_.dims = cl_float4{{static_cast<float>(dims_.x), static_cast<float>(dims_.y),
                                             static_cast<float>(dims_.z), 0.0f}};
-        fragmentUniforms_.slab = cl_float4{{static_cast<float>(plan_.depth(0)), static_cast<float>(plan_.deltaS), 0.0f, 0.0f}};
+        fragmentUniforms_.slab = cl_float4{{static_cast<float>(plan_.depth(0)), 0.0f, 0.0f, 0.0f}};
         if (clipTexture_) {  // the second texture: buffer 2, u->clip_tex, coordinates in attribute 1
             fragmentProgram_.buffers[2] = clipTexels_->buffer();
             const glm::ivec3 n = clipTexture_->dims();
