@@ -12,6 +12,7 @@
 #include "host/reference/reference_integral.h"
 #include "host/render/renderer.h"
 #include "host/runtime/errors.h"
+#include "raster/reference/pixel_transfer.h"
 #include "tests/support/test_util.h"
 
 #include <algorithm>
@@ -231,9 +232,7 @@ TEST(Slice3dPreintegrated, SkippingEmptyBricksKeepsTheImage)
         FrameStats withStats, withoutStats;
         const Image4f with = test::renderScene(makeScene(camera, tf, 61, on), sphere, &withStats);
         const Image4f without = test::renderScene(makeScene(camera, tf, 61, off), sphere, &withoutStats);
-        Image4d withoutD(without.width(), without.height());
-        for (std::size_t i = 0; i < without.pixelCount(); ++i)
-            withoutD.pixels()[i] = glm::dvec4(without.pixels()[i]);
+        const Image4d withoutD = raster::reference::toDouble(without);
         const test::ImageError e = test::imageError(with, withoutD);
         const auto skipped = withStats.extra["samples_skipped"].get<std::uint64_t>();
         std::printf("[ measured ] sphere %s: skipping on vs off max %.3g mean %.3g; %llu of %llu samples skipped\n",

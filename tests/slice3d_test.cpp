@@ -8,6 +8,7 @@
 #include "host/io/generators.h"
 #include "host/io/image_io.h"
 #include "host/reference/reference_integral.h"
+#include "raster/reference/pixel_transfer.h"
 #include "host/render/renderer.h"
 #include "host/io/volume_io.h"
 #include "tests/support/test_util.h"
@@ -382,13 +383,7 @@ void writePng(const std::string& name, const Image4f& image)
     writeImage("test_output/" + name + ".png", opaque);
 }
 
-Image4d toDouble(const Image4f& image)
-{
-    Image4d out(image.width(), image.height());
-    for (std::size_t i = 0; i < image.pixelCount(); ++i)
-        out.pixels()[i] = glm::dvec4(image.pixels()[i]);
-    return out;
-}
+using raster::reference::toDouble;  // Image4f -> Image4d, exactly
 
 // Largest ray length of one slice in the image: deltaS / cos(theta) at the corner pixel.
 double maxSliceLength(const Scene& scene, const Volume& volume)
