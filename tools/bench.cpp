@@ -5,6 +5,7 @@
 // meshes) on the same scene in the same run.
 #include "tools/bench.h"
 
+#include "host/reference/image_error.h"
 #include "host/reference/reference_integral.h"
 
 #include "host/runtime/device.h"
@@ -108,25 +109,18 @@ std::string si(double v)  // 1.23e+08 -> "123.0 M"
     return fixed(v, 1) + unit[u];
 }
 
-// Image error against the reference integral, as the tests measure it: per channel (R, G, B and A where
-// both have it) |image - reference|, the mean and the max of the worst channel.
+// Image error against the reference integral, as the tests measure it (host/reference/image_error.h): the
+// mean and the max of the worst channel, over R, G, B and, when withAlpha, A.
 nlohmann::json referenceError(const Image4f& image, const Image4d& want, bool withAlpha)
 {
     if (image.width() != want.width() || image.height() != want.height())
         throw InputError("bench --reference: image and reference differ in size");
+    const ImageError e = imageError(image, want);
     const int channels = withAlpha ? 4 : 3;
-    glm::dvec4 sum(0.0), worst(0.0);
-    for (std::size_t i = 0; i < image.pixelCount(); ++i)
-        for (int c = 0; c < channels; ++c) {
-            const double e = std::abs(static_cast<double>(image.pixels()[i][c]) - want.pixels()[i][c]);
-            sum[c] += e;
-            worst[c] = std::max(worst[c], e);
-        }
-    const double n = static_cast<double>(std::max<std::size_t>(image.pixelCount(), 1));
     double mean = 0.0, max = 0.0;
     for (int c = 0; c < channels; ++c) {
-        mean = std::max(mean, sum[c] / n);
-        max = std::max(max, worst[c]);
+        mean = std::max(mean, e.meanAbs[c]);
+        max = std::max(max, e.maxAbs[c]);
     }
     return {{"mean", mean}, {"max", max}, {"channels", withAlpha ? "rgba" : "rgb"}};
 }

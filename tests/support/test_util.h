@@ -6,6 +6,7 @@
 #include "host/model/scene.h"
 #include "host/model/transfer_function.h"
 #include "host/model/volume.h"
+#include "host/reference/image_error.h"
 #include "host/render/renderer.h"
 #include "host/runtime/device.h"
 #include "host/model/image.h"
@@ -44,12 +45,9 @@ struct Tolerance {
     double meanAbs = 0.0;  // per channel, averaged over the image
 };
 
-struct ImageError {
-    glm::dvec4 maxAbs{0.0};
-    glm::dvec4 meanAbs{0.0};
-    std::size_t nanCount = 0;
-};
-ImageError imageError(const Image4f& actual, const Image4d& expected);
+// Per channel max and mean absolute error (host/reference/image_error.h).
+using clvr::ImageError;
+using clvr::imageError;
 
 // Per channel max and mean absolute error against `expected`; fails on NaN or size mismatch.
 // On failure writes test_output/<suite>.<test>/{actual,expected,diff}.exr and says so.
