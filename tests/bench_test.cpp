@@ -6,12 +6,16 @@
 #include "tools/bench_mesh.cpp"
 #include "tools/bench_suites.cpp"
 #include "tools/ceiling.cpp"
+#include "tools/ceiling_harc.cpp"
 
 #include "host/runtime/errors.h"
 #include "host/io/generators.h"
 #include "host/io/mesh_io.h"
 #include "host/reference/reference_integral.h"
+#include "host/reference/tet_reference.h"
+#include "raster/reference/pixel_transfer.h"
 #include "host/render/renderer.h"
+#include "tests/support/mesh_fixtures.h"
 #include "tests/support/test_util.h"
 
 #include <gtest/gtest.h>
@@ -245,6 +249,53 @@ TEST(BenchMesh, BluntfinScenesRenderAndMoreSegmentsSplitMore)
     EXPECT_GT(f10.steps, 0u);
     EXPECT_EQ(f10.steps, f255.steps);
     EXPECT_GT(stats255.extra["pieces"].get<std::uint64_t>(), stats10.extra["pieces"].get<std::uint64_t>());
+}
+
+// harc's ceiling loop (tools/ceiling_harc.h) does the kernel's work: the same cells entered and pieces
+// integrated, the same image up to float rounding (PoCL fuses multiply-adds, the C++ loop does not; its
+// exp2 is the library's, the kernel's clvr_exp2). On bluntfin, 512² (clvr bench), the counts are equal too.
+void expectCeilingWalksLikeTheKernel(const clvr::Scene& scene, const clvr::TetMesh& mesh, double maxDiff)
+{
+    const clvr::TetTopology topology = clvr::buildTopology(mesh);
+    clvr::FrameStats stats;
+    const clvr::Image4f kernel = clvr::makeHarcRenderer(clvr::test::device(), scene, mesh, topology)->render(stats);
+    const clvr::tools::HarcCeiling ceiling(mesh, topology, scene.transferFunction, *scene.camera, scene.image,
+                                           clvr::parseHarcOptions(scene.options));
+    const clvr::tools::HarcCeilingResult result = ceiling.render(2);
+    EXPECT_GT(result.steps, 0u);
+    EXPECT_EQ(result.steps, stats.extra["steps"].get<std::uint64_t>());
+    EXPECT_EQ(result.pieces, stats.extra["pieces"].get<std::uint64_t>());
+    EXPECT_TRUE(clvr::test::imagesNear(result.image, clvr::raster::reference::toDouble(kernel),
+                                       {.maxAbs = maxDiff, .meanAbs = maxDiff / 10.0}));
+}
+
+TEST(HarcCeiling, WalksLikeTheKernelAndMatchesTheExactIntegral)
+{
+    // Two boxes with a gap between them along the view (the ray re-enters at its next entry crossing), and
+    // an eye inside an L of two boxes (every ray starts in the eye's cell): as Harc.NonConvexRayContinues-
+    // BehindTheGap and Harc.EyeInsideTheMeshStartsEveryRayInItsCell, with their tolerances.
+    const glm::dvec3 gradient(0.3, 0.35, -0.4);
+    struct Case {
+        std::vector<clvr::test::Box> boxes;
+        clvr::Camera camera;
+    };
+    const std::vector<Case> cases = {
+        {{{{0.0, 0.0, 0.0}, {1.0, 1.0, 0.4}, 3}, {{0.0, 0.0, 0.7}, {1.0, 1.0, 1.2}, 3}},
+         clvr::test::perspective({0.4, 0.6, 3.0}, {0.5, 0.5, 0.6}, 40.0)},
+        {{{{0.0, 0.0, 0.0}, {2.0, 1.0, 1.0}, 4}, {{0.0, 1.0, 0.0}, {1.0, 2.0, 1.0}, 3}},
+         clvr::test::perspective({0.55, 0.45, 0.6}, {1.6, 1.3, 0.3}, 95.0)},
+    };
+    for (const Case& c : cases) {
+        clvr::TetMesh mesh = clvr::test::boxMesh(c.boxes, gradient, 0.4);
+        clvr::checkMesh(mesh);
+        const clvr::TransferFunction tf = clvr::test::rampTransferFunction();
+        const clvr::Scene scene = clvr::test::meshScene("harc", c.camera, tf, 40);
+        const clvr::tools::HarcCeiling ceiling(mesh, clvr::buildTopology(mesh), tf, c.camera, scene.image,
+                                               clvr::parseHarcOptions(scene.options));
+        const clvr::Image4d expected = clvr::tetReferenceIntegral(mesh, tf, c.camera, scene.image);
+        EXPECT_TRUE(clvr::test::imagesNear(ceiling.render(2).image, expected, {.maxAbs = 2e-3, .meanAbs = 2e-4}));
+        expectCeilingWalksLikeTheKernel(scene, mesh, 1e-5);
+    }
 }
 
 }  // namespace

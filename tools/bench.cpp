@@ -1,7 +1,7 @@
 // tools/bench.cpp — `clvr bench` (DESIGN.md, "How results are judged": speed and peers), over
 // clvr::Session (host/session.h) on one device shared by every scene. Steady-state frames with the data
 // already on the device, compilation reported apart, median of several frames;
-// the ceiling loop (tools/ceiling.h) and VTK (tools/peer_vtk.py, tools/peer_vtk_unstructured.py for
+// the ceiling loops (tools/ceiling.h for slice3d, tools/ceiling_harc.h for harc) and VTK (tools/peer_vtk.py, tools/peer_vtk_unstructured.py for
 // meshes) on the same scene in the same run.
 #include "tools/bench.h"
 
@@ -22,6 +22,7 @@
 #include "tools/bench_mesh.h"
 #include "tools/bench_raster.h"
 #include "tools/ceiling.h"
+#include "tools/ceiling_harc.h"
 
 #if __has_include("raster/rasterizer.h")
 #include "raster/rasterizer.h"
@@ -271,15 +272,36 @@ nlohmann::json benchMeshScene(Device& device, const fs::path& scenePath, const S
     const double firstFrameMs = session.render().wallMs;
     const double compileMs = device.compileMs() - compile0;
 
-    std::vector<double> ms, statsMs;
+    // harc's ceiling loop (tools/ceiling_harc.h) walks the same entry lists and cells; its frames alternate
+    // with clvr's, set beside the kernel's own pass ("harc: walk"), whose host entry stage it does not repeat.
+    const bool isHarc = scene.technique == harcTechnique().name;
+    const HarcOptions harcOptions = isHarc ? parseHarcOptions(scene.options) : HarcOptions{};
+    std::unique_ptr<HarcCeiling> ceiling;
+    if (isHarc && harcCeilingFits(mesh, harcOptions))
+        ceiling = std::make_unique<HarcCeiling>(mesh, buildTopology(mesh), scene.transferFunction, session.camera(),
+                                                scene.image, harcOptions);
+    const int threads = threadBudget();
+    HarcCeilingResult ceilingResult;
+    if (ceiling)
+        ceilingResult = ceiling->render(threads);  // warms its caches
+
+    std::vector<double> ms, statsMs, walkMs, ceilingMs;
     FrameStats stats;
     Image4f image;
     for (int i = 0; i < frames; ++i) {
         Frame frame = session.render();
         ms.push_back(frame.wallMs);
         statsMs.push_back(frame.stats.frameMs);
+        for (const PassTime& p : frame.stats.passes)
+            if (p.name == "harc: walk")
+                walkMs.push_back(p.ms);
         stats = std::move(frame.stats);
         image = std::move(frame.image);
+        if (ceiling) {
+            const auto c0 = Clock::now();
+            ceilingResult = ceiling->render(threads);
+            ceilingMs.push_back(msSince(c0));
+        }
     }
     const Spread s = spread(ms);
     const MeshFigures f = meshFigures(stats.extra, s.median);
@@ -336,6 +358,35 @@ nlohmann::json benchMeshScene(Device& device, const fs::path& scenePath, const S
     for (const PassTime& p : stats.passes)
         std::cout << ' ' << p.name << ' ' << fixed(p.ms, 1) << " ms;";
     std::cout << " (last frame)\n" << std::flush;
+
+    if (ceiling && !walkMs.empty()) {
+        const Spread c = spread(ceilingMs), w = spread(walkMs);
+        const fs::path png = prefix.string() + ".ceiling.png";
+        writeImage(png.string(), ceilingResult.image);
+        const ImageDiff d = imageDiff(image, ceilingResult.image);
+        const double walkStepsPerS = static_cast<double>(f.steps) / (w.median * 1e-3);
+        const double ceilingStepsPerS = static_cast<double>(ceilingResult.steps) / (c.median * 1e-3);
+        r["ceiling"] = {{"threads", threads},
+                        {"frame_ms", c.median},
+                        {"frame_ms_min", c.min},
+                        {"frame_ms_max", c.max},
+                        {"frame_ms_all", ceilingMs},
+                        {"steps", ceilingResult.steps},
+                        {"pieces", ceilingResult.pieces},
+                        {"steps_per_s", ceilingStepsPerS},
+                        {"clvr_walk_ms", w.median},
+                        {"clvr_walk_ms_all", walkMs},
+                        {"clvr_walk_steps_per_s", walkStepsPerS},
+                        {"clvr_ratio", walkStepsPerS / ceilingStepsPerS},
+                        {"image", png.string()},
+                        {"image_diff_vs_clvr", {{"mean", d.mean}, {"max", d.max}}}};
+        std::cout << "  ceiling      walk " << fixed(c.median, 1) << " ms, " << si(ceilingStepsPerS) << " steps/s ("
+                  << threads << " threads, interleaved with clvr's); clvr's walk pass " << fixed(w.median, 1) << " ms, "
+                  << si(walkStepsPerS) << " steps/s: " << fixed(100.0 * walkStepsPerS / ceilingStepsPerS, 1)
+                  << "% of it; steps " << ceilingResult.steps << " vs " << f.steps << ", image |diff| max "
+                  << fixed(d.max, 4) << ", mean " << fixed(d.mean, 5) << '\n'
+                  << std::flush;
+    }
 
     if (options.peer) {
         const fs::path peerScene = prefix.string() + ".peer.json", peerMesh = prefix.string() + ".mesh.vtk";

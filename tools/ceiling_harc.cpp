@@ -1,0 +1,292 @@
+// tools/ceiling_harc.cpp — the plain C++ ceiling loop for harc (see ceiling_harc.h): kernels/harc.cl's
+// harc_render with partial integration and kernels/segment_integral.h's pieces, statement for statement
+// in float, over rows on std::threads.
+#include "tools/ceiling_harc.h"
+
+#include "host/render/camera_args.h"
+#include "host/render/transfer_function_upload.h"
+#include "host/runtime/parallel.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <thread>
+
+namespace clvr::tools {
+namespace {
+
+glm::vec4 toVec4(const cl_float4& v)
+{
+    return {v.s[0], v.s[1], v.s[2], v.s[3]};
+}
+
+glm::vec3 xyz(const cl_float4& v)
+{
+    return {v.s[0], v.s[1], v.s[2]};
+}
+
+}  // namespace
+
+bool harcCeilingFits(const TetMesh& mesh, const HarcOptions& options)
+{
+    return options.integration == HarcOptions::Integration::Partial && !mesh.part;
+}
+
+HarcCeiling::HarcCeiling(const TetMesh& mesh, const TetTopology& topology, const TransferFunction& tf,
+                         const Camera& camera, const ImageSpec& image, const HarcOptions& options)
+    : width_(image.width), height_(image.height), background_(image.background), psi_(psiTable())
+{
+    // The renderer's frame: coordinates relative to the bounding box's centre (HarcRenderer's shift_).
+    glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (const glm::uvec4& t : mesh.tets)
+        for (int k = 0; k < 4; ++k) {
+            lo = glm::min(lo, mesh.points[t[k]]);
+            hi = glm::max(hi, mesh.points[t[k]]);
+        }
+    const glm::dvec3 shift = 0.5 * (lo + hi);
+    camera_ = toClCamera(camera, width_, height_, shift);
+    const double tets = static_cast<double>(mesh.tets.size());
+    const std::uint64_t steps = options.maxSteps ? options.maxSteps : static_cast<std::uint64_t>(4.0 * std::cbrt(tets)) + 10000;
+    maxSteps_ = static_cast<std::uint32_t>(std::min<std::uint64_t>(steps, 0xffffffffu));
+    ertAlpha_ = options.earlyTermination < 1.0 ? static_cast<float>(options.earlyTermination) : 2.0f;
+
+    for (const cl_float4& v : packHarcTets(mesh, topology, shift))
+        tets_.push_back(toVec4(v));
+    lists_ = buildHarcEntryLists(mesh, topology, camera, width_, height_);
+    const std::int64_t eyeTet = camera.parallel ? -1 : locatePoint(mesh, camera.position);
+    if (eyeTet >= 0)
+        prependEyeEntry(lists_, static_cast<std::uint32_t>(eyeTet));
+
+    const std::vector<float> packed = packTransferFunction(tf);
+    const std::size_t n = tf.points().size(), m = (n + 3) / 4 * 4;
+    for (std::size_t i = 0; i < n; ++i) {
+        tfS_.push_back(packed[i]);
+        tfValue_.emplace_back(packed[m + 4 * i], packed[m + 4 * i + 1], packed[m + 4 * i + 2], packed[m + 4 * i + 3]);
+        const float* slope = &packed[m + 4 * n + 4 * i];
+        tfSlope_.emplace_back(slope[0], slope[1], slope[2], slope[3]);
+    }
+}
+
+HarcCeilingResult HarcCeiling::render(int threads) const
+{
+    if (threads <= 0)
+        threads = threadBudget();
+    HarcCeilingResult result;
+    result.image = Image4f(width_, height_);
+    std::atomic<int> nextRow{0};
+    std::vector<Counts> counts(threads);
+    std::vector<std::thread> pool;
+    for (int t = 0; t < threads; ++t)
+        pool.emplace_back([&, t] {
+            for (int y; (y = nextRow.fetch_add(1)) < height_;)
+                renderRow(y, result.image, counts[t]);
+        });
+    for (std::thread& th : pool)
+        th.join();
+    for (const Counts& c : counts) {
+        result.steps += c.steps;
+        result.pieces += c.pieces;
+    }
+    return result;
+}
+
+void HarcCeiling::renderRow(int y, Image4f& image, Counts& counts) const
+{
+    const int n = static_cast<int>(tfS_.size());
+    const float* tfS = tfS_.data();
+    const glm::vec4* tfValue = tfValue_.data();
+    const glm::vec4* tfSlope = tfSlope_.data();
+    const int psiN = psi_.size;
+    const float* psi = psi_.values.data();
+    const glm::vec4* tets = tets_.data();
+    const cl_uint* offsets = lists_.offsets.data();
+    const cl_int2* entries = lists_.entries.data();
+
+    // kernels/segment_integral.h, the same functions as lambdas.
+    auto psiLookup = [&](float front, float back) {  // harc_psi
+        const float f = std::min(front, 1e30f), b = std::min(back, 1e30f);
+        const float n1 = static_cast<float>(psiN - 1);
+        const float x = f / (1.0f + f) * n1, yy = b / (1.0f + b) * n1;
+        const int i = std::min(static_cast<int>(x), psiN - 2), j = std::min(static_cast<int>(yy), psiN - 2);
+        const float fx = x - static_cast<float>(i), fy = yy - static_cast<float>(j);
+        const float* r0 = psi + j * psiN + i;
+        const float* r1 = r0 + psiN;
+        const float a = r0[0] + fx * (r0[1] - r0[0]);
+        const float c = r1[0] + fx * (r1[1] - r1[0]);
+        return a + fy * (c - a);
+    };
+    auto piece = [&](const glm::vec4& cf, const glm::vec4& cb, float l, glm::vec3& color, float& transmittance) {
+        const float tf = cf.w * l, tb = cb.w * l;  // harc_piece: Eq. 2-4
+        if (tf == 0.0f && tb == 0.0f)
+            return;
+        const float zeta = std::exp2(-0.5f * 1.44269504f * (tf + tb));
+        const float p = psiLookup(tf, tb);
+        color += transmittance * (glm::vec3(cb) * (p - zeta) + glm::vec3(cf) * (1.0f - p));
+        transmittance *= zeta;
+    };
+    auto tfAt = [&](int k, float x) -> glm::vec4 {  // harc_tf_at
+        if (k == 0)
+            return tfValue[0];
+        if (k == n)
+            return tfValue[n - 1];
+        return tfValue[k - 1] + (x - tfS[k - 1]) * tfSlope[k - 1];
+    };
+    auto upper = [&](float x) {  // harc_upper
+        int lo = 0, hi = n;
+        while (lo < hi) {
+            const int mid = (lo + hi) >> 1;
+            if (tfS[mid] <= x)
+                lo = mid + 1;
+            else
+                hi = mid;
+        }
+        return lo;
+    };
+    struct TfPoint {
+        float s;
+        int k;
+        glm::vec4 c;
+    };
+    // harc_segment_from: the segment split at the control points strictly between its ends.
+    auto segment = [&](const TfPoint& front, float sB, float l, glm::vec3& color, float& transmittance, TfPoint& back) {
+        const float sF = front.s;
+        glm::vec4 cFront = front.c;
+        if (!(sB != sF)) {
+            piece(cFront, cFront, l, color, transmittance);
+            back = front;
+            return 1;
+        }
+        const float invDs = 1.0f / (sB - sF);
+        float lambdaFront = 0.0f;
+        int pieces = 0, kB;
+        if (sB > sF) {
+            int k = front.k;
+            for (; k < n && tfS[k] < sB; ++k) {
+                const float lambda = l * ((tfS[k] - sF) * invDs);
+                piece(cFront, tfValue[k], lambda - lambdaFront, color, transmittance);
+                cFront = tfValue[k];
+                lambdaFront = lambda;
+                ++pieces;
+            }
+            kB = k < n && tfS[k] <= sB ? k + 1 : k;
+        } else {
+            int k = front.k - 1;
+            while (k >= 0 && tfS[k] >= sF)
+                --k;
+            for (; k >= 0 && tfS[k] > sB; --k) {
+                const float lambda = l * ((tfS[k] - sF) * invDs);
+                piece(cFront, tfValue[k], lambda - lambdaFront, color, transmittance);
+                cFront = tfValue[k];
+                lambdaFront = lambda;
+                ++pieces;
+            }
+            kB = k + 1;
+        }
+        back = {sB, kB, tfAt(kB, sB)};
+        piece(cFront, back.c, l - lambdaFront, color, transmittance);
+        return pieces + 1;
+    };
+
+    // kernels/ray.h's clvr_ray_unit for the whole image (no band).
+    const glm::vec3 position = xyz(camera_.position), forward = xyz(camera_.forward), right = xyz(camera_.right),
+                    up = xyz(camera_.up);
+    const float scale = camera_.params.s[0], aspect = camera_.params.s[1];
+    const bool parallel = camera_.params.s[2] != 0.0f;
+    const float ndcY = 1.0f - (static_cast<float>(y) + 0.5f) / static_cast<float>(height_) * 2.0f;
+
+    std::uint64_t rowSteps = 0, rowPieces = 0;  // added to `counts` once per row (no shared cache line per piece)
+    for (int x = 0; x < width_; ++x) {
+        const float ndcX = (static_cast<float>(x) + 0.5f) / static_cast<float>(width_) * 2.0f - 1.0f;
+        const float sx = ndcX * scale * aspect, sy = ndcY * scale;
+        glm::vec3 e = position, d = forward;
+        if (parallel)
+            e = position + sx * right + sy * up;
+        else
+            d = glm::normalize(forward + sx * right + sy * up);
+
+        const std::size_t p = static_cast<std::size_t>(y) * width_ + x;
+        glm::vec3 color(0.0f);
+        float transmittance = 1.0f;
+        std::uint32_t steps = 0;
+        bool bounded = false;
+        float lambdaDone = -std::numeric_limits<float>::infinity();
+        const cl_uint end = offsets[p + 1];
+        for (cl_uint k = offsets[p]; k < end && !bounded; ++k) {
+            float lambda;
+            std::memcpy(&lambda, &entries[k].s[0], sizeof lambda);
+            const int code = entries[k].s[1];
+            if (lambda < lambdaDone - 1e-5f * (1.0f + std::fabs(lambdaDone)))
+                continue;
+            lambda = std::max(lambda, lambdaDone);
+            int t = code >= 0 ? code >> 2 : -1 - code;
+            int entryFace = code >= 0 ? code & 3 : -1;
+            TfPoint carried{};
+            bool carry = false, stop = false;
+            for (;;) {
+                if (steps >= maxSteps_) {
+                    bounded = true;
+                    break;
+                }
+                ++steps;
+                const glm::vec4* tet = tets + static_cast<std::size_t>(t) * 5;
+                const glm::vec4 planes[4] = {tet[0], tet[1], tet[2],
+                                             glm::vec4(-(glm::vec3(tet[0]) + glm::vec3(tet[1]) + glm::vec3(tet[2])),
+                                                       1.0f - (tet[0].w + tet[1].w + tet[2].w))};
+                const glm::vec4 grad = tet[3];
+                std::int32_t adj[4];
+                std::memcpy(adj, &tet[4], sizeof adj);
+                const glm::vec3 pos = e + lambda * d;
+                float bestNum = 0.0f, bestDen = 0.0f;
+                int exitFace = -1;
+                for (int i = 0; i < 4; ++i) {
+                    const float den = -glm::dot(glm::vec3(planes[i]), d);
+                    if (i != entryFace && den > 0.0f) {
+                        const float num = std::max(glm::dot(glm::vec3(planes[i]), pos) + planes[i].w, 0.0f);
+                        if (exitFace < 0 || num * bestDen < bestNum * den) {
+                            bestNum = num;
+                            bestDen = den;
+                            exitFace = i;
+                        }
+                    }
+                }
+                if (exitFace < 0) {
+                    lambdaDone = lambda;
+                    break;
+                }
+                const float step = bestNum / bestDen;
+                const float lambdaExit = lambda + step;
+                const float sB = glm::dot(glm::vec3(grad), e + lambdaExit * d) + grad.w;
+                TfPoint front = carried;
+                if (!carry) {
+                    const float sF = glm::dot(glm::vec3(grad), pos) + grad.w;
+                    const int kF = upper(sF);
+                    front = {sF, kF, tfAt(kF, sF)};
+                }
+                rowPieces += static_cast<std::uint64_t>(segment(front, sB, step, color, transmittance, carried));
+                carry = true;
+                if (1.0f - transmittance >= ertAlpha_) {
+                    stop = true;
+                    break;
+                }
+                const int next = adj[exitFace];
+                lambda = lambdaExit;
+                if (next < 0) {
+                    lambdaDone = lambdaExit;
+                    break;
+                }
+                t = next >> 2;
+                entryFace = next & 3;
+            }
+            if (stop)
+                break;
+        }
+        rowSteps += steps;
+        image.at(x, static_cast<int>(y)) = glm::vec4(color + transmittance * background_, 1.0f - transmittance);
+    }
+    counts.steps += rowSteps;
+    counts.pieces += rowPieces;
+}
+
+}  // namespace clvr::tools
