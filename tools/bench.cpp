@@ -1,8 +1,8 @@
 // tools/bench.cpp — `clvr bench` (DESIGN.md, "How results are judged": speed and peers), over
 // clvr::Session (host/session.h) on one device shared by every scene. Steady-state frames with the data
 // already on the device, compilation reported apart, median of several frames;
-// the ceiling loops (tools/ceiling.h for slice3d, tools/ceiling_harc.h for harc) and VTK (tools/peer_vtk.py, tools/peer_vtk_unstructured.py for
-// meshes) on the same scene in the same run.
+// the ceiling loops (tools/ceiling.h for slice3d, tools/ceiling_harc.h for harc) and VTK (tools/peer_vtk.py,
+// tools/peer_vtk_unstructured.py for meshes) on the same scene in the same run.
 #include "tools/bench.h"
 
 #include "host/reference/image_error.h"
