@@ -7,8 +7,10 @@
 
 #include "clvr_common.h"
 
-/* ψ of Eq. 4 from the γ-table of host/optics/psi_table.h (bilinear; same arithmetic as PsiTable::lookup). */
-float harc_psi(global const float* psi, const int n, float tau_l_front, float tau_l_back)
+/* ψ of Eq. 4 from the γ-table of host/optics/psi_table.h (bilinear; same arithmetic as PsiTable::lookup).
+ * This and harc_piece are inlined into the loops that call them: PoCL otherwise calls harc_piece once per
+ * piece with the color and transmittance through memory (harc's walk 4 % slower, BENCHMARKS.md). */
+__attribute__((always_inline)) float harc_psi(global const float* psi, const int n, float tau_l_front, float tau_l_back)
 {
     const float f = fmin(tau_l_front, 1e30f), b = fmin(tau_l_back, 1e30f);
     const float n1 = (float)(n - 1);
@@ -24,8 +26,8 @@ float harc_psi(global const float* psi, const int n, float tau_l_front, float ta
 
 /* One linear piece of length l with (C, τ) = cf at the front and cb at the back (Eq. 2, I_0 = 0):
  * composited under what is in front: color += T I, T *= ζ. */
-void harc_piece(global const float* psi, const int psi_n, const float4 cf, const float4 cb, const float l,
-                float3* color, float* transmittance)
+__attribute__((always_inline)) void harc_piece(global const float* psi, const int psi_n, const float4 cf,
+                                               const float4 cb, const float l, float3* color, float* transmittance)
 {
     const float tf = cf.w * l, tb = cb.w * l;
     if (tf == 0.0f && tb == 0.0f)  /* τ is linear along the piece, so 0 all along it: ζ = ψ = 1, nothing to add */
