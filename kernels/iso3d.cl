@@ -4,29 +4,14 @@
 //    of the slices: it samples the RGBA volume (encoded normal, value) trilinearly and puts the value,
 //    normalized to [0,1], in alpha, where the alpha test (GEQUAL iso) keeps the samples at or above
 //    the iso-value and the depth test (LESS) the nearest of them;
-//  - without it: iso3d_finish, the last pass, which puts the background where no slice passed.
+//  - without it: iso3d_fused, the fused path (the slice draws' work in one kernel: each pixel's ray steps
+//    through the same slices, nearest first, and stops at the first sample that passes the alpha test),
+//    and iso3d_finish, the last pass, which puts the background where no slice passed.
 // The host has validated everything; this file only does arithmetic.
 #include "clvr_common.h"
 #include "iso3d_params.h"
+#include "ray.h"
 #include "volume_sampling.h"
-
-#ifndef CLVR_ISO3D_FRAGMENT
-
-/* Last pass, per pixel: a pixel is on the surface iff some fragment passed both tests there, i.e.
- * its depth is below the cleared 1.0. On the surface: (color, 1), the color clamped to [0,1] as a
- * fixed-point frame buffer would after the color-matrix copy (shaded != 0), or the flat surface
- * color (shaded == 0). Elsewhere: (background, 0), so the image is I + (1 - A) background. */
-kernel void iso3d_finish(global float4* color, global const float* depth, const ClIso3dFinishParams p)
-{
-    CLVR_GUARD_1D(p.n);
-    const size_t i = get_global_id(0);
-    if (depth[i] < 1.0f)
-        color[i] = (float4)(p.shaded ? clamp(color[i].xyz, 0.0f, 1.0f) : p.surface.xyz, 1.0f);
-    else
-        color[i] = (float4)(p.background.xyz, 0.0f);
-}
-
-#else
 
 /* Trilinear RGBA at grid coordinates g (checked inside by the caller), the four channels of each
  * grid point interleaved: the 3D texture of the paper's gradient shading, filtered as one texture. */
@@ -48,6 +33,93 @@ float4 iso3d_trilinear4(global const float* v, const int4 dims, const float3 g)
     const float4 c0 = c00 + fy * (c10 - c00), c1 = c01 + fy * (c11 - c01);
     return c0 + fz * (c1 - c0);
 }
+
+/* The slices' fragment color for RGBA sample t at grid coordinates g of a grid with `dims` points and
+ * value_map m (ClIso3dUniforms): (0.5 N + 0.5 interpolated, turned round with m.w != 0; or with m.z != 0
+ * the point's 3D texture coordinates (g + 0.5) / n), and in alpha the value normalized to [0,1]. */
+float4 iso3d_color(const float4 t, const float3 g, const int4 dims, const float4 m)
+{
+    const float3 n = m.w != 0.0f ? 1.0f - t.xyz : t.xyz;
+    const float3 rgb = m.z != 0.0f ? (g + 0.5f) / convert_float3(dims.xyz) : n;
+    return (float4)(rgb, (t.w - m.x) * m.y);
+}
+
+#ifndef CLVR_ISO3D_FRAGMENT
+
+/* Last pass, per pixel: a pixel is on the surface iff some fragment passed both tests there, i.e.
+ * its depth is below the cleared 1.0. On the surface: (color, 1), the color clamped to [0,1] as a
+ * fixed-point frame buffer would after the color-matrix copy (shaded != 0), or the flat surface
+ * color (shaded == 0). Elsewhere: (background, 0), so the image is I + (1 - A) background. */
+kernel void iso3d_finish(global float4* color, global const float* depth, const ClIso3dFinishParams p)
+{
+    CLVR_GUARD_1D(p.n);
+    const size_t i = get_global_id(0);
+    if (depth[i] < 1.0f)
+        color[i] = (float4)(p.shaded ? clamp(color[i].xyz, 0.0f, 1.0f) : p.surface.xyz, 1.0f);
+    else
+        color[i] = (float4)(p.background.xyz, 0.0f);
+}
+
+/* The fused path (host/render/grid/iso3d.cpp, "path": "fused"): one work-item per pixel does what the slice
+ * draws do at that pixel. Its ray o + z d (z the eye depth, kernels/ray.h) meets slice k at the eye depth
+ * slices.x + k slices.y; front to back, the first sample inside the grid whose fragment color passes the
+ * alpha test (alpha >= alpha_ref) is kept, as the depth test LESS keeps the nearest passing fragment. Out:
+ * what the draws leave in the frame buffer — that color and the hit's window depth of the draws'
+ * projection (near slices.z, far slices.w), or (0, 0, 0, 0) and the cleared depth 1 where no sample passes
+ * — and samples[pixel] = the samples taken. The sample points are the slice polygons' fragments up to
+ * rounding: the draws interpolate world positions across the polygons, this adds z d to o. values is
+ * the scalar volume (float, the RGBA volume's fourth channel). */
+kernel void iso3d_fused(global float4* color, global float* depth, global uint* samples, global const float* volume,
+                        global const float* values, const ClIso3dFusedParams p)
+{
+    CLVR_GUARD_2D(p.width, p.height);
+    const int x = (int)get_global_id(0), y = (int)get_global_id(1);
+    const size_t pixel = (size_t)y * (size_t)p.width + (size_t)x;
+    const float2 s = clvr_ray_window_offset(clvr_ray_pixel_centre(x, y), (float2)((float)p.width, (float)p.height),
+                                            p.camera);
+    float3 o, d;
+    clvr_ray_depth(s, p.camera, &o, &d);
+    const int4 dims = convert_int4(p.grid.dims);
+    const float3 go = (o - p.grid.grid_origin.xyz) * p.grid.inv_spacing.xyz, gd = d * p.grid.inv_spacing.xyz;
+    const float depth0 = p.slices.x, delta_s = p.slices.y;
+
+    /* The slices near the ray's chord through the grid (one more each way; every sample is still checked). */
+    float zin, zout;
+    clvr_box_chord(go, gd, (float3)(0.0f), nextafter(convert_float3(dims.xyz - 1), (float3)(INFINITY)), &zin, &zout);
+    int k_lo = 0, k_hi = -1;
+    if (zin <= zout) {
+        const float n = (float)p.slice_count;
+        k_lo = (int)clamp(ceil((zin - depth0) / delta_s) - 1.0f, 0.0f, n);
+        k_hi = (int)clamp(floor((zout - depth0) / delta_s) + 1.0f, -1.0f, n - 1.0f);
+    }
+    float4 hit = (float4)(0.0f);
+    float window = 1.0f;
+    uint taken = 0;
+    for (int k = k_lo; k <= k_hi; ++k) {
+        const float z = depth0 + (float)k * delta_s;
+        const float3 g = go + z * gd;
+        if (!clvr_grid_inside(g, dims))
+            continue;
+        ++taken;
+        /* The alpha test on the value alone (values: the scalar volume, the RGBA volume's fourth channel: the
+         * same trilinear arithmetic on a quarter of the bytes); the whole RGBA sample only for the hit. */
+        if ((clvr_trilinear(values, dims, g) - p.grid.value_map.x) * p.grid.value_map.y >= p.alpha_ref) {
+            const float4 c = iso3d_color(iso3d_trilinear4(volume, dims, g), g, dims, p.grid.value_map);
+            /* glm's projection: NDC z in [-1, 1], window depth (ndc + 1) / 2. */
+            const float n = p.slices.z, f = p.slices.w;
+            const float ndc = clvr_ray_parallel(p.camera) ? (2.0f * z - f - n) / (f - n)
+                                                          : (f + n) / (f - n) - 2.0f * f * n / ((f - n) * z);
+            hit = c;
+            window = 0.5f * ndc + 0.5f;
+            break;
+        }
+    }
+    color[pixel] = hit;
+    depth[pixel] = window;
+    samples[pixel] = taken;
+}
+
+#else
 
 /* attr[0] = world position on the slice (perspective-correct). uniforms: ClIso3dUniforms
  * (kernels/iso3d_params.h): grid origin, 1 / spacing, dims; the brick's first grid point, its box's
@@ -73,11 +145,7 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
     const float4 hi = u->brick_end;
     if (g.x < lo.x || g.y < lo.y || g.z < lo.z || g.x >= hi.x || g.y >= hi.y || g.z >= hi.z)
         return 0;
-    const float4 t = iso3d_trilinear4(r->buffer[0], convert_int4(u->brick_dims), g - lo);
-    const float4 m = u->value_map;
-    const float3 n = m.w != 0.0f ? 1.0f - t.xyz : t.xyz;
-    const float3 rgb = m.z != 0.0f ? (g + 0.5f) / convert_float3(dims.xyz) : n;
-    *color = (float4)(rgb, (t.w - m.x) * m.y);
+    *color = iso3d_color(iso3d_trilinear4(r->buffer[0], convert_int4(u->brick_dims), g - lo), g, dims, u->value_map);
     return 1;
 }
 

@@ -36,30 +36,6 @@ float slice3d_slab_log2e(const float z, const float delta_s, const float chord_i
     return fmax(hi - lo, 0.0f) * neg_stretch_log2e;
 }
 
-/* The eye-depth interval [*zin, *zout] of the ray go + z gd (grid coordinates) inside the box [lo, hi)
- * (slab test; a ray parallel to an axis is inside for lo <= g < hi, so hi is the next float above the last
- * grid point); empty (*zin > *zout) when it misses. */
-void slice3d_chord(const float3 go, const float3 gd, const float3 lo, const float3 hi, float* zin, float* zout)
-{
-    float z0 = -INFINITY, z1 = INFINITY;
-    for (int a = 0; a < 3; ++a) {
-        const float g0 = a == 0 ? go.x : (a == 1 ? go.y : go.z);
-        const float gs = a == 0 ? gd.x : (a == 1 ? gd.y : gd.z);
-        const float l = a == 0 ? lo.x : (a == 1 ? lo.y : lo.z);
-        const float h = a == 0 ? hi.x : (a == 1 ? hi.y : hi.z);
-        if (gs == 0.0f) {
-            if (g0 < l || g0 >= h)
-                z1 = -INFINITY;
-            continue;
-        }
-        const float t0 = (l - g0) / gs, t1 = (h - g0) / gs;
-        z0 = fmax(z0, fmin(t0, t1));
-        z1 = fmin(z1, fmax(t0, t1));
-    }
-    *zin = z0;
-    *zout = z1;
-}
-
 #ifndef CLVR_SLICE3D_FRAGMENT
 
 /* The volume's type on the device for the fused kernel: float by default; the host builds with
@@ -207,7 +183,7 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
     const float3 own_lo = p.own_lo.xyz, own_hi = p.own_hi.xyz;
     const int4 offset = p.part_offset;
     float zin, zout;
-    slice3d_chord(go, gd, own_lo, own_hi, &zin, &zout);
+    clvr_box_chord(go, gd, own_lo, own_hi, &zin, &zout);
     int k_lo = 0, k_hi = -1;
     if (zin <= zout) {
         const float n = (float)p.slice_count;
@@ -270,7 +246,7 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
     /* The chord through the whole grid (not only this part's box: a sort-last part's slices weigh as the
      * whole grid's, so the parts composite to one process's image), from depth 0 on. */
     float chord_in, chord_out;
-    slice3d_chord(go, gd, (float3)(0.0f), p.grid_hi.xyz, &chord_in, &chord_out);
+    clvr_box_chord(go, gd, (float3)(0.0f), p.grid_hi.xyz, &chord_in, &chord_out);
     chord_in = fmax(chord_in, 0.0f);
     const float neg_stretch_log2e = -clvr_ray_stretch(s, p.camera) * M_LOG2E_F;
     if (p.front_to_back) {
@@ -380,7 +356,7 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
     float3 o, d;
     clvr_ray_depth(s, cam, &o, &d);
     float chord_in, chord_out;
-    slice3d_chord((o - u->grid_origin.xyz) * u->inv_spacing.xyz, d * u->inv_spacing.xyz, (float3)(0.0f),
+    clvr_box_chord((o - u->grid_origin.xyz) * u->inv_spacing.xyz, d * u->inv_spacing.xyz, (float3)(0.0f),
                   nextafter(u->dims.xyz - 1.0f, (float3)(INFINITY)), &chord_in, &chord_out);
     chord_in = fmax(chord_in, 0.0f);
     const float k = rint((dot(f->attr[0].xyz - o, cam.forward.xyz) - u->slab.x) / delta_s);

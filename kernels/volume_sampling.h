@@ -11,6 +11,30 @@ int clvr_grid_inside(const float3 g, const int4 dims)
            g.y <= (float)(dims.y - 1) && g.z <= (float)(dims.z - 1);
 }
 
+/* The eye-depth interval [*zin, *zout] of the ray go + z gd (grid coordinates) inside the box [lo, hi)
+ * (slab test; a ray parallel to an axis is inside for lo <= g < hi, so hi is the next float above the last
+ * grid point); empty (*zin > *zout) when it misses. */
+void clvr_box_chord(const float3 go, const float3 gd, const float3 lo, const float3 hi, float* zin, float* zout)
+{
+    float z0 = -INFINITY, z1 = INFINITY;
+    for (int a = 0; a < 3; ++a) {
+        const float g0 = a == 0 ? go.x : (a == 1 ? go.y : go.z);
+        const float gs = a == 0 ? gd.x : (a == 1 ? gd.y : gd.z);
+        const float l = a == 0 ? lo.x : (a == 1 ? lo.y : lo.z);
+        const float h = a == 0 ? hi.x : (a == 1 ? hi.y : hi.z);
+        if (gs == 0.0f) {
+            if (g0 < l || g0 >= h)
+                z1 = -INFINITY;
+            continue;
+        }
+        const float t0 = (l - g0) / gs, t1 = (h - g0) / gs;
+        z0 = fmax(z0, fmin(t0, t1));
+        z1 = fmin(z1, fmax(t0, t1));
+    }
+    *zin = z0;
+    *zout = z1;
+}
+
 /* Sort-last parts (host/model/volume.h GridPart): 1 when full-grid coordinates g are this volume's to
  * sample (own_lo <= g < own_hi per axis; for the whole grid own_hi is the next float above n - 1, so
  * this is clvr_grid_inside's g <= n - 1). */

@@ -24,6 +24,7 @@
 namespace clvr {
 
 static_assert(sizeof(ClIso3dFinishParams) == 48, "also probed on the device by tests/layout_test.cpp");
+static_assert(sizeof(ClIso3dFusedParams) == 224, "also probed on the device by tests/layout_test.cpp");
 
 namespace {
 
@@ -56,6 +57,9 @@ private:
     raster::FragmentProgram fragmentProgram_;
     ClIso3dUniforms fragmentUniforms_{};
     cl::Kernel finish_;
+    cl::Kernel fused_;             // options_.path == Fused: iso3d_fused ...
+    cl::Buffer fusedSamples_;      // ... its samples per pixel
+    cl::Buffer values_;            // ... and the scalar volume it tests the value on (the RGBA volume's alpha)
     // Gradientless shading: the scalar volume as a 3D texture (texel centers at the grid points) and
     // the shift Delta L in texture coordinates.
     std::unique_ptr<raster::Texture> scalarTexture_;
@@ -68,6 +72,8 @@ private:
     MemoryBricks bricks_;
     std::vector<std::vector<glm::vec4>> brickData_;
 
+    raster::DrawStats drawSlices(const glm::dmat4& viewProjection, FrameStats& stats);
+    raster::DrawStats drawFused();
     raster::DrawStats drawBricks(const raster::DrawState& state, const std::vector<raster::Vertex>& vertices,
                                  const std::vector<std::size_t>& sliceFirst, const glm::dmat4& viewProjection,
                                  FrameStats& stats);
@@ -145,6 +151,13 @@ Iso3dRendererImpl::Iso3dRendererImpl(Device& device, const Scene& scene, const V
 
     framebuffer_ = std::make_unique<raster::Framebuffer>(device_, image_.width, image_.height);
     finish_ = device_.kernel("iso3d.cl", "iso3d_finish");
+    if (options_.path == Iso3dOptions::Path::Fused) {
+        values_ = device_.upload("iso3d scalar volume (fused path's alpha test; float32)", volume.values);
+        residentBytes_ += volume.values.size() * sizeof(float);
+        fused_ = device_.kernel("iso3d.cl", "iso3d_fused");
+        fusedSamples_ = device_.buffer("iso3d fused samples per pixel", framebuffer_->pixelCount() * sizeof(cl_uint),
+                                       CL_MEM_WRITE_ONLY);
+    }
     const std::string_view source = embeddedKernelSource("iso3d.cl");
     fragmentProgram_.source = "#define CLVR_ISO3D_FRAGMENT 1\n" + std::string(source);
     fragmentProgram_.attributes = 1;  // the world position
@@ -194,12 +207,74 @@ void Iso3dRendererImpl::setTransferFunction(const TransferFunction& tf)
 Image4f Iso3dRendererImpl::render(FrameStats& stats)
 {
     const FrameClock clock;
-    // The slice polygons, nearest first, fanned into one triangle list; as slice3d's raster path.
-    const glm::dvec3 forward = camera_.forward();
+    // The projection of the slice draws (and of the fused path's window depths).
     nearZ_ = 0.5 * plan_.depth(0);
     farZ_ = 2.0 * plan_.depthMax + 1.0;
     const glm::dmat4 viewProjection =
         camera_.projectionMatrix(image_.width, image_.height, nearZ_, farZ_) * camera_.viewMatrix();
+    // Uploads per frame: none unbricked (the volume stays resident between frames); drawBricks counts its own.
+    stats.extra["brick_uploads"] = 0;
+    stats.extra["brick_upload_bytes"] = 0;
+    stats.extra["brick_upload_ms"] = 0.0;
+    const raster::DrawStats drawStats =
+        options_.path == Iso3dOptions::Path::Fused ? drawFused() : drawSlices(viewProjection, stats);
+
+    const bool shaded = iso_.shading != IsoSurface::Shading::None;
+    if (iso_.shading == IsoSurface::Shading::Gradient) {
+        // Gradient shading (§3): the frame buffer copied onto itself through the color matrix with the
+        // reflectivity as scale and the ambient term as bias, giving c (k_d <L, N> + I_a) in RGB.
+        raster::applyPixelTransfer(device_, *framebuffer_, isoShadingTransfer(iso_));
+    } else if (shaded) {
+        // Gradientless shading (§3): the frame buffer holds the surface points' texture coordinates;
+        // read back and drawn twice through the pixel texture: X(p0), then X(p0 + Delta L) (the shift as
+        // the pixel bias) subtracted from it by blending. X(p0) - X(p0 + Delta L) ~ -Delta dX/dL =
+        // Delta |grad X| <L, N>; times k = 1 / (Delta |grad|~) it is <L, N> where |grad X| = |grad|~
+        // (docs/iso3d.md: off by the factor |grad X| / |grad|~ elsewhere, the paper's condition).
+        const Image4f positions = framebuffer_->readColor(device_);
+        raster::drawPixels(device_, *framebuffer_, positions, {0, 0}, raster::PixelTransfer{},
+                           raster::DrawPixelsBlend::Replace, scalarTexture_.get());
+        raster::PixelTransfer shift;
+        shift.bias = textureShift_;
+        raster::drawPixels(device_, *framebuffer_, positions, {0, 0}, shift, raster::DrawPixelsBlend::ReverseSubtract,
+                           scalarTexture_.get());
+        raster::PixelTransfer light;
+        light.scale = glm::vec4(glm::vec3(iso_.diffuse * gradientlessScale_ * iso_.color), 1.0f);
+        light.bias = glm::vec4(glm::vec3(iso_.ambient * iso_.color), 0.0f);
+        raster::applyPixelTransfer(device_, *framebuffer_, light);
+    }
+    const std::size_t pixels = framebuffer_->pixelCount();
+    ClIso3dFinishParams finish{};
+    finish.surface = toCl4(iso_.color, 1.0);
+    finish.background = toCl4(image_.background, 0.0);
+    finish.n = static_cast<cl_uint>(pixels);
+    finish.shaded = shaded ? 1 : 0;
+    finish_.setArg(0, framebuffer_->color());
+    finish_.setArg(1, framebuffer_->depth());
+    finish_.setArg(2, finish);
+    device_.launch("iso3d: finish", finish_, pixels);
+    Image4f image = framebuffer_->readColor(device_);
+
+    finishFrame(device_, clock, stats);
+    stats.samples = drawStats.fragments;
+    stats.extra["slices"] = plan_.count;
+    stats.extra["slice_spacing"] = plan_.deltaS;
+    stats.extra["triangles"] = drawStats.triangles;
+    stats.extra["iso_value"] = iso_.value;
+    stats.extra["shading"] = shadingName(iso_.shading);
+    stats.extra["resident_bytes"] = residentBytes_;
+    stats.extra["interior"] = options_.interior;
+    stats.extra["path"] = options_.path == Iso3dOptions::Path::Fused ? "fused" : "raster";
+    stats.extra["bricks"] = bricks_.count();
+    stats.extra["brick_grid"] = {bricks_.counts.x, bricks_.counts.y, bricks_.counts.z};
+    stats.extra["brick_bytes"] = bricks_.maxBytes();
+    return image;
+}
+
+// The raster path: the slice polygons drawn under the alpha and depth tests (bricked, or Figure 7's passes).
+raster::DrawStats Iso3dRendererImpl::drawSlices(const glm::dmat4& viewProjection, FrameStats& stats)
+{
+    // The slice polygons, nearest first, fanned into one triangle list; as slice3d's raster path.
+    const glm::dvec3 forward = camera_.forward();
     std::vector<raster::Vertex> vertices;
     vertices.reserve(static_cast<std::size_t>(plan_.count) * 12);
     std::vector<std::size_t> sliceFirst;  // slice k's triangles: vertices[sliceFirst[k] .. sliceFirst[k + 1])
@@ -234,10 +309,6 @@ Image4f Iso3dRendererImpl::render(FrameStats& stats)
     framebuffer_->clearColor(device_, glm::vec4(0.0f));
     framebuffer_->clearDepth(device_, 1.0f);
     raster::DrawStats drawStats;
-    // Uploads per frame: none unbricked (the volume stays resident between frames); drawBricks counts its own.
-    stats.extra["brick_uploads"] = 0;
-    stats.extra["brick_upload_bytes"] = 0;
-    stats.extra["brick_upload_ms"] = 0.0;
     if (vertices.empty()) {
         // the box is behind the camera: nothing to draw
     } else if (bricks_.count() > 1) {
@@ -301,54 +372,33 @@ Image4f Iso3dRendererImpl::render(FrameStats& stats)
         drawStats.triangles += d.triangles;
     }
 
-    const bool shaded = iso_.shading != IsoSurface::Shading::None;
-    if (iso_.shading == IsoSurface::Shading::Gradient) {
-        // Gradient shading (§3): the frame buffer copied onto itself through the color matrix with the
-        // reflectivity as scale and the ambient term as bias, giving c (k_d <L, N> + I_a) in RGB.
-        raster::applyPixelTransfer(device_, *framebuffer_, isoShadingTransfer(iso_));
-    } else if (shaded) {
-        // Gradientless shading (§3): the frame buffer holds the surface points' texture coordinates;
-        // read back and drawn twice through the pixel texture: X(p0), then X(p0 + Delta L) (the shift as
-        // the pixel bias) subtracted from it by blending. X(p0) - X(p0 + Delta L) ~ -Delta dX/dL =
-        // Delta |grad X| <L, N>; times k = 1 / (Delta |grad|~) it is <L, N> where |grad X| = |grad|~
-        // (docs/iso3d.md: off by the factor |grad X| / |grad|~ elsewhere, the paper's condition).
-        const Image4f positions = framebuffer_->readColor(device_);
-        raster::drawPixels(device_, *framebuffer_, positions, {0, 0}, raster::PixelTransfer{},
-                           raster::DrawPixelsBlend::Replace, scalarTexture_.get());
-        raster::PixelTransfer shift;
-        shift.bias = textureShift_;
-        raster::drawPixels(device_, *framebuffer_, positions, {0, 0}, shift, raster::DrawPixelsBlend::ReverseSubtract,
-                           scalarTexture_.get());
-        raster::PixelTransfer light;
-        light.scale = glm::vec4(glm::vec3(iso_.diffuse * gradientlessScale_ * iso_.color), 1.0f);
-        light.bias = glm::vec4(glm::vec3(iso_.ambient * iso_.color), 0.0f);
-        raster::applyPixelTransfer(device_, *framebuffer_, light);
-    }
-    const std::size_t pixels = framebuffer_->pixelCount();
-    ClIso3dFinishParams finish{};
-    finish.surface = toCl4(iso_.color, 1.0);
-    finish.background = toCl4(image_.background, 0.0);
-    finish.n = static_cast<cl_uint>(pixels);
-    finish.shaded = shaded ? 1 : 0;
-    finish_.setArg(0, framebuffer_->color());
-    finish_.setArg(1, framebuffer_->depth());
-    finish_.setArg(2, finish);
-    device_.launch("iso3d: finish", finish_, pixels);
-    Image4f image = framebuffer_->readColor(device_);
+    return drawStats;
+}
 
-    finishFrame(device_, clock, stats);
-    stats.samples = drawStats.fragments;
-    stats.extra["slices"] = plan_.count;
-    stats.extra["slice_spacing"] = plan_.deltaS;
-    stats.extra["triangles"] = drawStats.triangles;
-    stats.extra["iso_value"] = iso_.value;
-    stats.extra["shading"] = shadingName(iso_.shading);
-    stats.extra["resident_bytes"] = residentBytes_;
-    stats.extra["interior"] = options_.interior;
-    stats.extra["bricks"] = bricks_.count();
-    stats.extra["brick_grid"] = {bricks_.counts.x, bricks_.counts.y, bricks_.counts.z};
-    stats.extra["brick_bytes"] = bricks_.maxBytes();
-    return image;
+// The fused path: kernels/iso3d.cl's iso3d_fused leaves in the frame buffer what drawSlices would (color and
+// depth; the stencil is unused), one work-item per pixel. Its `fragments` are the samples taken.
+raster::DrawStats Iso3dRendererImpl::drawFused()
+{
+    ClIso3dFusedParams p{};
+    p.camera = toClCamera(camera_, image_.width, image_.height);
+    p.grid = fragmentUniforms_;
+    p.slices = cl_float4{{static_cast<float>(plan_.depth(0)), static_cast<float>(plan_.deltaS), static_cast<float>(nearZ_),
+                          static_cast<float>(farZ_)}};
+    p.width = image_.width;
+    p.height = image_.height;
+    p.slice_count = plan_.count;
+    p.alpha_ref = alphaRef_;
+    fused_.setArg(0, framebuffer_->color());
+    fused_.setArg(1, framebuffer_->depth());
+    fused_.setArg(2, fusedSamples_);
+    fused_.setArg(3, volume_);
+    fused_.setArg(4, values_);
+    fused_.setArg(5, p);
+    device_.launch("iso3d: fused slices", fused_, image_.width, image_.height);
+    raster::DrawStats d;
+    for (const cl_uint n : device_.download<cl_uint>(fusedSamples_, framebuffer_->pixelCount()))
+        d.fragments += n;
+    return d;
 }
 
 raster::DrawStats Iso3dRendererImpl::drawBricks(const raster::DrawState& unbricked,
@@ -471,6 +521,8 @@ TechniqueInfo iso3dTechnique()
         sliceSpacingInfo(),
         {"gradientless_step", nullptr, "the smallest grid spacing", "gradientless shading: Delta, world units towards the light"},
         {"gradientless_scale", nullptr, "1 / (Delta median |grad| at iso)", "gradientless shading: k, per data unit"},
+        {"path", "fused", "", "\"fused\" (each pixel steps through the slices in one kernel) or \"raster\" (slice draws); "
+                              "interior and bricks take \"raster\""},
         {"interior", false, "", "Figure 7: show the interior surface where the box entry is already inside"},
         {"brick_budget", nullptr, "unbricked", "at most this many bytes of brick textures on the device"},
         {"bricks", nullptr, "unbricked", "[nx, ny, nz]: exactly this brick grid (not with brick_budget)"},
@@ -510,6 +562,14 @@ Iso3dOptions parseIso3dOptions(const nlohmann::json& options)
                     badOption(key, "must be [nx, ny, nz], integers in [1, 65536], got " + value.dump());
                 o.bricks[a] = value[a].get<int>();
             }
+        } else if (key == "path") {
+            const std::string v = value.is_string() ? value.get<std::string>() : "";
+            if (v == "fused")
+                o.path = Iso3dOptions::Path::Fused;
+            else if (v == "raster")
+                o.path = Iso3dOptions::Path::Raster;
+            else
+                badOption(key, "must be \"fused\" or \"raster\", got " + value.dump());
         } else if (key == "interior") {
             if (!value.is_boolean())
                 badOption(key, "must be true or false, got " + value.dump());
@@ -521,6 +581,15 @@ Iso3dOptions parseIso3dOptions(const nlohmann::json& options)
     checkSlicesOrSpacing(options);
     if (options.contains("brick_budget") && options.contains("bricks"))
         badOption("bricks", "give either brick_budget or bricks, not both");
+    // Bricks (one texture upload per brick between draws) and Figure 7's stencil passes are raster-stage work.
+    for (const char* key : {"interior", "brick_budget", "bricks"}) {
+        if (!options.contains(key) || (std::string(key) == "interior" && !o.interior))
+            continue;
+        if (options.contains("path") && o.path == Iso3dOptions::Path::Fused)
+            badOption("path", std::string("\"fused\" does not work with ") + key +
+                                  " (the raster path's passes do it): give \"path\": \"raster\" or leave path out");
+        o.path = Iso3dOptions::Path::Raster;
+    }
     return o;
 }
 

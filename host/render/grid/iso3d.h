@@ -32,13 +32,19 @@ struct Iso3dOptions {
     std::uint64_t brickBudget = 0;
     // ... or exactly this brick grid (0: not given).
     glm::ivec3 bricks{0};
+    // The slices drawn through the raster stage pass by pass (Raster: the paper's alpha and depth tests) or
+    // the same slices stepped through per pixel in one kernel that stops at the first passing sample
+    // (Fused, kernels/iso3d.cl iso3d_fused; the same frame buffer contents up to rounding). Bricking and
+    // interior need the raster path (chosen when they are given without a path).
+    enum class Path { Fused, Raster };
+    Path path = Path::Fused;
 };
 
 // Its registry entry (host/render/renderer.h): name, data kind, one line, options with defaults.
 TechniqueInfo iso3dTechnique();
 
 // Reads the scene's "options" for iso3d (slices, slice_spacing, gradientless_step, gradientless_scale,
-// interior, brick_budget, bricks). Throws InputError naming the key.
+// interior, brick_budget, bricks, path). Throws InputError naming the key.
 Iso3dOptions parseIso3dOptions(const nlohmann::json& options);
 
 // The scene's "iso" as iso3d and its reference use it: the light resolved for the camera, the color
