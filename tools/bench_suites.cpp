@@ -29,6 +29,7 @@ std::vector<std::string> benchSuiteScenes(const std::string& suite)
     std::vector<std::string> regular;
     for (const char* volume : {"engine", "lobster", "ml256"}) {
         regular.push_back(std::string("reg-iso3d-") + volume + ".json");
+        regular.push_back(std::string("reg-iso3d-") + volume + "-raster.json");
         regular.push_back(std::string("reg-iso3d-") + volume + "-bricked.json");
         if (std::string(volume) == "engine")
             regular.push_back("reg-iso3d-engine-gradientless.json");

@@ -10,7 +10,8 @@ Marschner-Lobb 256^3 at 512x512).
 Volumes, cameras and the translucent transfer function are those of tools/make_rts_bench.py, so a row
 here and a resample-then-shade row of the same volume see the same data from the same place.
 Per volume:
-  reg-iso3d-V            iso3d, gradient shading, 512 slices (seeds/000 §3)
+  reg-iso3d-V            iso3d, gradient shading, 512 slices (seeds/000 §3), its default fused path
+  reg-iso3d-V-raster     the same through the raster stage: the slice draws under the alpha and depth tests
   reg-iso3d-V-bricked    the same within a 16 MiB device-memory budget: bricks front to back, the
                          stencil locking the first hit (seeds/000 §3.1)
   reg-stack2d-V          stack2d, plain bilinear slices of the stack (seeds/003)
@@ -76,6 +77,9 @@ def scenes():
         clip = {"mesh": {"generator": "sphere", "center": center, "radius": radius, "segments": 64},
                 "inverse": True, "method": "two-pass"}
         out.append(("reg-iso3d-%s.json" % volume, iso_scene(volume, "gradient")))
+        raster = iso_scene(volume, "gradient")
+        raster["options"]["path"] = "raster"
+        out.append(("reg-iso3d-%s-raster.json" % volume, raster))
         bricked = iso_scene(volume, "gradient")
         bricked["options"]["brick_budget"] = 16 * 2**20
         out.append(("reg-iso3d-%s-bricked.json" % volume, bricked))
