@@ -12,6 +12,7 @@
 #include "texture.h"
 #include "transfer_function.h"
 #include "volume_sampling.h"
+#include "empty_space.h"
 #ifdef SLICE3D_PREINTEGRATED
 #include "segment_integral.h"
 #endif
@@ -45,84 +46,6 @@ float slice3d_slab_log2e(const float z, const float delta_s, const float chord_i
 #define SLICE3D_VOXEL float
 #define SLICE3D_TRILINEAR clvr_trilinear
 #endif
-
-/* Empty-space skipping (docs/slice3d.md). The grid's cells are grouped in bricks of
- * B = 2^SLICE3D_BRICK_SHIFT = 4 cells per axis (host: kBrickCells); brick b covers the cells
- * [Bb, Bb + B), i.e. the grid points [Bb, Bb + B] (one point of overlap with its neighbour), so every
- * trilinear footprint lies in the brick of its lower corner. A brick is empty when the transfer function's tau is exactly 0 for
- * every value the trilinear interpolation can produce in it (host: min-max of its points); a sample
- * there has alpha = 1 - clvr_exp2(0) = 0 and leaves the pixel unchanged bit for bit.
- * space[brick] = 0 for a brick that is not empty, else r + 1 where every brick within Chebyshev
- * distance r (bricks outside the grid count as empty) is empty: one run steps over that cube. */
-#define SLICE3D_BRICK_SHIFT 2
-
-/* Grid coordinates of slice k's sample: the one expression used for every sample position, so that
- * the run ends found by slice3d_empty_run are the positions the main loop would compute. Each
- * coordinate is a monotonic function of k (every rounded operation is), hence so are the inside
- * test and the brick index per axis: two samples in the same box of bricks enclose only samples in it. */
-float3 slice3d_point(const float3 go, const float3 gd, const float depth0, const float delta_s, const int k)
-{
-    return go + (depth0 + (float)k * delta_s) * gd;
-}
-
-/* Brick (x, y, z) of the cell clvr_trilinear uses at the volume's own coordinates gl (its lower corner,
- * clamped to n - 2). */
-int4 slice3d_brick(const float3 gl, const int4 dims)
-{
-    return (int4)(min((int)gl.x, dims.x - 2), min((int)gl.y, dims.y - 2), min((int)gl.z, dims.z - 2), 0) >>
-           SLICE3D_BRICK_SHIFT;
-}
-
-/* 1 if slice k's sample is this volume's and its brick within Chebyshev distance r of brick b. */
-int slice3d_in_cube(const float3 go, const float3 gd, const float depth0, const float delta_s, const int k,
-                    const ClSlice3dParams* p, const int4 b, const int r)
-{
-    const float3 g = slice3d_point(go, gd, depth0, delta_s, k);
-    if (!clvr_grid_owned(g, p->own_lo.xyz, p->own_hi.xyz))
-        return 0;
-    const uint4 c = abs_diff(slice3d_brick(clvr_grid_local(g, p->part_offset), p->dims), b);
-    return max(c.x, max(c.y, c.z)) <= (uint)r;
-}
-
-/* Slice k's sample lies in brick b, and every brick within Chebyshev distance r of b is empty;
- * walking in direction step (+1 or -1) towards k_end, the last slice whose sample is still inside
- * the grid and in that cube of bricks. The ray's exit from the cube's box (clipped to the grid; inv_gd
- * = 1 / gd) gives a candidate, checked with the main loop's own arithmetic (and one slice back if it
- * fails); by monotonicity every slice between k and it is then in the cube too. Falls back to k. */
-int slice3d_empty_run(const float3 go, const float3 gd, const float3 inv_gd, const float depth0,
-                      const float delta_s, const int k, const int step, const int k_end, const ClSlice3dParams* p,
-                      const int4 b, const int r)
-{
-    /* the cube's box in full-grid coordinates */
-    const int4 dims = p->dims;
-    const float3 offset = convert_float3(p->part_offset.xyz);
-    const float3 lo = offset + convert_float3(max(b.xyz - r, 0) << SLICE3D_BRICK_SHIFT);
-    const float3 hi = offset + fmin(convert_float3((b.xyz + r + 1) << SLICE3D_BRICK_SHIFT), convert_float3(dims.xyz - 1));
-    /* eye depth where the ray crosses each face it walks towards */
-    const float3 face = (float)step * gd > 0.0f ? hi : lo;
-    const float3 t = (face - go) * inv_gd;
-    float zexit;
-    if (step > 0)
-        zexit = fmin(gd.x != 0.0f ? t.x : INFINITY, fmin(gd.y != 0.0f ? t.y : INFINITY, gd.z != 0.0f ? t.z : INFINITY));
-    else
-        zexit = fmax(gd.x != 0.0f ? t.x : -INFINITY, fmax(gd.y != 0.0f ? t.y : -INFINITY, gd.z != 0.0f ? t.z : -INFINITY));
-    const float kf = (zexit - depth0) / delta_s;
-    int cand;
-    if (step > 0)
-        cand = (int)clamp(floor(kf), (float)k, (float)k_end);
-    else
-        cand = (int)clamp(ceil(kf), (float)k_end, (float)k);
-    for (int tries = 0; tries < 2 && cand != k; ++tries, cand -= step)
-        if (slice3d_in_cube(go, gd, depth0, delta_s, cand, p, b, r))
-            return cand;
-    return k;
-}
-
-/* space[] of brick b: 0 if not empty, else r + 1 (see above). */
-int slice3d_space(global const uchar* space, const int4 bdims, const int4 b)
-{
-    return space[((uint)b.z * (uint)bdims.y + (uint)b.y) * (uint)bdims.x + (uint)b.x];
-}
 
 #ifdef SLICE3D_PREINTEGRATED
 /* The value at eye depth z where the ray enters or leaves the grid: the slab test's depth rounds, so the
@@ -182,6 +105,7 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
      * sample is still checked, so this only limits the loop. */
     const float3 own_lo = p.own_lo.xyz, own_hi = p.own_hi.xyz;
     const int4 offset = p.part_offset;
+    const ClvrOwnedGrid owned = {dims, offset, own_lo, own_hi};  /* for empty-space runs */
     float zin, zout;
     clvr_box_chord(go, gd, own_lo, own_hi, &zin, &zout);
     int k_lo = 0, k_hi = -1;
@@ -208,7 +132,7 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
         HarcTfPoint front = harc_tf_point(tf, tf_count, slice3d_value_at_depth(volume, dims, go, gd, z_begin));
         float z_front = z_begin;
         for (int k = k_lo; k <= k_hi; ++k) {
-            const float3 g = slice3d_point(go, gd, depth0, delta_s, k);
+            const float3 g = clvr_slice_point(go, gd, depth0, delta_s, k);
             if (!clvr_grid_owned(g, own_lo, own_hi))
                 continue;
             const float z = depth0 + (float)k * delta_s;
@@ -222,17 +146,17 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
             if (1.0f - transmittance >= ert_alpha)
                 break;
             if (skip) {
-                const int4 b = slice3d_brick(g, dims);
-                const int space_b = slice3d_space(space, bdims, b);
+                const int4 b = clvr_brick(g, dims);
+                const int space_b = clvr_space(space, bdims, b);
                 if (space_b != 0) {
-                    const int run_end = slice3d_empty_run(go, gd, inv_gd, depth0, delta_s, k, 1, k_hi, &p, b,
+                    const int run_end = clvr_empty_run(go, gd, inv_gd, depth0, delta_s, k, 1, k_hi, &owned, b,
                                                           space_b - 1);
                     if (run_end > k) {
                         stepped_over += (uint)(run_end - k);
                         k = run_end;
                         z_front = depth0 + (float)k * delta_s;
                         front = harc_tf_point(tf, tf_count,
-                                              SLICE3D_TRILINEAR(volume, dims, slice3d_point(go, gd, depth0, delta_s, k)));
+                                              SLICE3D_TRILINEAR(volume, dims, clvr_slice_point(go, gd, depth0, delta_s, k)));
                     }
                 }
             }
@@ -252,15 +176,15 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
     if (p.front_to_back) {
         float transmittance = 1.0f;
         for (int k = k_lo; k <= k_hi; ++k) {
-            const float3 g = slice3d_point(go, gd, depth0, delta_s, k);
+            const float3 g = clvr_slice_point(go, gd, depth0, delta_s, k);
             if (!clvr_grid_owned(g, own_lo, own_hi))
                 continue;
             const float3 gl = clvr_grid_local(g, offset);
             if (skip) {
-                const int4 b = slice3d_brick(gl, dims);
-                const int space_b = slice3d_space(space, bdims, b);
+                const int4 b = clvr_brick(gl, dims);
+                const int space_b = clvr_space(space, bdims, b);
                 if (space_b != 0) {
-                    const int run_end = slice3d_empty_run(go, gd, inv_gd, depth0, delta_s, k, 1, k_hi, &p, b,
+                    const int run_end = clvr_empty_run(go, gd, inv_gd, depth0, delta_s, k, 1, k_hi, &owned, b,
                                                           space_b - 1);
                     stepped_over += (uint)(run_end - k + 1);
                     k = run_end;
@@ -284,15 +208,15 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
         alpha_acc = 1.0f - transmittance;
     } else {
         for (int k = k_hi; k >= k_lo; --k) {
-            const float3 g = slice3d_point(go, gd, depth0, delta_s, k);
+            const float3 g = clvr_slice_point(go, gd, depth0, delta_s, k);
             if (!clvr_grid_owned(g, own_lo, own_hi))
                 continue;
             const float3 gl = clvr_grid_local(g, offset);
             if (skip) {
-                const int4 b = slice3d_brick(gl, dims);
-                const int space_b = slice3d_space(space, bdims, b);
+                const int4 b = clvr_brick(gl, dims);
+                const int space_b = clvr_space(space, bdims, b);
                 if (space_b != 0) {
-                    const int run_end = slice3d_empty_run(go, gd, inv_gd, depth0, delta_s, k, -1, k_lo, &p, b,
+                    const int run_end = clvr_empty_run(go, gd, inv_gd, depth0, delta_s, k, -1, k_lo, &owned, b,
                                                           space_b - 1);
                     stepped_over += (uint)(k - run_end + 1);
                     k = run_end;

@@ -58,8 +58,8 @@ Slice3dOptions parseSlice3dOptions(const nlohmann::json& options);
 // (planSlices of host/render/slice_plan.h).
 SlicePlan planSlices(const Camera& camera, const glm::dvec3& lo, const glm::dvec3& hi, const Slice3dOptions& options);
 
-// Empty-space skipping (docs/slice3d.md): bricks of B^3 cells, B = kBrickCells (= 2^SLICE3D_BRICK_SHIFT
-// in kernels/slice3d.cl; 4 measured faster than 8 on the engine); brick b covers the grid points
+// Empty-space skipping (docs/slice3d.md): bricks of B^3 cells, B = kBrickCells (= 2^CLVR_BRICK_SHIFT
+// in kernels/empty_space.h; 4 measured faster than 8 on the engine); brick b covers the grid points
 // [Bb, Bb + B] on each axis (one point of overlap), so it holds every trilinear footprint whose lower
 // corner lies in it. The min-max grid is built once per volume.
 constexpr int kBrickCells = 4;
