@@ -9,6 +9,7 @@
 //    and iso3d_finish, the last pass, which puts the background where no slice passed.
 // The host has validated everything; this file only does arithmetic.
 #include "clvr_common.h"
+#include "empty_space.h"
 #include "iso3d_params.h"
 #include "ray.h"
 #include "volume_sampling.h"
@@ -68,9 +69,11 @@ kernel void iso3d_finish(global float4* color, global const float* depth, const 
  * projection (near slices.z, far slices.w), or (0, 0, 0, 0) and the cleared depth 1 where no sample passes
  * — and samples[pixel] = the samples taken. The sample points are the slice polygons' fragments up to
  * rounding: the draws interpolate world positions across the polygons, this adds z d to o. values is
- * the scalar volume (float, the RGBA volume's fourth channel). */
+ * the scalar volume (float, the RGBA volume's fourth channel). With p.bricks.w != 0 runs of slices in
+ * bricks whose values all lie below the iso-value (space[], kernels/empty_space.h) are stepped over: no
+ * sample there could pass, so the frame buffer is the same bit for bit; they are not counted in samples. */
 kernel void iso3d_fused(global float4* color, global float* depth, global uint* samples, global const float* volume,
-                        global const float* values, const ClIso3dFusedParams p)
+                        global const float* values, global const uchar* space, const ClIso3dFusedParams p)
 {
     CLVR_GUARD_2D(p.width, p.height);
     const int x = (int)get_global_id(0), y = (int)get_global_id(1);
@@ -83,24 +86,36 @@ kernel void iso3d_fused(global float4* color, global float* depth, global uint* 
     const float3 go = (o - p.grid.grid_origin.xyz) * p.grid.inv_spacing.xyz, gd = d * p.grid.inv_spacing.xyz;
     const float depth0 = p.slices.x, delta_s = p.slices.y;
 
+    /* The whole grid (no parts): own_hi the next float above n - 1, the box of clvr_grid_inside. */
+    const float3 top = nextafter(convert_float3(dims.xyz - 1), (float3)(INFINITY));
+    const ClvrOwnedGrid grid = {dims, (int4)(0), (float3)(0.0f), top};
     /* The slices near the ray's chord through the grid (one more each way; every sample is still checked). */
     float zin, zout;
-    clvr_box_chord(go, gd, (float3)(0.0f), nextafter(convert_float3(dims.xyz - 1), (float3)(INFINITY)), &zin, &zout);
+    clvr_box_chord(go, gd, grid.own_lo, grid.own_hi, &zin, &zout);
     int k_lo = 0, k_hi = -1;
     if (zin <= zout) {
         const float n = (float)p.slice_count;
         k_lo = (int)clamp(ceil((zin - depth0) / delta_s) - 1.0f, 0.0f, n);
         k_hi = (int)clamp(floor((zout - depth0) / delta_s) + 1.0f, -1.0f, n - 1.0f);
     }
+    const float3 inv_gd = 1.0f / gd;  /* for empty-space runs only (inf where gd is 0, not used there) */
     float4 hit = (float4)(0.0f);
     float window = 1.0f;
     uint taken = 0;
     for (int k = k_lo; k <= k_hi; ++k) {
-        const float z = depth0 + (float)k * delta_s;
-        const float3 g = go + z * gd;
+        const float3 g = clvr_slice_point(go, gd, depth0, delta_s, k);
         if (!clvr_grid_inside(g, dims))
             continue;
+        if (p.bricks.w) {
+            const int4 b = clvr_brick(g, dims);
+            const int space_b = clvr_space(space, p.bricks, b);
+            if (space_b != 0) {
+                k = clvr_empty_run(go, gd, inv_gd, depth0, delta_s, k, 1, k_hi, &grid, b, space_b - 1);
+                continue;
+            }
+        }
         ++taken;
+        const float z = depth0 + (float)k * delta_s;
         /* The alpha test on the value alone (values: the scalar volume, the RGBA volume's fourth channel: the
          * same trilinear arithmetic on a quarter of the bytes); the whole RGBA sample only for the hit. */
         if ((clvr_trilinear(values, dims, g) - p.grid.value_map.x) * p.grid.value_map.y >= p.alpha_ref) {

@@ -34,9 +34,10 @@ typedef struct {
     ClIso3dUniforms grid;   /* as the fragment program's (brick = the whole grid); value_map.w (flip) is 0 */
     cl_float4 slices;       /* (eye depth of slice 0, slice spacing, near, far): near and far are the slice draws'
                              * projection, for the window depth of a hit */
+    cl_int4 bricks;         /* empty-space skipping (kernels/empty_space.h): bricks per axis; w = 1 to skip */
     cl_int width, height;   /* image size in pixels */
     cl_int slice_count;
     cl_float alpha_ref;     /* the alpha test's reference: a sample is on the surface if its alpha >= this */
-} ClIso3dFusedParams;       /* 224 bytes */
+} ClIso3dFusedParams;       /* 240 bytes */
 
 #endif

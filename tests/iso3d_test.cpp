@@ -550,6 +550,34 @@ TEST(Iso3dFused, LeavesTheSliceDrawsFrameBufferOnMarschnerLobb)
         expectFusedLikeRaster(compareFused(makeScene(camera, 0.5, {{"slices", 128}}), marschnerLobb41()));
 }
 
+// Empty-space skipping steps over bricks whose values all lie below the iso-value: the same frame, bit for
+// bit, with fewer samples.
+TEST(Iso3dFused, EmptySpaceSkippingLeavesTheSameBits)
+{
+    struct Case {
+        const Volume* volume;
+        Camera camera;
+    };
+    for (const Case& c : {Case{&sphere33(), perspectiveCamera()}, Case{&sphere33(), insideCamera()},
+                          Case{&marschnerLobb41(), parallelCamera()}}) {
+        Scene on = makeScene(c.camera, 0.5, {{"slices", 128}}), off = on;
+        off.options["empty_space_skipping"] = false;
+        FrameStats son, soff;
+        auto ron = makeIso3dRenderer(test::device(), on, *c.volume);
+        const Image4f ion = ron->render(son);
+        const Image4f ioff = makeIso3dRenderer(test::device(), off, *c.volume)->render(soff);
+        EXPECT_TRUE(son.extra["empty_space_skipping"].get<bool>());
+        EXPECT_FALSE(soff.extra["empty_space_skipping"].get<bool>());
+        EXPECT_GT(son.extra["empty_bricks"].get<std::uint64_t>(), 0u);
+        ASSERT_EQ(ion.pixels().size(), ioff.pixels().size());
+        EXPECT_EQ(std::memcmp(ion.pixels().data(), ioff.pixels().data(), ion.pixels().size() * sizeof(glm::vec4)), 0);
+        EXPECT_LT(son.samples, soff.samples);
+        std::printf("iso3d empty-space skipping: %llu empty bricks, samples %llu -> %llu\n",
+                    static_cast<unsigned long long>(son.extra["empty_bricks"].get<std::uint64_t>()),
+                    static_cast<unsigned long long>(soff.samples), static_cast<unsigned long long>(son.samples));
+    }
+}
+
 TEST(Iso3dFused, HitsWithinOneSliceOfTheExactFirstHit)
 {
     for (const Camera& camera : {perspectiveCamera(), parallelCamera()}) {

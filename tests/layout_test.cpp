@@ -119,7 +119,7 @@ TEST(Layout, EveryParamsStructFitsTheKernelArgumentSpace)
         {"spherical_shell", sizeof(ClSphericalParams) + 5 * sizeof(void*)},
         {"slice3d_over_background", sizeof(ClSlice3dOverBackgroundParams) + 1 * sizeof(void*)},
         {"iso3d_finish", sizeof(ClIso3dFinishParams) + 2 * sizeof(void*)},
-        {"iso3d_fused", sizeof(ClIso3dFusedParams) + 5 * sizeof(void*)},
+        {"iso3d_fused", sizeof(ClIso3dFusedParams) + 6 * sizeof(void*)},
         {"stack2d_iso_finish", sizeof(ClStack2dIsoFinishParams) + 2 * sizeof(void*)},
         {"pixel_transfer", sizeof(ClPixelTransferParams) + 2 * sizeof(void*)},
         {"draw_pixels", sizeof(ClDrawPixelsParams) + 4 * sizeof(void*)},
@@ -143,7 +143,7 @@ TEST(Layout, EveryParamsStructFitsTheKernelArgumentSpace)
     EXPECT_EQ(sizeof(ClTetsliceCompositeParams), 112u);
     EXPECT_EQ(sizeof(ClTetisoParams), 32u);
     EXPECT_EQ(sizeof(ClIso3dFinishParams), 48u);
-    EXPECT_EQ(sizeof(ClIso3dFusedParams), 224u);
+    EXPECT_EQ(sizeof(ClIso3dFusedParams), 240u);
     EXPECT_EQ(sizeof(ClStack2dIsoFinishParams), 32u);
     EXPECT_EQ(sizeof(ClPixelTransfer), 128u);
     EXPECT_EQ(sizeof(ClPixelTransferParams), 144u);

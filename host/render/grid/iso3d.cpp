@@ -3,6 +3,8 @@
 // program under the alpha and depth tests, the color-matrix copy, and kernels/iso3d.cl: iso3d_finish.
 #include "host/render/grid/iso3d.h"
 
+#include "host/render/grid/slice3d.h"  // buildBrickGrid, emptySpaceRadii: slice3d's bricks
+
 #include "host/render/scaffold.h"
 #include "host/runtime/embedded_kernels.h"
 #include "host/runtime/errors.h"
@@ -24,7 +26,7 @@
 namespace clvr {
 
 static_assert(sizeof(ClIso3dFinishParams) == 48, "also probed on the device by tests/layout_test.cpp");
-static_assert(sizeof(ClIso3dFusedParams) == 224, "also probed on the device by tests/layout_test.cpp");
+static_assert(sizeof(ClIso3dFusedParams) == 240, "also probed on the device by tests/layout_test.cpp");
 
 namespace {
 
@@ -59,7 +61,10 @@ private:
     cl::Kernel finish_;
     cl::Kernel fused_;             // options_.path == Fused: iso3d_fused ...
     cl::Buffer fusedSamples_;      // ... its samples per pixel
-    cl::Buffer values_;            // ... and the scalar volume it tests the value on (the RGBA volume's alpha)
+    cl::Buffer values_;            // ... the scalar volume it tests the value on (the RGBA volume's alpha)
+    cl::Buffer space_;             // ... and its empty-space radii per brick (kernels/empty_space.h)
+    glm::ivec3 brickDims_{0};
+    std::uint64_t emptyBrickCount_ = 0;
     // Gradientless shading: the scalar volume as a 3D texture (texel centers at the grid points) and
     // the shift Delta L in texture coordinates.
     std::unique_ptr<raster::Texture> scalarTexture_;
@@ -154,6 +159,17 @@ Iso3dRendererImpl::Iso3dRendererImpl(Device& device, const Scene& scene, const V
     if (options_.path == Iso3dOptions::Path::Fused) {
         values_ = device_.upload("iso3d scalar volume (fused path's alpha test; float32)", volume.values);
         residentBytes_ += volume.values.size() * sizeof(float);
+        // Empty-space skipping: slice3d's bricks (kernels/empty_space.h), empty where every value lies below
+        // the iso-value by more than float rounding in the trilinear interpolation could make up.
+        const BrickGrid grid = buildBrickGrid(volume);
+        const double margin = 1e-5 * std::max({std::abs(range.x), std::abs(range.y), std::abs(iso_.value)});
+        std::vector<cl_uchar> empty(grid.minMax.size());
+        for (std::size_t b = 0; b < empty.size(); ++b)
+            empty[b] = static_cast<double>(grid.minMax[b].y) + margin < iso_.value ? 1 : 0;
+        emptyBrickCount_ = static_cast<std::uint64_t>(std::count(empty.begin(), empty.end(), cl_uchar(1)));
+        brickDims_ = grid.dims;
+        space_ = device_.upload("iso3d empty-space radii", emptySpaceRadii(grid.dims, empty));
+        residentBytes_ += empty.size();
         fused_ = device_.kernel("iso3d.cl", "iso3d_fused");
         fusedSamples_ = device_.buffer("iso3d fused samples per pixel", framebuffer_->pixelCount() * sizeof(cl_uint),
                                        CL_MEM_WRITE_ONLY);
@@ -264,6 +280,10 @@ Image4f Iso3dRendererImpl::render(FrameStats& stats)
     stats.extra["resident_bytes"] = residentBytes_;
     stats.extra["interior"] = options_.interior;
     stats.extra["path"] = options_.path == Iso3dOptions::Path::Fused ? "fused" : "raster";
+    if (options_.path == Iso3dOptions::Path::Fused) {
+        stats.extra["empty_space_skipping"] = options_.emptySpaceSkipping && emptyBrickCount_ > 0;
+        stats.extra["empty_bricks"] = emptyBrickCount_;
+    }
     stats.extra["bricks"] = bricks_.count();
     stats.extra["brick_grid"] = {bricks_.counts.x, bricks_.counts.y, bricks_.counts.z};
     stats.extra["brick_bytes"] = bricks_.maxBytes();
@@ -388,12 +408,15 @@ raster::DrawStats Iso3dRendererImpl::drawFused()
     p.height = image_.height;
     p.slice_count = plan_.count;
     p.alpha_ref = alphaRef_;
+    const bool skip = options_.emptySpaceSkipping && emptyBrickCount_ > 0;
+    p.bricks = cl_int4{{brickDims_.x, brickDims_.y, brickDims_.z, skip ? 1 : 0}};
     fused_.setArg(0, framebuffer_->color());
     fused_.setArg(1, framebuffer_->depth());
     fused_.setArg(2, fusedSamples_);
     fused_.setArg(3, volume_);
     fused_.setArg(4, values_);
-    fused_.setArg(5, p);
+    fused_.setArg(5, space_);
+    fused_.setArg(6, p);
     device_.launch("iso3d: fused slices", fused_, image_.width, image_.height);
     raster::DrawStats d;
     for (const cl_uint n : device_.download<cl_uint>(fusedSamples_, framebuffer_->pixelCount()))
@@ -523,6 +546,7 @@ TechniqueInfo iso3dTechnique()
         {"gradientless_scale", nullptr, "1 / (Delta median |grad| at iso)", "gradientless shading: k, per data unit"},
         {"path", "fused", "", "\"fused\" (each pixel steps through the slices in one kernel) or \"raster\" (slice draws); "
                               "interior and bricks take \"raster\""},
+        {"empty_space_skipping", true, "", "fused path: step over bricks whose values all lie below the iso-value (same image)"},
         {"interior", false, "", "Figure 7: show the interior surface where the box entry is already inside"},
         {"brick_budget", nullptr, "unbricked", "at most this many bytes of brick textures on the device"},
         {"bricks", nullptr, "unbricked", "[nx, ny, nz]: exactly this brick grid (not with brick_budget)"},
@@ -570,6 +594,10 @@ Iso3dOptions parseIso3dOptions(const nlohmann::json& options)
                 o.path = Iso3dOptions::Path::Raster;
             else
                 badOption(key, "must be \"fused\" or \"raster\", got " + value.dump());
+        } else if (key == "empty_space_skipping") {
+            if (!value.is_boolean())
+                badOption(key, "must be true or false, got " + value.dump());
+            o.emptySpaceSkipping = value.get<bool>();
         } else if (key == "interior") {
             if (!value.is_boolean())
                 badOption(key, "must be true or false, got " + value.dump());

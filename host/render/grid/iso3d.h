@@ -38,13 +38,15 @@ struct Iso3dOptions {
     // interior need the raster path (chosen when they are given without a path).
     enum class Path { Fused, Raster };
     Path path = Path::Fused;
+    bool emptySpaceSkipping = true;  // fused path: step over bricks whose values all lie below the iso-value
+
 };
 
 // Its registry entry (host/render/renderer.h): name, data kind, one line, options with defaults.
 TechniqueInfo iso3dTechnique();
 
 // Reads the scene's "options" for iso3d (slices, slice_spacing, gradientless_step, gradientless_scale,
-// interior, brick_budget, bricks, path). Throws InputError naming the key.
+// interior, brick_budget, bricks, path, empty_space_skipping). Throws InputError naming the key.
 Iso3dOptions parseIso3dOptions(const nlohmann::json& options);
 
 // The scene's "iso" as iso3d and its reference use it: the light resolved for the camera, the color
