@@ -248,11 +248,11 @@ if(PART STREQUAL "device")
   expect_error(2 ${out} "default scene: options.brick_budget: 100 bytes is less than the smallest brick"
     ${CLVR} render -o ${out} ${SMALL} ${ISO} --set options.brick_budget=100)
   # Faults injected mid-run (CLVR_INJECT_FAULT, docs/robustness.md): a launch in the middle of an iso3d frame
-  # (the 7th: clears and slices come before it) and of an orbit's last frame (the 5th: frame 0 renders
+  # (the 2nd, its shading pass: the fused slices come before it) and of an orbit's last frame (the 5th: frame 0 renders
   # twice) fail with exit 3 and one line, and leave no image (the orbit's first frames are removed again);
   # a kernel build failure exits 3 with the compiler's log under the line; a malformed value is bad input.
-  expect_error(3 ${out} "launching \"[^\"]+\" failed: CL_OUT_OF_RESOURCES \\(injected by CLVR_INJECT_FAULT=launch:7\\)"
-    ${CMAKE_COMMAND} -E env CLVR_INJECT_FAULT=launch:7 ${CLVR} render -o ${out} ${SMALL} ${ISO} --stats ${WORK}/fault.json)
+  expect_error(3 ${out} "launching \"[^\"]+\" failed: CL_OUT_OF_RESOURCES \\(injected by CLVR_INJECT_FAULT=launch:2\\)"
+    ${CMAKE_COMMAND} -E env CLVR_INJECT_FAULT=launch:2 ${CLVR} render -o ${out} ${SMALL} ${ISO} --stats ${WORK}/fault.json)
   if(EXISTS ${WORK}/fault.json)
     message(FATAL_ERROR "a failed launch left its --stats file")
   endif()
