@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <initializer_list>
 #include <string>
 
 namespace clvr {
@@ -52,6 +53,29 @@ inline int integerOption(const std::string& key, const nlohmann::json& value, lo
     if (!value.is_number_integer() || value.get<long long>() < lo || value.get<long long>() > hi)
         badOption(key, "must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + value.dump());
     return static_cast<int>(value.get<long long>());
+}
+
+// The index in `names` of string option `key`; else "options.KEY: must be "a", "b" or "c", got V".
+inline int choiceOption(const std::string& key, const nlohmann::json& value, std::initializer_list<const char*> names)
+{
+    const std::string s = value.is_string() ? value.get<std::string>() : "";
+    std::string list;
+    int i = 0;
+    for (const char* name : names) {
+        if (s == name)
+            return i;
+        list += std::string(i == 0 ? "" : (i + 1 == static_cast<int>(names.size()) ? " or " : ", ")) + '"' + name + '"';
+        ++i;
+    }
+    badOption(key, "must be " + list + ", got " + value.dump());
+}
+
+// The value of boolean option `key`; else "options.KEY: must be true or false, got V".
+inline bool booleanOption(const std::string& key, const nlohmann::json& value)
+{
+    if (!value.is_boolean())
+        badOption(key, "must be true or false, got " + value.dump());
+    return value.get<bool>();
 }
 
 // The value of number option `key` when it is finite and ok(value); else "options.KEY: must be WHAT, got V".

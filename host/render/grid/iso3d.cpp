@@ -587,21 +587,12 @@ Iso3dOptions parseIso3dOptions(const nlohmann::json& options)
                 o.bricks[a] = value[a].get<int>();
             }
         } else if (key == "path") {
-            const std::string v = value.is_string() ? value.get<std::string>() : "";
-            if (v == "fused")
-                o.path = Iso3dOptions::Path::Fused;
-            else if (v == "raster")
-                o.path = Iso3dOptions::Path::Raster;
-            else
-                badOption(key, "must be \"fused\" or \"raster\", got " + value.dump());
+            o.path = choiceOption(key, value, {"fused", "raster"}) == 0 ? Iso3dOptions::Path::Fused
+                                                                          : Iso3dOptions::Path::Raster;
         } else if (key == "empty_space_skipping") {
-            if (!value.is_boolean())
-                badOption(key, "must be true or false, got " + value.dump());
-            o.emptySpaceSkipping = value.get<bool>();
+            o.emptySpaceSkipping = booleanOption(key, value);
         } else if (key == "interior") {
-            if (!value.is_boolean())
-                badOption(key, "must be true or false, got " + value.dump());
-            o.interior = value.get<bool>();
+            o.interior = booleanOption(key, value);
         } else {
             unparsedOption(info, key);
         }

@@ -537,13 +537,8 @@ Slice3dOptions parseSlice3dOptions(const nlohmann::json& options)
         } else if (key == "early_termination") {
             o.earlyTermination = earlyTerminationOption(value);
         } else if (key == "path") {
-            const std::string s = value.is_string() ? value.get<std::string>() : "";
-            if (s == "fused")
-                o.path = Slice3dOptions::Path::Fused;
-            else if (s == "raster")
-                o.path = Slice3dOptions::Path::Raster;
-            else
-                badOption(key, "must be \"fused\" or \"raster\", got " + value.dump());
+            o.path = choiceOption(key, value, {"fused", "raster"}) == 0 ? Slice3dOptions::Path::Fused
+                                                                          : Slice3dOptions::Path::Raster;
         } else if (key == "voxel_type") {
             const std::string s = value.is_string() ? value.get<std::string>() : "";
             if (s == "auto")
@@ -561,9 +556,7 @@ Slice3dOptions parseSlice3dOptions(const nlohmann::json& options)
             else
                 badOption(key, "must be \"sample\" or \"preintegrated\", got " + value.dump());
         } else if (key == "empty_space_skipping") {
-            if (!value.is_boolean())
-                badOption(key, "must be true or false, got " + value.dump());
-            o.emptySpaceSkipping = value.get<bool>();
+            o.emptySpaceSkipping = booleanOption(key, value);
         } else if (key == "clip") {
             o.clip = parseClip(value);
         } else if (key == "clip_texture") {
