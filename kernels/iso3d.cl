@@ -92,12 +92,8 @@ kernel void iso3d_fused(global float4* color, global float* depth, global uint* 
     /* The slices near the ray's chord through the grid (one more each way; every sample is still checked). */
     float zin, zout;
     clvr_box_chord(go, gd, grid.own_lo, grid.own_hi, &zin, &zout);
-    int k_lo = 0, k_hi = -1;
-    if (zin <= zout) {
-        const float n = (float)p.slice_count;
-        k_lo = (int)clamp(ceil((zin - depth0) / delta_s) - 1.0f, 0.0f, n);
-        k_hi = (int)clamp(floor((zout - depth0) / delta_s) + 1.0f, -1.0f, n - 1.0f);
-    }
+    int k_lo, k_hi;
+    clvr_slice_range(zin, zout, depth0, delta_s, p.slice_count, &k_lo, &k_hi);
     const float3 inv_gd = 1.0f / gd;  /* for empty-space runs only (inf where gd is 0, not used there) */
     float4 hit = (float4)(0.0f);
     float window = 1.0f;

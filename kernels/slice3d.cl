@@ -108,12 +108,8 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
     const ClvrOwnedGrid owned = {dims, offset, own_lo, own_hi};  /* for empty-space runs */
     float zin, zout;
     clvr_box_chord(go, gd, own_lo, own_hi, &zin, &zout);
-    int k_lo = 0, k_hi = -1;
-    if (zin <= zout) {
-        const float n = (float)p.slice_count;
-        k_lo = (int)clamp(ceil((zin - depth0) / delta_s) - 1.0f, 0.0f, n);
-        k_hi = (int)clamp(floor((zout - depth0) / delta_s) + 1.0f, -1.0f, n - 1.0f);
-    }
+    int k_lo, k_hi;
+    clvr_slice_range(zin, zout, depth0, delta_s, p.slice_count, &k_lo, &k_hi);
 
     float3 c = (float3)(0.0f);
     float alpha_acc = 0.0f;

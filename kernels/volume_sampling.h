@@ -35,6 +35,20 @@ void clvr_box_chord(const float3 go, const float3 gd, const float3 lo, const flo
     *zout = z1;
 }
 
+/* The slices k_lo..k_hi (of 0..count - 1, at eye depths depth0 + k delta_s) near the chord [zin, zout], one
+ * more each way; none (k_lo > k_hi) for an empty chord. Only bounds a loop: every sample is still checked. */
+void clvr_slice_range(const float zin, const float zout, const float depth0, const float delta_s, const int count,
+                      int* k_lo, int* k_hi)
+{
+    *k_lo = 0;
+    *k_hi = -1;
+    if (zin <= zout) {
+        const float n = (float)count;
+        *k_lo = (int)clamp(ceil((zin - depth0) / delta_s) - 1.0f, 0.0f, n);
+        *k_hi = (int)clamp(floor((zout - depth0) / delta_s) + 1.0f, -1.0f, n - 1.0f);
+    }
+}
+
 /* Sort-last parts (host/model/volume.h GridPart): 1 when full-grid coordinates g are this volume's to
  * sample (own_lo <= g < own_hi per axis; for the whole grid own_hi is the next float above n - 1, so
  * this is clvr_grid_inside's g <= n - 1). */
