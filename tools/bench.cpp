@@ -273,7 +273,7 @@ nlohmann::json benchMeshScene(Device& device, const fs::path& scenePath, const S
     const double compileMs = device.compileMs() - compile0;
 
     // harc's ceiling loop (tools/ceiling_harc.h) walks the same entry lists and cells; its frames alternate
-    // with clvr's, set beside the kernel's own pass ("harc: walk"), whose host entry stage it does not repeat.
+    // with clvr's, set beside the kernel's own pass (kHarcWalkPass), whose host entry stage it does not repeat.
     const bool isHarc = scene.technique == harcTechnique().name;
     const HarcOptions harcOptions = isHarc ? parseHarcOptions(scene.options) : HarcOptions{};
     std::unique_ptr<HarcCeiling> ceiling;
@@ -293,7 +293,7 @@ nlohmann::json benchMeshScene(Device& device, const fs::path& scenePath, const S
         ms.push_back(frame.wallMs);
         statsMs.push_back(frame.stats.frameMs);
         for (const PassTime& p : frame.stats.passes)
-            if (p.name == "harc: walk")
+            if (p.name == kHarcWalkPass)
                 walkMs.push_back(p.ms);
         stats = std::move(frame.stats);
         image = std::move(frame.image);

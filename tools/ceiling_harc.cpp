@@ -4,6 +4,7 @@
 #include "tools/ceiling_harc.h"
 
 #include "host/render/camera_args.h"
+#include "host/render/scaffold.h"
 #include "host/render/transfer_function_upload.h"
 #include "host/runtime/parallel.h"
 
@@ -38,18 +39,13 @@ HarcCeiling::HarcCeiling(const TetMesh& mesh, const TetTopology& topology, const
                          const Camera& camera, const ImageSpec& image, const HarcOptions& options)
     : width_(image.width), height_(image.height), background_(image.background), psi_(psiTable())
 {
-    // The renderer's frame: coordinates relative to the bounding box's centre (HarcRenderer's shift_).
-    glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi = -lo;
-    for (const glm::uvec4& t : mesh.tets)
-        for (int k = 0; k < 4; ++k) {
-            lo = glm::min(lo, mesh.points[t[k]]);
-            hi = glm::max(hi, mesh.points[t[k]]);
-        }
+    // The renderer's frame: coordinates relative to the centre of harc's box.
+    glm::dvec3 lo, hi;
+    harcBounds(mesh, lo, hi);
     const glm::dvec3 shift = 0.5 * (lo + hi);
     camera_ = toClCamera(camera, width_, height_, shift);
-    const double tets = static_cast<double>(mesh.tets.size());
-    const std::uint64_t steps = options.maxSteps ? options.maxSteps : static_cast<std::uint64_t>(4.0 * std::cbrt(tets)) + 10000;
-    maxSteps_ = static_cast<std::uint32_t>(std::min<std::uint64_t>(steps, 0xffffffffu));
+    maxSteps_ = static_cast<std::uint32_t>(std::min<std::uint64_t>(harcMaxSteps(options, MeshCounts::of(mesh).rendered),
+                                                                   0xffffffffu));
     ertAlpha_ = options.earlyTermination < 1.0 ? static_cast<float>(options.earlyTermination) : 2.0f;
 
     for (const cl_float4& v : packHarcTets(mesh, topology, shift))

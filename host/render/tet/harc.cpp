@@ -27,17 +27,6 @@ namespace clvr {
 namespace {
 
 
-void meshBounds(const TetMesh& mesh, glm::dvec3& lo, glm::dvec3& hi)
-{
-    lo = glm::dvec3(std::numeric_limits<double>::infinity());
-    hi = -lo;
-    for (const glm::uvec4& t : mesh.tets)
-        for (int k = 0; k < 4; ++k) {
-            lo = glm::min(lo, mesh.points[t[k]]);
-            hi = glm::max(hi, mesh.points[t[k]]);
-        }
-}
-
 class HarcRenderer final : public Renderer {
 public:
     HarcRenderer(Device& device, const Scene& scene, const TetMesh& mesh, const TetTopology& topology);
@@ -87,19 +76,13 @@ HarcRenderer::HarcRenderer(Device& device, const Scene& scene, const TetMesh& me
     // A part of a larger mesh (sort-last) computes in the full mesh's frame and integrates only inside
     // its box (host/model/mesh.h's MeshPart), so that the parts' images composite to the full one.
     glm::dvec3 lo, hi;
-    meshBounds(mesh, lo, hi);
-    if (mesh.part) {
-        lo = mesh.part->fullLo;
-        hi = mesh.part->fullHi;
-    }
+    harcBounds(mesh, lo, hi);
     shift_ = 0.5 * (lo + hi);
     camera_ = frameCamera(scene, lo, hi);
     part_ = mesh.part;
 
     counts_ = MeshCounts::of(mesh);
-    maxSteps_ = options_.maxSteps
-                    ? options_.maxSteps
-                    : static_cast<std::uint64_t>(4.0 * std::cbrt(static_cast<double>(counts_.rendered))) + 10000;
+    maxSteps_ = harcMaxSteps(options_, counts_.rendered);
 
     const std::vector<cl_float4> tets = packHarcTets(mesh, topology, shift_);
     tets_ = device_.upload("harc tetrahedra (80 bytes each)", tets);
@@ -210,7 +193,7 @@ Image4f HarcRenderer::render(FrameStats& stats)
     kernel_.setArg(a++, psi_);
     kernel_.setArg(a++, full_);
     kernel_.setArg(a++, params);
-    device_.launch("harc: walk", kernel_, image_.width, image_.height);
+    device_.launch(kHarcWalkPass, kernel_, image_.width, image_.height);
 
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
     Image4f image = readImage(device_, out_, image_.width, image_.height);
@@ -358,6 +341,29 @@ double longestTetEdge(const TetMesh& mesh)
                 longest2 = std::max(longest2, glm::dot(e, e));
             }
     return std::sqrt(longest2);
+}
+
+void harcBounds(const TetMesh& mesh, glm::dvec3& lo, glm::dvec3& hi)
+{
+    if (mesh.part) {
+        lo = mesh.part->fullLo;
+        hi = mesh.part->fullHi;
+        return;
+    }
+    lo = glm::dvec3(std::numeric_limits<double>::infinity());
+    hi = -lo;
+    for (const glm::uvec4& t : mesh.tets)
+        for (int k = 0; k < 4; ++k) {
+            lo = glm::min(lo, mesh.points[t[k]]);
+            hi = glm::max(hi, mesh.points[t[k]]);
+        }
+}
+
+std::uint64_t harcMaxSteps(const HarcOptions& options, std::uint64_t tets)
+{
+    if (options.maxSteps)
+        return options.maxSteps;
+    return static_cast<std::uint64_t>(4.0 * std::cbrt(static_cast<double>(tets))) + 10000;
 }
 
 std::vector<cl_float4> packHarcTets(const TetMesh& mesh, const TetTopology& topology, const glm::dvec3& shift)

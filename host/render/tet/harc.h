@@ -54,6 +54,17 @@ inline constexpr std::uint64_t kMaxFullTableBytes = std::uint64_t(256) << 20;
 // the full pre-integration table.
 double longestTetEdge(const TetMesh& mesh);
 
+// The box harc computes in: the bounding box of the mesh's tetrahedra, or for a part of a larger mesh
+// (sort-last, host/model/mesh.h MeshPart) the full mesh's, so that the parts' images composite to the full
+// one. Its centre is the origin the packed cells are relative to (packHarcTets' `shift`), for float precision.
+void harcBounds(const TetMesh& mesh, glm::dvec3& lo, glm::dvec3& hi);
+
+// Traversal steps per ray: options.maxSteps, or by default 4 cbrt(tets) + 10000 for `tets` tetrahedra.
+std::uint64_t harcMaxSteps(const HarcOptions& options, std::uint64_t tets);
+
+// The name of the walk kernel's launch in a frame's passes (FrameStats::passes; clvr bench's ceiling).
+inline constexpr const char* kHarcWalkPass = "harc: walk";
+
 // The device layout, 5 float4 = 80 bytes per tetrahedron (kernels/harc.cl describes it): three
 // barycentric planes (the fourth is 1 minus their sum), the gradient and scalar term of Eq. 6, and the
 // adjacency. Coordinates are relative to `shift` (the mesh's bounding-box center, for float precision).
