@@ -14,27 +14,6 @@
 #include "ray.h"
 #include "volume_sampling.h"
 
-/* Trilinear RGBA at grid coordinates g (checked inside by the caller), the four channels of each
- * grid point interleaved: the 3D texture of the paper's gradient shading, filtered as one texture. */
-float4 iso3d_trilinear4(global const float* v, const int4 dims, const float3 g)
-{
-    const int i = min((int)g.x, dims.x - 2);
-    const int j = min((int)g.y, dims.y - 2);
-    const int k = min((int)g.z, dims.z - 2);
-    const float fx = g.x - (float)i, fy = g.y - (float)j, fz = g.z - (float)k;
-    const uint nx = (uint)dims.x;
-    const uint nxy = nx * (uint)dims.y;
-    const uint p = (uint)k * nxy + (uint)j * nx + (uint)i;
-    const float4 c000 = vload4(p, v), c100 = vload4(p + 1u, v);
-    const float4 c010 = vload4(p + nx, v), c110 = vload4(p + nx + 1u, v);
-    const float4 c001 = vload4(p + nxy, v), c101 = vload4(p + nxy + 1u, v);
-    const float4 c011 = vload4(p + nxy + nx, v), c111 = vload4(p + nxy + nx + 1u, v);
-    const float4 c00 = c000 + fx * (c100 - c000), c10 = c010 + fx * (c110 - c010);
-    const float4 c01 = c001 + fx * (c101 - c001), c11 = c011 + fx * (c111 - c011);
-    const float4 c0 = c00 + fy * (c10 - c00), c1 = c01 + fy * (c11 - c01);
-    return c0 + fz * (c1 - c0);
-}
-
 /* The slices' fragment color for RGBA sample t at grid coordinates g of a grid with `dims` points and
  * value_map m (ClIso3dUniforms): (0.5 N + 0.5 interpolated, turned round with m.w != 0; or with m.z != 0
  * the point's 3D texture coordinates (g + 0.5) / n), and in alpha the value normalized to [0,1]. */
@@ -115,7 +94,7 @@ kernel void iso3d_fused(global float4* color, global float* depth, global uint* 
         /* The alpha test on the value alone (values: the scalar volume, the RGBA volume's fourth channel: the
          * same trilinear arithmetic on a quarter of the bytes); the whole RGBA sample only for the hit. */
         if ((clvr_trilinear(values, dims, g) - p.grid.value_map.x) * p.grid.value_map.y >= p.alpha_ref) {
-            const float4 c = iso3d_color(iso3d_trilinear4(volume, dims, g), g, dims, p.grid.value_map);
+            const float4 c = iso3d_color(clvr_trilinear4((global const float4*)volume, dims, g), g, dims, p.grid.value_map);
             /* glm's projection: NDC z in [-1, 1], window depth (ndc + 1) / 2. */
             const float n = p.slices.z, f = p.slices.w;
             const float ndc = clvr_ray_parallel(p.camera) ? (2.0f * z - f - n) / (f - n)
@@ -156,7 +135,7 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
     const float4 hi = u->brick_end;
     if (g.x < lo.x || g.y < lo.y || g.z < lo.z || g.x >= hi.x || g.y >= hi.y || g.z >= hi.z)
         return 0;
-    *color = iso3d_color(iso3d_trilinear4(r->buffer[0], convert_int4(u->brick_dims), g - lo), g, dims, u->value_map);
+    *color = iso3d_color(clvr_trilinear4((global const float4*)r->buffer[0], convert_int4(u->brick_dims), g - lo), g, dims, u->value_map);
     return 1;
 }
 

@@ -1,25 +1,10 @@
 /* kernels/reflectance_map.h — shading of volume samples on the device (§2.2-2.3 of
- * seeds/004_35d3c76e603b55b1.txt): trilinear reconstruction of the RGBA volume (gradient, value) and
- * the reflectance-map lookup. The map's layout and cube-face convention are host/optics/reflectance_map.h's:
- * 6 n^2 float4 entries (rgb = shade), entry 6 n^2 = the shade of a zero gradient. OpenCL C 1.2. */
+ * seeds/004_35d3c76e603b55b1.txt): the reflectance-map lookup of a sample's gradient (the RGBA volume
+ * (gradient, value) is reconstructed by volume_sampling.h's clvr_trilinear4). The map's layout and
+ * cube-face convention are host/optics/reflectance_map.h's: 6 n^2 float4 entries (rgb = shade), entry
+ * 6 n^2 = the shade of a zero gradient. OpenCL C 1.2. */
 #ifndef CLVR_REFLECTANCE_MAP_H
 #define CLVR_REFLECTANCE_MAP_H
-
-/* Trilinear (gx, gy, gz, value) at grid coordinates g inside [0, n-1] (checked or clamped by the caller);
- * lower corner clamped to n-2 as clvr_trilinear does. At most 2^32 - 1 grid points. */
-float4 clvr_trilinear4(global const float4* v, const int4 dims, const float3 g)
-{
-    const int i = min((int)g.x, dims.x - 2);
-    const int j = min((int)g.y, dims.y - 2);
-    const int k = min((int)g.z, dims.z - 2);
-    const float fx = g.x - (float)i, fy = g.y - (float)j, fz = g.z - (float)k;
-    const uint nx = (uint)dims.x;
-    const uint nxy = nx * (uint)dims.y;
-    global const float4* p = v + ((uint)k * nxy + (uint)j * nx + (uint)i);
-    const float4 c00 = mix(p[0], p[1], fx), c10 = mix(p[nx], p[nx + 1], fx);
-    const float4 c01 = mix(p[nxy], p[nxy + 1], fx), c11 = mix(p[nxy + nx], p[nxy + nx + 1], fx);
-    return mix(mix(c00, c10, fy), mix(c01, c11, fy), fz);
-}
 
 /* The map's shade of gradient grad seen along to_eye (unit): the normal turned to face the viewer
  * (two-sided), normalized by its largest component |N_a| (no square root needed: the patch depends only on

@@ -9,6 +9,8 @@
 #include "reflectance_map.h"
 #ifndef CLVR_STACK2D_FRAGMENT
 #include "raster.cl"
+#include "clvr_common.h"
+#include "empty_space.h"
 #endif
 
 /* One fragment of a stack quad (direct volume rendering; iso-surfaces below). attr[0] = (u, v, lower, weight): the 2D texture coordinates on the
@@ -85,30 +87,46 @@ static float4 stack2d_fetch(global const float* stack, const ClTexture slice, in
     return sample;
 }
 
-/* Iso-surface mode: (shaded color, value mapped to [0, 1] over the data range). */
-static float4 stack2d_iso_shade(constant ClStack2dUniforms* u, float4 sample)
+/* Iso-surface mode: (shaded color, value mapped to [0, 1] over the data range) of an RGBA sample (gradient,
+ * value); iso, surface, light as ClStack2dUniforms' fields of those names, to_eye towards the eye. */
+static float4 stack2d_surface(const float4 sample, const float4 iso, const float4 surface, const float4 light,
+                              const float3 to_eye)
 {
     float shade = 1.0f;
-    if (u->surface.w != 0.0f) {
+    if (surface.w != 0.0f) {
         const float len = length(sample.xyz);
         float3 n = len > 0.0f ? sample.xyz / len : (float3)(0.0f);
-        if (dot(n, u->to_eye.xyz) < 0.0f)
+        if (dot(n, to_eye) < 0.0f)
             n = -n;
-        shade = u->iso.z + u->iso.w * fmax(0.0f, dot(n, u->light.xyz));
+        shade = iso.z + iso.w * fmax(0.0f, dot(n, light.xyz));
     }
-    return (float4)(u->surface.xyz * shade, (sample.w - u->iso.x) * u->light.w);
+    return (float4)(surface.xyz * shade, (sample.w - iso.x) * light.w);
+}
+
+/* Direct volume rendering: (color, tau) of a sample, the color shaded by the reflectance map's shade of the
+ * sample's gradient (sample.xyz) when shaded != 0 (tau is not shaded). */
+static float4 stack2d_color_tau(global const float* tf, const int tf_count, global const float4* map, const int map_n,
+                                const int shaded, const float4 sample, const float3 to_eye)
+{
+    float4 ct = clvr_tf_eval(tf, tf_count, sample.w);
+    if (shaded)
+        ct.xyz *= clvr_reflectance(map, map_n, sample.xyz, to_eye);
+    return ct;
+}
+
+static float4 stack2d_iso_shade(constant ClStack2dUniforms* u, float4 sample)
+{
+    return stack2d_surface(sample, u->iso, u->surface, u->light, u->to_eye.xyz);
 }
 
 /* Direct volume rendering: the premultiplied color of a sample standing for a ray length delta. */
 static float4 stack2d_classify(const ClFragmentResources* r, float4 sample, float delta)
 {
     constant ClStack2dUniforms* u = (constant ClStack2dUniforms*)r->uniforms;
-    const float4 ct = clvr_tf_eval(r->buffer[1], (int)u->frame.z, sample.w);
+    const float4 ct = stack2d_color_tau(r->buffer[1], (int)u->frame.z, (global const float4*)r->buffer[2],
+                                        (int)u->shading.x, u->shading.y != 0.0f, sample, u->to_eye.xyz);
     const float alpha = 1.0f - exp(-ct.w * delta);
-    float3 c = ct.xyz;
-    if (u->shading.y != 0.0f)
-        c *= clvr_reflectance((global const float4*)r->buffer[2], (int)u->shading.x, sample.xyz, u->to_eye.xyz);
-    return (float4)(c * alpha, alpha);
+    return (float4)(ct.xyz * alpha, alpha);
 }
 
 int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* color)
@@ -200,3 +218,123 @@ kernel void stack2d_iso_finish(global float4* color, global const uchar* stencil
     const size_t i = get_global_id(0);
     color[i] = stencil[i] != 0 ? (float4)(color[i].xyz, 1.0f) : (float4)(p.background.xyz, 0.0f);
 }
+
+#ifndef CLVR_STACK2D_FRAGMENT
+
+/* The fused path (host/render/grid/stack2d.cpp, "path": "fused"): one work-item per pixel does what the
+ * quads of the drawn stack do at that pixel. In stack grid coordinates q = (b, c, axis) (to_stack), plane
+ * j of (n_axis - 1)(intermediate + 1) + 1 lies at q.z = j plane_step, and its sample is the trilinear value
+ * of the stack at the ray's point on it — exactly what a quad's fragment computes (bilinear in slice
+ * floor(q.z), lerped towards the next by the fraction), at the ray's point instead of the rasterizer's
+ * interpolated texture coordinates. A plane counts where that point lies in the box (the quad's
+ * coverage) and in front of the eye (eye depth > 0; the draws clip at their near plane). Its slab
+ * stands for Delta = thickness / cos = plane_step |d| / |q_d.z| of ray (half at the first and last plane,
+ * whose slabs end at the box faces). Front to back — the same sum as the draws' back-to-front blending up
+ * to rounding: c += T alpha C, T *= 1 - alpha, stopping once 1 - T >= ert_alpha; the pixel is
+ * c + T background, 1 - T. mode 1 (shaded): the stack holds (gradient, value) and C is shaded by the
+ * reflectance map; mode 2 (iso-surface): the first sample whose mapped value passes alpha_ref is the
+ * pixel, (its shade, 1), else (background, 0) — what the alpha test, the drawing order and
+ * stack2d_iso_finish leave. With clip textures, a clipped sample is skipped. With p.bricks.w != 0, runs of
+ * planes in bricks of the stack grid where nothing can show (kernels/empty_space.h; tau is 0, or all values
+ * lie below the iso-value) are stepped over: the pixel is the same bit for bit. samples[pixel]: planes
+ * met inside the box (taken or stepped over), skipped[pixel]: those stepped over. */
+kernel void stack2d_fused(global float4* out, global uint* samples, global uint* skipped, global const float* stack,
+                          global const float* tf, global const float4* map, global const uchar* space,
+#ifdef CLVR_STACK2D_CLIP_TEXTURE
+                          global const float* clip_texels,
+#endif
+                          const ClStack2dFusedParams p)
+{
+    CLVR_GUARD_2D(p.width, p.height);
+    const int x = (int)get_global_id(0), y = (int)get_global_id(1);
+    const size_t pixel = (size_t)y * (size_t)p.width + (size_t)x;
+    const float2 s = clvr_ray_window_offset(clvr_ray_pixel_centre(x, y), (float2)((float)p.width, (float)p.height),
+                                            p.camera);
+    float3 o, d;
+    clvr_ray_depth(s, p.camera, &o, &d); /* o + z d, z the eye depth (> 0: in front of the eye or image plane) */
+    const float4 r0 = p.to_stack[0], r1 = p.to_stack[1], r2 = p.to_stack[2];
+    const float3 qo = (float3)(dot(r0.xyz, o) + r0.w, dot(r1.xyz, o) + r1.w, dot(r2.xyz, o) + r2.w);
+    const float3 qd = (float3)(dot(r0.xyz, d), dot(r1.xyz, d), dot(r2.xyz, d));
+    const int mode = p.mode;
+    float3 c = (float3)(0.0f);
+    float transmittance = 1.0f;
+    float4 iso_hit = (float4)(p.background.xyz, 0.0f);
+    uint taken = 0, stepped_over = 0;
+    if (qd.z != 0.0f) { /* else the ray runs parallel to the planes: the quads are seen edge-on */
+        /* The ray parameterized by the plane coordinate u = q.z: q = q1o + u q1d (q1d.z = 1, q1o.z = 0), so
+         * that plane j's point is clvr_slice_point(q1o, q1d, 0, plane_step, j), the one expression the
+         * empty-space runs check. */
+        const float3 q1d = (float3)(qd.x / qd.z, qd.y / qd.z, 1.0f);
+        const float3 q1o = (float3)(qo.x - qo.z * q1d.x, qo.y - qo.z * q1d.y, 0.0f);
+        const float step = p.plane_step;
+        const int4 dims = p.dims;
+        /* The box in (b, c) as the quads cover it; along the axis every plane is inside by construction (the
+         * last one's j plane_step may round a hair above n - 1, which the trilinear clamp absorbs). */
+        const float3 own_lo = (float3)(0.0f, 0.0f, -INFINITY);
+        const float3 own_hi = (float3)(nextafter((float)(dims.x - 1), INFINITY), nextafter((float)(dims.y - 1), INFINITY),
+                                       INFINITY);
+        const ClvrOwnedGrid grid = {dims, (int4)(0), own_lo, own_hi};
+        float uin, uout;
+        clvr_box_chord(q1o, q1d, (float3)(0.0f), (float3)(own_hi.xy, (float)(dims.z - 1)), &uin, &uout);
+        int j_lo, j_hi;
+        clvr_slice_range(uin, uout, 0.0f, step, p.planes, &j_lo, &j_hi);
+        /* Front to back: along the ray u grows with the eye depth where qd.z > 0. */
+        const int dir = qd.z > 0.0f ? 1 : -1;
+        const int j_end = dir > 0 ? j_hi : j_lo;
+        const float neg_full_log2e = -step * length(d) / fabs(qd.z) * M_LOG2E_F;
+        const float3 inv_q1d = 1.0f / q1d; /* for empty-space runs only */
+#ifdef CLVR_STACK2D_CLIP_TEXTURE
+        const float4 k0 = p.clip_row[0], k1 = p.clip_row[1], k2 = p.clip_row[2];
+#endif
+        for (int j = dir > 0 ? j_lo : j_hi; dir * (j_end - j) >= 0; j += dir) {
+            const float3 q = clvr_slice_point(q1o, q1d, 0.0f, step, j);
+            if (!clvr_grid_owned(q, own_lo, own_hi))
+                continue;
+            /* behind the eye (or the image plane): eye depth (u - qo.z) / qd.z <= 0; front to back, these
+             * come first and no run of empty bricks starts there */
+            if (!((q.z - qo.z) * (float)dir > 0.0f))
+                continue;
+            if (p.bricks.w) {
+                const int4 b = clvr_brick(q, dims);
+                const int space_b = clvr_space(space, p.bricks, b);
+                if (space_b != 0) {
+                    const int run_end = clvr_empty_run(q1o, q1d, inv_q1d, 0.0f, step, j, dir, j_end, &grid, b,
+                                                       space_b - 1);
+                    stepped_over += (uint)(dir * (run_end - j) + 1);
+                    j = run_end;
+                    continue;
+                }
+            }
+            ++taken;
+#ifdef CLVR_STACK2D_CLIP_TEXTURE
+            {
+                const float3 w = o + ((q.z - qo.z) / qd.z) * d; /* the world point */
+                const float3 uc = (float3)(dot(k0.xyz, w) + k0.w, dot(k1.xyz, w) + k1.w, dot(k2.xyz, w) + k2.w);
+                if (!clvr_clip_keep(clip_texels, p.clip_tex, uc, p.clip_inverse))
+                    continue;
+            }
+#endif
+            const float4 sample = mode == 0 ? (float4)(clvr_trilinear(stack, dims, q)) : clvr_trilinear4((global const float4*)stack, dims, q);
+            if (mode == 2) {
+                const float4 shaded = stack2d_surface(sample, p.iso, p.surface, p.light, p.to_eye.xyz);
+                if (shaded.w >= p.alpha_ref) {
+                    iso_hit = (float4)(shaded.xyz, 1.0f);
+                    break;
+                }
+                continue;
+            }
+            const float4 ct = stack2d_color_tau(tf, p.tf_count, map, p.map_n, mode == 1, sample, p.to_eye.xyz);
+            const float slab = j == 0 || j == p.planes - 1 ? 0.5f : 1.0f; /* the end planes' slabs are half */
+            const float alpha = 1.0f - clvr_exp2(ct.w * (slab * neg_full_log2e));
+            c += (transmittance * alpha) * ct.xyz;
+            transmittance *= 1.0f - alpha;
+            if (1.0f - transmittance >= p.ert_alpha)
+                break;
+        }
+    }
+    out[pixel] = mode == 2 ? iso_hit : (float4)(c + transmittance * p.background.xyz, 1.0f - transmittance);
+    samples[pixel] = taken + stepped_over;
+    skipped[pixel] = stepped_over;
+}
+
+#endif

@@ -90,6 +90,24 @@ float clvr_trilinear(global const float* v, const int4 dims, const float3 g)
     return c0 + fz * (c1 - c0);
 }
 
+/* Trilinear RGBA at grid coordinates g inside [0, n-1] (checked or clamped by the caller), the four channels
+ * of a grid point together and filtered as one texture: the (gradient, value) volumes of planes and blend
+ * (seeds/004), iso3d's (normal, value) volume (seeds/000 §3), stack2d's RGBA stacks (seeds/003). Lower
+ * corner clamped to n-2 as clvr_trilinear does. At most 2^32 - 1 grid points. */
+float4 clvr_trilinear4(global const float4* v, const int4 dims, const float3 g)
+{
+    const int i = min((int)g.x, dims.x - 2);
+    const int j = min((int)g.y, dims.y - 2);
+    const int k = min((int)g.z, dims.z - 2);
+    const float fx = g.x - (float)i, fy = g.y - (float)j, fz = g.z - (float)k;
+    const uint nx = (uint)dims.x;
+    const uint nxy = nx * (uint)dims.y;
+    global const float4* p = v + ((uint)k * nxy + (uint)j * nx + (uint)i);
+    const float4 c00 = mix(p[0], p[1], fx), c10 = mix(p[nx], p[nx + 1], fx);
+    const float4 c01 = mix(p[nxy], p[nxy + 1], fx), c11 = mix(p[nxy + nx], p[nxy + nx + 1], fx);
+    return mix(mix(c00, c10, fy), mix(c01, c11, fy), fz);
+}
+
 /* The same for volumes stored in their native integer type (1 or 2 bytes per grid point): the
  * conversion of each grid value to float is exact, so the result equals clvr_trilinear on the same
  * values stored as float, bit for bit. */

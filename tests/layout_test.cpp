@@ -121,6 +121,7 @@ TEST(Layout, EveryParamsStructFitsTheKernelArgumentSpace)
         {"iso3d_finish", sizeof(ClIso3dFinishParams) + 2 * sizeof(void*)},
         {"iso3d_fused", sizeof(ClIso3dFusedParams) + 6 * sizeof(void*)},
         {"stack2d_iso_finish", sizeof(ClStack2dIsoFinishParams) + 2 * sizeof(void*)},
+        {"stack2d_fused", sizeof(ClStack2dFusedParams) + 8 * sizeof(void*)},
         {"pixel_transfer", sizeof(ClPixelTransferParams) + 2 * sizeof(void*)},
         {"draw_pixels", sizeof(ClDrawPixelsParams) + 4 * sizeof(void*)},
         {"pixel_texture", sizeof(ClPixelTextureParams) + 2 * sizeof(void*)},
@@ -145,6 +146,7 @@ TEST(Layout, EveryParamsStructFitsTheKernelArgumentSpace)
     EXPECT_EQ(sizeof(ClIso3dFinishParams), 48u);
     EXPECT_EQ(sizeof(ClIso3dFusedParams), 240u);
     EXPECT_EQ(sizeof(ClStack2dIsoFinishParams), 32u);
+    EXPECT_EQ(sizeof(ClStack2dFusedParams), 384u);
     EXPECT_EQ(sizeof(ClPixelTransfer), 128u);
     EXPECT_EQ(sizeof(ClPixelTransferParams), 144u);
     EXPECT_EQ(sizeof(ClDrawPixelsParams), 208u);

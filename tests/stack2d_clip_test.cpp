@@ -1,7 +1,7 @@
 // tests/stack2d_clip_test.cpp — stack2d clipped by a second "stencil" texture (seeds/003, "Clipping
 // with arbitrary clipping geometry"; host/optics/clip_texture.h, the same options.clip_texture as slice3d):
-// sphere (inside, inverse, moved by an offset) and box, both cameras, one slice per quad and three
-// slices per polygon, against the reference integral restricted to the clip intervals (as
+// sphere (inside, inverse, moved by an offset) and box, both cameras, the fused path and the raster path
+// with one slice per quad and three slices per polygon, against the reference integral restricted to the clip intervals (as
 // tests/clip_texture_test.cpp builds it); a clip texture holding the whole volume changes nothing;
 // clipped samples are no iso-surface hits; bad input gives slice3d's errors.
 #include "host/optics/clip_texture.h"
@@ -56,7 +56,9 @@ const Volume& marschnerLobb41()
 }
 
 constexpr int kIntermediate = 1;
+constexpr int kFused = 0;  // makeScene's slicesPerPolygon for the fused path
 
+// slicesPerPolygon k >= 1: the raster path, k slices per quad; kFused: the fused path.
 Scene makeScene(const Camera& camera, const json& clipTexture, int slicesPerPolygon)
 {
     Scene s;
@@ -65,7 +67,9 @@ Scene makeScene(const Camera& camera, const json& clipTexture, int slicesPerPoly
     s.camera = camera;
     s.image = ImageSpec{kSize, kSize, {0.1, 0.2, 0.3}};
     s.transferFunction = test::designTransferFunction(kTauMax);
-    s.options = {{"intermediate", kIntermediate}, {"slices_per_polygon", slicesPerPolygon}};
+    s.options = {{"intermediate", kIntermediate},
+                 {"slices_per_polygon", std::max(slicesPerPolygon, 1)},
+                 {"path", slicesPerPolygon == kFused ? "fused" : "raster"}};
     if (!clipTexture.is_null())
         s.options["clip_texture"] = clipTexture;
     return s;
@@ -168,7 +172,7 @@ TEST(Stack2dClip, SphereInverseAndOffsetMatchTheExactReference)
                           Case{"sphere_inverse_perspective", perspectiveCamera(), inverse, kSphere},
                           Case{"sphere_offset_parallel", parallelCamera(), moved, kSphere}}) {
         const Image4d want = shapeReference(makeScene(c.camera, c.clip, 1));
-        for (const int k : {1, 3}) {
+        for (const int k : {kFused, 1, 3}) {
             const Scene scene = makeScene(c.camera, c.clip, k);
             test::Tolerance tolerance = slabTolerance(scene, 4);
             tolerance.maxAbs = std::min(1.0, tolerance.maxAbs + term.maxAbs);
@@ -196,7 +200,7 @@ TEST(Stack2dClip, BoxAndInverseSphereMatchTheirTextureReference)
           std::tuple{"box_offset_perspective", perspectiveCamera(), box, kBox},
           std::tuple{"sphere_inverse_parallel", parallelCamera(), inverse, kSphere}}) {
         const Image4d want = textureReference(makeScene(camera, clip, 1));
-        for (const int k : {1, 3}) {
+        for (const int k : {kFused, 1, 3}) {
             const Scene scene = makeScene(camera, clip, k);
             const test::Tolerance tolerance = slabTolerance(scene, 4);
             check(scene, want, tolerance, std::string(name) + "_k" + std::to_string(k));
@@ -219,7 +223,7 @@ TEST(Stack2dClip, AClipTextureHoldingTheVolumeChangesNothing)
     json none = whole;
     none["inverse"] = true;
     for (const Camera& camera : {perspectiveCamera(), parallelCamera()})
-        for (const int k : {1, 3})
+        for (const int k : {kFused, 1, 3})
             for (const bool iso : {false, true}) {
                 Scene plain = makeScene(camera, json(), k);
                 if (iso)
@@ -258,7 +262,7 @@ TEST(Stack2dClip, MovingTheClipBetweenFramesGivesTheImageOfANewRenderer)
     const json sphere = {{"shape", "sphere"}, {"center", {0.1, -0.1, 0.2}}, {"radius", 0.55}};
     const glm::dvec3 offset(0.2, 0.1, -0.15);
     const glm::dmat3 matrix(glm::dvec3(1.0, 0.0, 0.0), glm::dvec3(0.1, 0.9, 0.0), glm::dvec3(0.0, 0.0, 1.1));
-    for (const int k : {1, 3}) {
+    for (const int k : {kFused, 1, 3}) {
         const Scene scene = makeScene(perspectiveCamera(), sphere, k);
         auto renderer = makeRenderer(test::device(), scene, marschnerLobb41());
         FrameStats stats;
@@ -296,7 +300,7 @@ TEST(Stack2dClip, ClippedSamplesAreNoIsoSurfaceHits)
     static const Volume sphere = generateVolume("sphere", {33, 33, 33});
     const json clip = {{"shape", "sphere"}, {"center", {0.0, 0.0, 0.0}}, {"radius", 0.3}};
     for (const Camera& camera : {perspectiveCamera(), parallelCamera()})
-        for (const int k : {1, 6}) {
+        for (const int k : {kFused, 1, 6}) {
             Scene scene = makeScene(camera, clip, k);
             scene.options["intermediate"] = 3;
             scene.transferFunction = TransferFunction();

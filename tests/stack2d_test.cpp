@@ -97,7 +97,7 @@ void expectInputError(const json& options, const std::string& fragment)
 
 TEST(Stack2dOptions, BadOptionsThrowInputErrorNamingTheKey)
 {
-    expectInputError({{"foo", 1}}, "options.foo: unknown option for stack2d (known: intermediate, reflectance_map_size, slices_per_polygon, clip_texture)");
+    expectInputError({{"foo", 1}}, "options.foo: unknown option for stack2d (known: intermediate, reflectance_map_size, slices_per_polygon, clip_texture, path, empty_space_skipping, early_termination)");
     expectInputError({{"slices_per_polygon", 0}}, "options.slices_per_polygon: must be an integer in [1, 64], got 0");
     expectInputError({{"slices_per_polygon", 65}}, "options.slices_per_polygon");
     EXPECT_EQ(parseStack2dOptions({{"slices_per_polygon", 4}}).slicesPerPolygon, 4);
@@ -184,16 +184,17 @@ struct Measured {
     double deltaMax = 0.0;  // the longest slab along any pixel's ray
 };
 
-Measured measure(const Camera& camera, int size, int intermediate)
+Measured measure(const Camera& camera, int size, int intermediate, const std::string& path)
 {
-    const Image4f image = test::renderScene(makeScene(camera, size, {{"intermediate", intermediate}}), marschnerLobb41());
+    const Image4f image =
+        test::renderScene(makeScene(camera, size, {{"intermediate", intermediate}, {"path", path}}), marschnerLobb41());
     Measured m;
     m.error = test::imageError(image, reference(camera, size));
     const double spacing = 2.0 / 40.0;
     m.deltaMax = spacing / (intermediate + 1) / minCos(camera, size, stackAxis(camera));
-    std::printf("[ measured ] %s, intermediate %d: max %.3g %.3g %.3g %.3g, mean %.2g %.2g %.2g %.2g, "
+    std::printf("[ measured ] %s, %s, intermediate %d: max %.3g %.3g %.3g %.3g, mean %.2g %.2g %.2g %.2g, "
                 "Delta_max %.4f\n",
-                camera.parallel ? "parallel" : "perspective", intermediate, m.error.maxAbs.r, m.error.maxAbs.g,
+                path.c_str(), camera.parallel ? "parallel" : "perspective", intermediate, m.error.maxAbs.r, m.error.maxAbs.g,
                 m.error.maxAbs.b, m.error.maxAbs.a, m.error.meanAbs.r, m.error.meanAbs.g, m.error.meanAbs.b,
                 m.error.meanAbs.a, m.deltaMax);
     return m;
@@ -202,20 +203,22 @@ Measured measure(const Camera& camera, int size, int intermediate)
 void expectErrorFallsWithIntermediateSlices(const Camera& camera)
 {
     const int size = 64;
+    for (const char* path : {"fused", "raster"}) {
     double previousMean = 1e30;
     for (const int intermediate : {0, 1, 3}) {
-        const Measured m = measure(camera, size, intermediate);
+        const Measured m = measure(camera, size, intermediate, path);
         EXPECT_EQ(m.error.nanCount, 0u);
         // Tolerance (docs/stack2d.md): a ray entering or leaving through a side face of the box (parallel
         // to the slices) gains or loses at most one slab's opacity there, max <= 2 (1 - exp(-tau_max
         // Delta_max)); the mean is first order in the slab, c tau_max Delta_max with c = 0.02 as slice3d's.
         const double maxTolerance = 2.0 * (1.0 - std::exp(-kTauMax * m.deltaMax));
         const double meanTolerance = 0.02 * kTauMax * m.deltaMax;
-        EXPECT_LE(maxChannel(m.error.maxAbs), maxTolerance) << "intermediate " << intermediate;
-        EXPECT_LE(maxChannel(m.error.meanAbs), meanTolerance) << "intermediate " << intermediate;
+        EXPECT_LE(maxChannel(m.error.maxAbs), maxTolerance) << path << ", intermediate " << intermediate;
+        EXPECT_LE(maxChannel(m.error.meanAbs), meanTolerance) << path << ", intermediate " << intermediate;
         // The artifact of plain stacks: the error falls as intermediate slices are added.
-        EXPECT_LT(maxChannel(m.error.meanAbs), previousMean) << "intermediate " << intermediate;
+        EXPECT_LT(maxChannel(m.error.meanAbs), previousMean) << path << ", intermediate " << intermediate;
         previousMean = maxChannel(m.error.meanAbs);
+    }
     }
 }
 
@@ -241,7 +244,8 @@ TEST(Stack2dRender, TwoRendersGiveIdenticalBits)
     EXPECT_EQ(std::memcmp(a.pixels().data(), b.pixels().data(), a.pixels().size() * sizeof(glm::vec4)), 0);
     EXPECT_EQ(std::memcmp(a.pixels().data(), c.pixels().data(), a.pixels().size() * sizeof(glm::vec4)), 0);
     EXPECT_EQ(stats.extra["slices"], 81);
-    EXPECT_EQ(renderer->residentBytes(), 3u * 41 * 41 * 41 * 4 + 4 * (4 + 8 * 3));
+    // three stacks, the transfer function, and the fused path's empty-space radii (one byte per brick of 4^3 cells)
+    EXPECT_EQ(renderer->residentBytes(), 3u * 41 * 41 * 41 * 4 + 4 * (4 + 8 * 3) + 10 * 10 * 10);
 }
 
 TEST(Stack2dRender, NewTransferFunctionGivesTheImageOfANewRenderer)
@@ -290,11 +294,13 @@ Image4d shadedReference(const Scene& scene)
 TEST(Stack2dShaded, MatchesShadedReferenceAndErrorFallsWithIntermediateSlices)
 {
     const int size = 40;
-    for (const Camera& camera : {perspectiveCamera(), parallelCamera()}) {
+    for (const Camera& camera : {perspectiveCamera(), parallelCamera()})
+        for (const char* path : {"fused", "raster"}) {
         double previousMean = 1e30;
         Scene first;
         for (const int intermediate : {0, 3}) {
-            const Scene scene = shadedScene(camera, {{"intermediate", intermediate}, {"reflectance_map_size", 256}});
+            const Scene scene =
+                shadedScene(camera, {{"intermediate", intermediate}, {"reflectance_map_size", 256}, {"path", path}});
             if (intermediate == 0)
                 first = scene;
             FrameStats stats;
@@ -303,19 +309,19 @@ TEST(Stack2dShaded, MatchesShadedReferenceAndErrorFallsWithIntermediateSlices)
             const Image4d expected = shadedReference(first);
             const test::ImageError e = test::imageError(image, expected);
             const double deltaMax = 2.0 / 32.0 / (intermediate + 1) / minCos(camera, size, stackAxis(camera));
-            std::printf("[ measured ] shaded %s, intermediate %d: max %.3g %.3g %.3g %.3g, mean %.2g %.2g %.2g %.2g, "
+            std::printf("[ measured ] shaded %s, %s, intermediate %d: max %.3g %.3g %.3g %.3g, mean %.2g %.2g %.2g %.2g, "
                         "Delta_max %.4f\n",
-                        camera.parallel ? "parallel" : "perspective", intermediate, e.maxAbs.r, e.maxAbs.g, e.maxAbs.b,
+                        path, camera.parallel ? "parallel" : "perspective", intermediate, e.maxAbs.r, e.maxAbs.g, e.maxAbs.b,
                         e.maxAbs.a, e.meanAbs.r, e.meanAbs.g, e.meanAbs.b, e.meanAbs.a, deltaMax);
             const double slab = 1.0 - std::exp(-6.0 * deltaMax);
             const double mapBound = reflectanceMapBound(scene.lighting, 256);
             EXPECT_TRUE(test::imagesNear(image, expected, {.maxAbs = 2.0 * 1.65 * slab + mapBound,
                                                            .meanAbs = 1.65 * 0.02 * 6.0 * deltaMax}))
-                << (camera.parallel ? "parallel" : "perspective") << ", intermediate " << intermediate;
+                << path << ", " << (camera.parallel ? "parallel" : "perspective") << ", intermediate " << intermediate;
             EXPECT_LT(maxChannel(e.meanAbs), previousMean);
             previousMean = maxChannel(e.meanAbs);
         }
-    }
+        }
 }
 
 TEST(Stack2dShaded, LightsChangeTheImage)
@@ -346,8 +352,9 @@ TEST(Stack2dIso, SphereSilhouetteAndShadeMatchTheAnalyticSurface)
 {
     const double r = 0.5, ambient = 0.15, diffuse = 0.8;
     const glm::dvec3 light = glm::normalize(glm::dvec3(0.4, 0.6, 1.0));
-    for (const Camera& camera : {perspectiveCamera(), parallelCamera()}) {
-        Scene scene = makeScene(camera, 48, {{"intermediate", 3}});
+    for (const Camera& camera : {perspectiveCamera(), parallelCamera()})
+        for (const char* path : {"fused", "raster"}) {
+        Scene scene = makeScene(camera, 48, {{"intermediate", 3}, {"path", path}});
         scene.transferFunction = TransferFunction();
         scene.iso = test::isoSpec(0.5, {0.4, 0.6, 1.0}, ambient, diffuse);
         FrameStats stats;
@@ -379,13 +386,13 @@ TEST(Stack2dIso, SphereSilhouetteAndShadeMatchTheAnalyticSurface)
                 }
             }
         meanShadeError /= std::max(inside, 1);
-        std::printf("[ measured ] iso %s: %d inner pixels, shade error max %.3g mean %.3g; %d outside\n",
-                    camera.parallel ? "parallel" : "perspective", inside, maxShadeError, meanShadeError, outside);
+        std::printf("[ measured ] iso %s, %s: %d inner pixels, shade error max %.3g mean %.3g; %d outside\n",
+                    path, camera.parallel ? "parallel" : "perspective", inside, maxShadeError, meanShadeError, outside);
         EXPECT_GT(inside, 50);
         EXPECT_GT(outside, 1000);
         EXPECT_LT(maxShadeError, 0.04);
         EXPECT_LT(meanShadeError, 0.01);
-    }
+        }
 }
 
 // ---- several slices per polygon (seeds/003's multi-texture speed-up) --------------------------------
@@ -459,8 +466,8 @@ TEST(Stack2dPolygons, SeveralSlicesPerPolygonGiveTheImageOfOneQuadPerSlice)
     for (const Camera& camera : {perspectiveCamera(), parallelCamera()})
         for (const int intermediate : {0, 1}) {
             FrameStats oneStats;
-            const Image4f one =
-                test::renderScene(makeScene(camera, size, {{"intermediate", intermediate}}), marschnerLobb41(), &oneStats);
+            const Image4f one = test::renderScene(makeScene(camera, size, {{"intermediate", intermediate}, {"path", "raster"}}),
+                                                  marschnerLobb41(), &oneStats);
             Image4d oned(size, size);
             for (std::size_t i = 0; i < one.pixelCount(); ++i)
                 oned.pixels()[i] = glm::dvec4(one.pixels()[i]);
@@ -502,7 +509,7 @@ TEST(Stack2dPolygons, SeveralSlicesPerPolygonGiveTheImageOfOneQuadPerSlice)
 TEST(Stack2dPolygons, ShadedAndIsoSurfacesWithSeveralSlicesPerPolygon)
 {
     for (const Camera& camera : {perspectiveCamera(), parallelCamera()}) {
-        const Image4f a = test::renderScene(shadedScene(camera, {{"intermediate", 1}}), sphere33());
+        const Image4f a = test::renderScene(shadedScene(camera, {{"intermediate", 1}, {"path", "raster"}}), sphere33());
         const Image4f b = test::renderScene(shadedScene(camera, {{"intermediate", 1}, {"slices_per_polygon", 4}}), sphere33());
         Image4d ad(a.width(), a.height());
         for (std::size_t i = 0; i < a.pixelCount(); ++i)
@@ -513,7 +520,7 @@ TEST(Stack2dPolygons, ShadedAndIsoSurfacesWithSeveralSlicesPerPolygon)
         EXPECT_LE(maxChannel(e.maxAbs), 0.05);
         EXPECT_LE(maxChannel(e.meanAbs), 3e-4);
 
-        Scene iso = makeScene(camera, 48, {{"intermediate", 3}});
+        Scene iso = makeScene(camera, 48, {{"intermediate", 3}, {"path", "raster"}});
         iso.transferFunction = TransferFunction();
         iso.iso = test::isoSpec(0.5, {0.4, 0.6, 1.0}, 0.15, 0.8);
         const Image4f isoOne = test::renderScene(iso, sphere33());
@@ -539,6 +546,189 @@ TEST(Stack2dPolygons, ShadedAndIsoSurfacesWithSeveralSlicesPerPolygon)
         EXPECT_LE(shadeMax, 0.04);
         EXPECT_LE(shadeMean, 2e-3);
     }
+}
+
+// ---- the fused path (kernels/stack2d.cl stack2d_fused) ------------------------------------------------
+
+// In the box [-1, 1]^3, looking past the center: the planes on both sides of the eye, the near ones clipped.
+Camera insideCamera()
+{
+    Camera c;
+    c.position = {0.35, 0.45, 0.55};
+    c.focalPoint = {0.0, -0.1, 0.0};
+    c.viewAngle = 70.0;
+    return c;
+}
+
+struct PathDifference {
+    double maxAbs = 0.0, meanAbs = 0.0;  // largest channel, over all pixels
+    int differing = 0;                   // pixels with a channel differing by more than 1e-3
+    std::uint64_t fusedSamples = 0, rasterFragments = 0;
+};
+
+// The fused path's image against the raster path's for the same scene.
+PathDifference comparePaths(Scene scene, const Volume& volume)
+{
+    scene.options["path"] = "fused";
+    FrameStats fusedStats, rasterStats;
+    const Image4f fused = test::renderScene(scene, volume, &fusedStats);
+    scene.options["path"] = "raster";
+    const Image4f raster = test::renderScene(scene, volume, &rasterStats);
+    EXPECT_EQ(fusedStats.extra["path"], "fused");
+    EXPECT_EQ(rasterStats.extra["path"], "raster");
+    PathDifference d;
+    for (std::size_t i = 0; i < fused.pixelCount(); ++i) {
+        const double e = maxChannel(glm::abs(glm::dvec4(fused.pixels()[i]) - glm::dvec4(raster.pixels()[i])));
+        d.maxAbs = std::max(d.maxAbs, e);
+        d.meanAbs += e;
+        d.differing += e > 1e-3;
+    }
+    d.meanAbs /= static_cast<double>(fused.pixelCount());
+    d.fusedSamples = fusedStats.samples;
+    d.rasterFragments = rasterStats.samples;
+    return d;
+}
+
+const char* cameraName(const Camera& camera)
+{
+    return camera.parallel ? "parallel" : (camera.position.x < 1.0 ? "inside" : "perspective");
+}
+
+// The fused kernel samples the same planes as the quads, at the ray's point on each instead of the
+// rasterizer's interpolated texture coordinates of vertices snapped to 1/256 pixel (docs/raster.md), and
+// a pixel whose center lies within that snapping of a quad's edge can be covered on one path and not on
+// the other: that plane's slab, at most `slab` (1 - exp(-tau_max Delta_max), times the largest color),
+// on a few pixels along the box's silhouette. Everywhere else the two are equal up to rounding and the
+// snapping's sample offsets (< 1e-3 per pixel, 1.6e-5 on the mean at most as measured). Bounds: max one
+// slab; at most 2 % of the pixels over 1e-3; the mean at most those pixels' slabs spread over the image,
+// plus 5e-5.
+void expectPathsAgree(const PathDifference& d, double slab, int pixels, const std::string& what)
+{
+    EXPECT_LE(d.maxAbs, slab) << what;
+    EXPECT_LE(d.differing, pixels / 50) << what;
+    EXPECT_LE(d.meanAbs, d.differing * slab / pixels + 5e-5) << what;
+}
+
+// Measured (64x64, Marschner–Lobb 41^3): 5-29 pixels over 1e-3 outside, max 0.056-0.30 (one slab at
+// the silhouette), mean 3.8e-5-1.5e-4; the camera inside the box: 0-1 pixels, max 1.1e-3.
+TEST(Stack2dFused, EqualsTheQuadsOfTheRasterPath)
+{
+    const int size = 64;
+    for (const Camera& camera : {perspectiveCamera(), parallelCamera(), insideCamera()})
+        for (const int intermediate : {0, 1, 3}) {
+            const PathDifference d = comparePaths(makeScene(camera, size, {{"intermediate", intermediate}}), marschnerLobb41());
+            const double deltaMax = 2.0 / 40.0 / (intermediate + 1) / minCos(camera, size, stackAxis(camera));
+            std::printf("[ measured ] fused vs raster, %s, intermediate %d: max %.3g, mean %.3g, %d pixels over 1e-3; "
+                        "samples %llu, fragments %llu\n",
+                        cameraName(camera), intermediate, d.maxAbs, d.meanAbs, d.differing,
+                        static_cast<unsigned long long>(d.fusedSamples), static_cast<unsigned long long>(d.rasterFragments));
+            expectPathsAgree(d, 1.0 - std::exp(-kTauMax * deltaMax), size * size,
+                             std::string(cameraName(camera)) + ", intermediate " + std::to_string(intermediate));
+        }
+}
+
+// The same for shaded volumes (the RGBA stacks, the reflectance map; a slab's color is at most 1.65
+// alpha, tau_max 6, as in Stack2dShaded) and for iso-surfaces (the first sample at or above the iso-value,
+// as the alpha test and the drawing order keep it; a pixel can differ where a sample lies within the
+// snapping's offset of the iso-value). Measured: shaded 0-4 pixels over 1e-3, max 2.8e-3; iso 1-3
+// pixels, max 0.093, mean 1.4e-5-6.9e-5.
+TEST(Stack2dFused, ShadedAndIsoSurfacesEqualTheRasterPath)
+{
+    for (const Camera& camera : {perspectiveCamera(), parallelCamera(), insideCamera()}) {
+        const PathDifference shaded = comparePaths(shadedScene(camera, {{"intermediate", 1}}), sphere33());
+        std::printf("[ measured ] fused vs raster, shaded %s: max %.3g, mean %.3g, %d pixels over 1e-3\n",
+                    cameraName(camera), shaded.maxAbs, shaded.meanAbs, shaded.differing);
+        const double deltaMax = 2.0 / 32.0 / 2.0 / minCos(camera, 40, stackAxis(camera));
+        expectPathsAgree(shaded, 1.65 * (1.0 - std::exp(-6.0 * deltaMax)), 40 * 40, std::string("shaded, ") + cameraName(camera));
+
+        Scene iso = makeScene(camera, 48, {{"intermediate", 3}});
+        iso.transferFunction = TransferFunction();
+        iso.iso = test::isoSpec(0.5, {0.4, 0.6, 1.0}, 0.15, 0.8);
+        const PathDifference surface = comparePaths(iso, sphere33());
+        std::printf("[ measured ] fused vs raster, iso %s: max %.3g, mean %.3g, %d pixels over 1e-3; samples %llu, "
+                    "fragments %llu\n",
+                    cameraName(camera), surface.maxAbs, surface.meanAbs, surface.differing,
+                    static_cast<unsigned long long>(surface.fusedSamples),
+                    static_cast<unsigned long long>(surface.rasterFragments));
+        EXPECT_LE(surface.differing, 48 * 48 / 200) << cameraName(camera);
+        EXPECT_LE(surface.meanAbs, 2e-3) << cameraName(camera);
+        // the fused kernel stops at the first hit
+        EXPECT_LT(surface.fusedSamples, surface.rasterFragments) << cameraName(camera);
+    }
+}
+
+// Empty-space skipping steps over bricks where tau is 0 (or, for iso-surfaces, where every value lies below
+// the iso-value): the same image bit for bit, with samples stepped over. A transfer function that is 0 on
+// the lower half of Marschner–Lobb's range leaves bricks empty.
+TEST(Stack2dFused, EmptySpaceSkippingLeavesTheSameBits)
+{
+    for (const Camera& camera : {perspectiveCamera(), parallelCamera(), insideCamera()})
+        for (const bool iso : {false, true}) {
+            Scene on = makeScene(camera, 48, {{"intermediate", 1}});
+            on.transferFunction = TransferFunction({{0.0, {0, 0, 0}, 0.0}, {0.55, {0.2, 0.5, 0.9}, 0.0},
+                                                    {0.7, {1.0, 0.8, 0.3}, 6.0}, {1.0, {1, 1, 1}, 2.0}});
+            if (iso) {
+                on.transferFunction = TransferFunction();
+                on.iso = test::isoSpec(0.75, {0.4, 0.6, 1.0}, 0.15, 0.8);
+            }
+            Scene off = on;
+            off.options["empty_space_skipping"] = false;
+            FrameStats son, soff;
+            const Image4f a = test::renderScene(on, marschnerLobb41(), &son);
+            const Image4f b = test::renderScene(off, marschnerLobb41(), &soff);
+            EXPECT_TRUE(son.extra["empty_space_skipping"].get<bool>());
+            EXPECT_FALSE(soff.extra["empty_space_skipping"].get<bool>());
+            EXPECT_EQ(std::memcmp(a.pixels().data(), b.pixels().data(), a.pixels().size() * sizeof(glm::vec4)), 0)
+                << cameraName(camera) << (iso ? ", iso" : "");
+            const auto skipped = son.extra["skipped"].get<std::uint64_t>();
+            std::printf("[ measured ] skipping, %s%s: %llu empty bricks, %llu of %llu samples stepped over\n",
+                        cameraName(camera), iso ? ", iso" : "",
+                        static_cast<unsigned long long>(son.extra["empty_bricks"].get<std::uint64_t>()),
+                        static_cast<unsigned long long>(skipped), static_cast<unsigned long long>(son.samples));
+            EXPECT_GT(skipped, son.samples / 20);
+            EXPECT_EQ(soff.extra["skipped"].get<std::uint64_t>(), 0u);
+            if (!iso) {  // both count every plane met in the box (iso-surfaces stop at the hit, earlier with skipping)
+                EXPECT_EQ(son.samples, soff.samples);
+            }
+        }
+}
+
+// Early ray termination at opacity a: a pixel stops once 1 - T >= a, so what it leaves out is at most
+// T <= 1 - a of every channel (the background is weighted by T as well).
+TEST(Stack2dFused, EarlyTerminationLeavesOutAtMostTheRemainingTransmittance)
+{
+    Scene scene = makeScene(perspectiveCamera(), 64, {{"intermediate", 1}, {"empty_space_skipping", false}});
+    scene.transferFunction = test::designTransferFunction(40.0);  // dense: many rays become opaque
+    FrameStats full, early;
+    const Image4f a = test::renderScene(scene, marschnerLobb41(), &full);
+    scene.options["early_termination"] = 0.95;
+    const Image4f b = test::renderScene(scene, marschnerLobb41(), &early);
+    double maxDiff = 0.0;
+    for (std::size_t i = 0; i < a.pixelCount(); ++i)
+        maxDiff = std::max(maxDiff, maxChannel(glm::abs(glm::dvec4(a.pixels()[i]) - glm::dvec4(b.pixels()[i]))));
+    std::printf("[ measured ] early termination 0.95: max difference %.3g, samples %llu -> %llu\n", maxDiff,
+                static_cast<unsigned long long>(full.samples), static_cast<unsigned long long>(early.samples));
+    EXPECT_LE(maxDiff, 0.05 + 1e-6);
+    EXPECT_GT(maxDiff, 0.0);
+    EXPECT_LT(early.samples, full.samples * 9 / 10);
+}
+
+// "path" and the options that only one path has.
+TEST(Stack2dFused, PathOptions)
+{
+    EXPECT_EQ(parseStack2dOptions(json::object()).path, Stack2dOptions::Path::Fused);
+    EXPECT_EQ(parseStack2dOptions({{"path", "raster"}}).path, Stack2dOptions::Path::Raster);
+    EXPECT_EQ(parseStack2dOptions({{"slices_per_polygon", 2}}).path, Stack2dOptions::Path::Raster);
+    expectInputError({{"path", "gpu"}}, "options.path: must be \"fused\" or \"raster\", got \"gpu\"");
+    expectInputError({{"path", "fused"}, {"slices_per_polygon", 2}},
+                     "options.path: \"fused\" does not work with slices_per_polygon > 1");
+    expectInputError({{"path", "raster"}, {"early_termination", 0.9}},
+                     "options.early_termination: is only available on the fused path");
+    expectInputError({{"empty_space_skipping", 1}}, "options.empty_space_skipping: must be true or false");
+    FrameStats stats;
+    test::renderScene(makeScene(perspectiveCamera(), 16, {{"slices_per_polygon", 3}}), marschnerLobb41(), &stats);
+    EXPECT_EQ(stats.extra["path"], "raster");
+    EXPECT_EQ(stats.extra["polygons"], 14);  // 41 planes, 3 per quad
 }
 
 }  // namespace

@@ -1,7 +1,10 @@
-// host/render/grid/stack2d.cpp — options, stack choice, slice planning and the pass-by-pass rendering of
-// the stack2d technique: one raster::draw of all quads of the chosen stack, back to front, with
-// kernels/stack2d.cl as fragment program, then the background pass of slice3d.
+// host/render/grid/stack2d.cpp — options, stack choice, slice planning and the rendering of the stack2d
+// technique: pass by pass, one raster::draw of all quads of the chosen stack, back to front, with
+// kernels/stack2d.cl as fragment program, then the background pass of slice3d; or fused, the same
+// planes stepped through per pixel by kernels/stack2d.cl's stack2d_fused.
 #include "host/render/grid/stack2d.h"
+
+#include "host/render/grid/slice3d.h"  // buildBrickGrid, emptyBricks, emptySpaceRadii: slice3d's bricks
 
 #include "host/render/scaffold.h"
 #include "host/runtime/embedded_kernels.h"
@@ -26,6 +29,7 @@
 namespace clvr {
 
 static_assert(sizeof(ClStack2dIsoFinishParams) == 32, "also probed on the device by tests/layout_test.cpp");
+static_assert(sizeof(ClStack2dFusedParams) == 384, "also probed on the device by tests/layout_test.cpp");
 
 namespace {
 
@@ -77,6 +81,9 @@ public:
 
 private:
     void setClipCoordinateUniforms();
+    void setUpFused(const Volume& volume, const TransferFunction& tf);
+    std::uint64_t renderFused(std::uint64_t& steppedOver);
+    raster::DrawStats drawQuads();
 
     Device& device_;
     Stack2dOptions options_;
@@ -112,6 +119,13 @@ private:
     ClStack2dUniforms uniforms_{};  // fragmentProgram_.uniforms, by field
     OverBackground overBackground_;
     cl::Kernel isoFinish_;
+    // The fused path: its kernel, samples per pixel (planes met in the box, and of them stepped over), and
+    // the empty-space radii of the bricks of the drawn stack's grid (kernels/empty_space.h), kept with the
+    // bricks' min-max for a new transfer function.
+    cl::Kernel fused_;
+    cl::Buffer fusedSamples_, fusedSkipped_, space_, noMap_;
+    BrickGrid brickGrid_;
+    std::uint64_t emptyBrickCount_ = 0;
 };
 
 Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volume& volume)
@@ -243,6 +257,38 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
     u.frame.s[2] = static_cast<float>(scene.transferFunction.points().size());
     fragmentProgram_.uniforms = fragmentUniforms(u);
     fragmentProgram_.buffers[1] = tf_.buffer();
+    if (options_.path == Stack2dOptions::Path::Fused)
+        setUpFused(volume, scene.transferFunction);
+}
+
+// The fused path's bricks: slice3d's, over the drawn stack's grid (b, c, axis), which is the volume with its
+// axes renamed; empty where tau is 0 over the brick's values (direct volume rendering) or where they all
+// lie below the iso-value by more than float rounding in the trilinear interpolation could make up.
+void Stack2dRenderer::setUpFused(const Volume& volume, const TransferFunction& tf)
+{
+    const StackShape s = stackShape(axis_);
+    Volume stackGrid;
+    stackGrid.dims = glm::ivec3(dims_[s.b], dims_[s.c], dims_[axis_]);
+    stackGrid.values = stackTexels(volume.values.data(), dims_, 1, axis_);
+    brickGrid_ = buildBrickGrid(stackGrid);
+    std::vector<cl_uchar> empty;
+    if (iso_) {
+        const double margin = 1e-5 * std::max({std::abs(iso_->dataMin), std::abs(iso_->dataMax), std::abs(iso_->value)});
+        empty.resize(brickGrid_.minMax.size());
+        for (std::size_t b = 0; b < empty.size(); ++b)
+            empty[b] = static_cast<double>(brickGrid_.minMax[b].y) + margin < iso_->value ? 1 : 0;
+    } else {
+        empty = emptyBricks(brickGrid_, tf);
+    }
+    emptyBrickCount_ = static_cast<std::uint64_t>(std::count(empty.begin(), empty.end(), cl_uchar(1)));
+    space_ = device_.upload("stack2d empty-space radii", emptySpaceRadii(brickGrid_.dims, empty));
+    residentBytes_ += empty.size();
+    if (!map_())  // the kernel takes a reflectance map argument in every mode
+        noMap_ = device_.upload("stack2d no reflectance map", std::vector<glm::vec4>(1));
+    fused_ = device_.kernel("stack2d.cl", "stack2d_fused", {}, clipTexture_ ? "-DCLVR_STACK2D_CLIP_TEXTURE=1" : "");
+    const std::size_t pixels = framebuffer_->pixelCount();
+    fusedSamples_ = device_.buffer("stack2d fused samples per pixel", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
+    fusedSkipped_ = device_.buffer("stack2d fused skipped samples per pixel", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
 }
 
 // The uniforms' clip_row: the rows of world -> clip-texture coordinates (the several-slices path maps
@@ -280,11 +326,138 @@ void Stack2dRenderer::setTransferFunction(const TransferFunction& tf)
         uniforms_.surface = toCl4(iso_->color, uniforms_.surface.s[3]);
     }
     fragmentProgram_.uniforms = fragmentUniforms(uniforms_);
+    if (options_.path == Stack2dOptions::Path::Fused && !iso_) {
+        // Which bricks are empty depends on the transfer function: classify the kept min-max again.
+        const std::vector<cl_uchar> empty = emptyBricks(brickGrid_, tf);
+        const std::vector<cl_uchar> radii = emptySpaceRadii(brickGrid_.dims, empty);
+        emptyBrickCount_ = static_cast<std::uint64_t>(std::count(empty.begin(), empty.end(), cl_uchar(1)));
+        device_.queue().enqueueWriteBuffer(space_, CL_TRUE, 0, radii.size(), radii.data());
+    }
 }
 
 Image4f Stack2dRenderer::render(FrameStats& stats)
 {
     const FrameClock clock;
+    const bool fused = options_.path == Stack2dOptions::Path::Fused;
+    std::uint64_t samples = 0, steppedOver = 0;
+    raster::DrawStats drawStats;
+    if (fused) {
+        samples = renderFused(steppedOver);
+    } else {
+        drawStats = drawQuads();
+        // One sample per fragment of a quad; with several slices per polygon at most `count` per fragment
+        // (fewer where the enlarged quad covers pixels outside some of its slices): an upper bound.
+        samples = drawStats.fragments;
+        if (options_.slicesPerPolygon > 1)
+            samples = static_cast<std::uint64_t>(static_cast<double>(drawStats.fragments) * grouped_.slices.size() /
+                                                 std::max<std::size_t>(grouped_.groups.size(), 1));
+    }
+    Image4f image = framebuffer_->readColor(device_);
+    finishFrame(device_, clock, stats);
+    stats.samples = samples;
+    stats.extra["path"] = fused ? "fused" : "raster";
+    stats.extra["axis"] = kAxisNames[axis_];
+    stats.extra["slices"] = slices_.size();
+    stats.extra["intermediate"] = options_.intermediate;
+    stats.extra["slices_per_polygon"] = options_.slicesPerPolygon;
+    stats.extra["shaded"] = lighting_.shaded();
+    stats.extra["iso"] = iso_.has_value();
+    stats.extra["reflectance_map_size"] = options_.reflectanceMapSize;
+    stats.extra["voxels"] = static_cast<std::uint64_t>(dims_.x) * dims_.y * dims_.z;
+    stats.extra["resident_bytes"] = residentBytes_;
+    if (fused) {
+        stats.extra["empty_space_skipping"] = options_.emptySpaceSkipping && emptyBrickCount_ > 0;
+        stats.extra["empty_bricks"] = emptyBrickCount_;
+        stats.extra["skipped"] = steppedOver;
+        stats.extra["early_termination"] = options_.earlyTermination;
+    } else {
+        stats.extra["polygons"] = options_.slicesPerPolygon > 1 ? grouped_.groups.size() : slices_.size();
+        stats.extra["fragments"] = drawStats.fragments;
+        stats.extra["triangles"] = drawStats.triangles;
+    }
+    if (clipTexture_) {
+        const glm::ivec3 n = clipTexture_->dims();
+        stats.extra["clip_texture"] = clipTexture_->source;
+        stats.extra["clip_texture_dims"] = {n.x, n.y, n.z};
+        stats.extra["clip_texture_inverse"] = options_.clipTexture->inverse;
+    }
+    return image;
+}
+
+// The fused path: stack2d_fused leaves the finished image (over the background) in the frame buffer's
+// color. Returns the samples (planes met in the box), with those stepped over in `steppedOver`.
+std::uint64_t Stack2dRenderer::renderFused(std::uint64_t& steppedOver)
+{
+    const StackShape s = stackShape(axis_);
+    ClStack2dFusedParams p{};
+    p.camera = toClCamera(camera_, image_.width, image_.height);
+    const int stackAxes[3] = {s.b, s.c, axis_};
+    for (int r = 0; r < 3; ++r) {  // q_r = (p[a] - origin[a]) / spacing[a] for a = stackAxes[r]
+        const int a = stackAxes[r];
+        p.to_stack[r].s[a] = static_cast<float>(1.0 / spacing_[a]);
+        p.to_stack[r].s[3] = static_cast<float>(-origin_[a] / spacing_[a]);
+    }
+    p.to_eye = uniforms_.to_eye;
+    p.background = toCl4(glm::dvec3(image_.background), 0.0);
+    p.iso = uniforms_.iso;
+    p.surface = uniforms_.surface;
+    p.light = uniforms_.light;
+    p.dims = cl_int4{{dims_[s.b], dims_[s.c], dims_[axis_], 0}};
+    const bool skip = options_.emptySpaceSkipping && emptyBrickCount_ > 0;
+    p.bricks = cl_int4{{brickGrid_.dims.x, brickGrid_.dims.y, brickGrid_.dims.z, skip ? 1 : 0}};
+    p.width = image_.width;
+    p.height = image_.height;
+    p.tf_count = static_cast<cl_int>(uniforms_.frame.s[2]);
+    p.planes = static_cast<cl_int>(slices_.size());
+    p.plane_step = static_cast<float>(1.0 / (options_.intermediate + 1));
+    p.ert_alpha = options_.earlyTermination < 1.0 ? static_cast<float>(options_.earlyTermination) : 2.0f;
+    if (iso_) {
+        // The draws' alpha test GEQUAL the mapped iso-value (NEVER above the data).
+        const double range = iso_->dataMax > iso_->dataMin ? iso_->dataMax - iso_->dataMin : 1.0;
+        p.alpha_ref = iso_->value > iso_->dataMax
+                          ? std::numeric_limits<float>::infinity()
+                          : static_cast<float>(std::clamp((iso_->value - iso_->dataMin) / range, 0.0, 1.0));
+    }
+    p.mode = iso_ ? 2 : (lighting_.shaded() ? 1 : 0);
+    p.map_n = options_.reflectanceMapSize;
+    if (clipTexture_) {
+        for (int r = 0; r < 3; ++r)
+            p.clip_row[r] = uniforms_.clip_row[r];
+        const glm::ivec3 n = clipTexture_->dims();
+        p.clip_tex.width = static_cast<cl_uint>(n.x);
+        p.clip_tex.height = static_cast<cl_uint>(n.y);
+        p.clip_tex.depth = static_cast<cl_uint>(n.z);
+        p.clip_tex.channels = 1;
+        p.clip_tex.filter = CLVR_FILTER_LINEAR;
+        p.clip_tex.wrap = CLVR_WRAP_CLAMP_TO_EDGE;
+        p.clip_inverse = options_.clipTexture->inverse ? 1 : 0;
+    }
+    int a = 0;
+    fused_.setArg(a++, framebuffer_->color());
+    fused_.setArg(a++, fusedSamples_);
+    fused_.setArg(a++, fusedSkipped_);
+    fused_.setArg(a++, stacks_[axis_].buffer());
+    fused_.setArg(a++, tf_.buffer());
+    fused_.setArg(a++, map_() ? map_ : noMap_);
+    fused_.setArg(a++, space_);
+    if (clipTexture_)
+        fused_.setArg(a++, sliceTable_);  // one slice per quad: the table is empty, the texels start at 0
+    fused_.setArg(a++, p);
+    device_.launch("stack2d: fused planes", fused_, image_.width, image_.height);
+    const std::size_t pixels = framebuffer_->pixelCount();
+    std::uint64_t samples = 0;
+    steppedOver = 0;
+    for (const cl_uint n : device_.download<cl_uint>(fusedSamples_, pixels))
+        samples += n;
+    for (const cl_uint n : device_.download<cl_uint>(fusedSkipped_, pixels))
+        steppedOver += n;
+    return samples;
+}
+
+// The raster path: every quad of the drawn stack in one raster::draw, then the background (or the iso-surface's
+// last pass); the image is left in the frame buffer's color.
+raster::DrawStats Stack2dRenderer::drawQuads()
+{
     // Near and far planes around the box's eye-depth range; depth is not tested, so only the near
     // plane matters: it removes what lies behind the camera (perspective) or in front of its image
     // plane (parallel: depth 0, as the reference integral counts the ray from there).
@@ -399,34 +572,7 @@ Image4f Stack2dRenderer::render(FrameStats& stats)
     } else {
         overBackground_.run(framebuffer_->color(), pixels, image_.background, "stack2d: over background");
     }
-    Image4f image = framebuffer_->readColor(device_);
-    finishFrame(device_, clock, stats);
-    // One sample per fragment of a quad; with several slices per polygon at most `count` per fragment
-    // (fewer where the enlarged quad covers pixels outside some of its slices): an upper bound.
-    std::uint64_t samples = drawStats.fragments;
-    if (options_.slicesPerPolygon > 1)
-        samples = static_cast<std::uint64_t>(static_cast<double>(drawStats.fragments) * grouped_.slices.size() /
-                                             std::max<std::size_t>(grouped_.groups.size(), 1));
-    stats.samples = samples;
-    stats.extra["axis"] = kAxisNames[axis_];
-    stats.extra["slices"] = slices_.size();
-    stats.extra["intermediate"] = options_.intermediate;
-    stats.extra["slices_per_polygon"] = options_.slicesPerPolygon;
-    stats.extra["polygons"] = options_.slicesPerPolygon > 1 ? grouped_.groups.size() : slices_.size();
-    stats.extra["fragments"] = drawStats.fragments;
-    stats.extra["shaded"] = lighting_.shaded();
-    stats.extra["iso"] = iso_.has_value();
-    stats.extra["reflectance_map_size"] = options_.reflectanceMapSize;
-    stats.extra["triangles"] = drawStats.triangles;
-    stats.extra["voxels"] = static_cast<std::uint64_t>(dims_.x) * dims_.y * dims_.z;
-    stats.extra["resident_bytes"] = residentBytes_;
-    if (clipTexture_) {
-        const glm::ivec3 n = clipTexture_->dims();
-        stats.extra["clip_texture"] = clipTexture_->source;
-        stats.extra["clip_texture_dims"] = {n.x, n.y, n.z};
-        stats.extra["clip_texture_inverse"] = options_.clipTexture->inverse;
-    }
-    return image;
+    return drawStats;
 }
 
 }  // namespace
@@ -440,8 +586,12 @@ TechniqueInfo stack2dTechnique()
     t.options = {
         {"intermediate", 0, "", "slices interpolated between two neighbouring stack slices"},
         reflectanceMapSizeInfo(),
-        {"slices_per_polygon", 1, "", "stack slices one quad stands for (seeds/003's multi-texture speed-up)"},
+        {"slices_per_polygon", 1, "", "stack slices one quad stands for (seeds/003's multi-texture speed-up; raster path)"},
         clipTextureInfo(),
+        {"path", "fused", "", "\"fused\" (each pixel steps through the planes in one kernel) or \"raster\" (the quads "
+                              "through the raster stage); slices_per_polygon > 1 takes \"raster\""},
+        {"empty_space_skipping", true, "", "fused path: step over bricks where nothing can show (same image)"},
+        earlyTerminationInfo(1.0),
     };
     t.makeForVolume = makeStack2dRenderer;
     return t;
@@ -460,9 +610,25 @@ Stack2dOptions parseStack2dOptions(const nlohmann::json& options)
             o.slicesPerPolygon = integerOption(key, value, 1, kMaxSlicesPerPolygon);
         else if (key == "clip_texture")
             o.clipTexture = parseClipTextureSpec(value, "options.clip_texture");
+        else if (key == "path")
+            o.path = choiceOption(key, value, {"fused", "raster"}) == 0 ? Stack2dOptions::Path::Fused
+                                                                       : Stack2dOptions::Path::Raster;
+        else if (key == "empty_space_skipping")
+            o.emptySpaceSkipping = booleanOption(key, value);
+        else if (key == "early_termination")
+            o.earlyTermination = earlyTerminationOption(value);
         else
             unparsedOption(info, key);
     });
+    // Several slices per polygon is the raster path's speed-up (one quad for several planes).
+    if (o.slicesPerPolygon > 1) {
+        if (options.contains("path") && o.path == Stack2dOptions::Path::Fused)
+            badOption("path", "\"fused\" does not work with slices_per_polygon > 1 (the raster path's quads do it): "
+                              "give \"path\": \"raster\" or leave path out");
+        o.path = Stack2dOptions::Path::Raster;
+    }
+    if (o.earlyTermination < 1.0 && o.path == Stack2dOptions::Path::Raster)
+        badOption("early_termination", "is only available on the fused path (the blending stage cannot stop a pixel)");
     return o;
 }
 

@@ -7,7 +7,9 @@
 // slices lerp the bilinear samples of both (the paper's multi-texture combiner), so their sampling is
 // trilinear. With options.clip_texture (slice3d's, host/optics/clip_texture.h), a second "stencil" texture
 // drops the samples it calls clipped (seeds/003's clipping with arbitrary clipping geometry). Pass by
-// pass through raster::draw with kernels/stack2d.cl as fragment program.
+// pass through raster::draw with kernels/stack2d.cl as fragment program ("path": "raster"), or by the
+// fused kernel stack2d_fused of the same file, which steps each pixel's ray through the same planes
+// ("path": "fused", the default).
 // docs/stack2d.md.
 #pragma once
 
@@ -24,6 +26,14 @@
 namespace clvr {
 
 struct Stack2dOptions {
+    // Raster: the quads through raster::draw (the paper's passes, the specification). Fused: each pixel's
+    // ray steps through the same planes in one kernel (kernels/stack2d.cl stack2d_fused; the same image up
+    // to rounding and the draws' vertex snapping). Several slices per polygon are raster-path work (chosen
+    // when given without a path).
+    enum class Path { Fused, Raster };
+    Path path = Path::Fused;
+    bool emptySpaceSkipping = true;  // fused path: step over bricks where nothing can show (same image)
+    double earlyTermination = 1.0;   // fused path: stop a ray once its opacity reaches this (1: off)
     int intermediate = 0;  // slices interpolated between two neighbouring stack slices (0: the stack itself)
     int reflectanceMapSize = 128;  // shaded ("lights" in the scene): n, 6 n^2 shades (host/optics/reflectance_map.h)
     int slicesPerPolygon = 1;      // slices one quad stands for (seeds/003's multi-texture speed-up)
