@@ -33,7 +33,7 @@ std::vector<std::string> benchSuiteScenes(const std::string& suite)
         regular.push_back(std::string("reg-iso3d-") + volume + "-bricked.json");
         if (std::string(volume) == "engine")
             regular.push_back("reg-iso3d-engine-gradientless.json");
-        for (const char* suffix : {"", "-k1", "-k1-p4"})
+        for (const char* suffix : {"", "-k1", "-k1-raster", "-k1-p4"})
             regular.push_back(std::string("reg-stack2d-") + volume + suffix + ".json");
         if (std::string(volume) == "engine")
             regular.push_back("reg-stack2d-engine-k1-cliptex.json");

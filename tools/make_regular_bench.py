@@ -16,7 +16,8 @@ Per volume:
                          stencil locking the first hit (seeds/000 §3.1)
   reg-stack2d-V          stack2d, plain bilinear slices of the stack (seeds/003)
   reg-stack2d-V-k1       stack2d, one lerped intermediate slice between stack slices (trilinear again)
-  reg-stack2d-V-k1-p4    the same with four slices per polygon (seeds/003's multi-texture speed-up)
+  reg-stack2d-V-k1-raster  the same through the raster stage: the quads (the fused path's baseline)
+  reg-stack2d-V-k1-p4    the same with four slices per polygon (seeds/003's multi-texture speed-up; raster)
   reg-stack2d-engine-k1-cliptex  (engine only) reg-stack2d-engine-k1 clipped by the clip texture below
   reg-slice3d-raster-V   slice3d through the raster stage, 256 slices: the baseline of the clip rows
   reg-clip-V             the same with a sphere clip mesh, two-pass stencil (seeds/000 §2.1)
@@ -87,6 +88,8 @@ def scenes():
             out.append(("reg-iso3d-engine-gradientless.json", iso_scene(volume, "gradientless")))
         out.append(("reg-stack2d-%s.json" % volume, translucent_scene(volume, "stack2d", {"intermediate": 0})))
         out.append(("reg-stack2d-%s-k1.json" % volume, translucent_scene(volume, "stack2d", {"intermediate": 1})))
+        out.append(("reg-stack2d-%s-k1-raster.json" % volume,
+                    translucent_scene(volume, "stack2d", {"intermediate": 1, "path": "raster"})))
         out.append(("reg-stack2d-%s-k1-p4.json" % volume,
                     translucent_scene(volume, "stack2d", {"intermediate": 1, "slices_per_polygon": 4})))
         if volume == "engine":
