@@ -28,4 +28,31 @@ float clvr_exp2(const float x)
     return p * as_float(((int)n + 127) << 23);
 }
 
+/* atan2(y, x) in (-pi, pi], the angle of (x, y): a = min(|x|, |y|) / max(|x|, |y|) in [0, 1], atan(a) =
+ * a P(a^2) with P of degree 8 (fitted here: relative error 1.5e-8 in exact arithmetic, 1.3e-7 evaluated in
+ * float on [0, 1]), then pi/2 - r where |y| > |x|, pi - r where x < 0, the sign of y. Absolute error below
+ * 5e-7 (tests/device_test.cpp against the host's atan2); atan2(±0, 0) = ±0. PoCL's atan2 and acos took 57 %
+ * of spherical's fused per-sample time on this CPU. */
+float clvr_atan2(const float y, const float x)
+{
+    const float ax = fabs(x), ay = fabs(y);
+    const float hi = fmax(ax, ay), lo = fmin(ax, ay);
+    const float a = hi > 0.0f ? lo / hi : 0.0f;
+    const float s = a * a;
+    float r = 2.8501858469098806e-3f;
+    r = r * s - 1.6069890931248665e-2f;
+    r = r * s + 4.269373044371605e-2f;
+    r = r * s - 7.504499703645706e-2f;
+    r = r * s + 1.064104288816452e-1f;
+    r = r * s - 1.4203676581382751e-1f;
+    r = r * s + 1.999262422323227e-1f;
+    r = r * s - 3.3333075046539307e-1f;
+    r = (r * s + 1.0f) * a;
+    if (ay > ax)
+        r = 1.5707963267948966f - r;
+    if (x < 0.0f)
+        r = 3.14159265358979323846f - r;
+    return copysign(r, y);
+}
+
 #endif

@@ -37,3 +37,10 @@ kernel void exp2_values(global float* out, global const float* x, const uint n)
     CLVR_GUARD_1D(n);
     out[get_global_id(0)] = clvr_exp2(x[get_global_id(0)]);
 }
+
+/* out[i] = clvr_atan2(y[i], x[i]) (tests/device_test.cpp against the host's atan2). */
+kernel void atan2_values(global float* out, global const float* y, global const float* x, const uint n)
+{
+    CLVR_GUARD_1D(n);
+    out[get_global_id(0)] = clvr_atan2(y[get_global_id(0)], x[get_global_id(0)]);
+}

@@ -117,6 +117,7 @@ TEST(Layout, EveryParamsStructFitsTheKernelArgumentSpace)
         {"blend_render", sizeof(ClBlendParams) + 6 * sizeof(void*)},
         {"harc_render", sizeof(ClHarcParams) + 8 * sizeof(void*)},
         {"spherical_shell", sizeof(ClSphericalParams) + 5 * sizeof(void*)},
+        {"spherical_fused", sizeof(ClSphericalFusedParams) + 5 * sizeof(void*)},
         {"slice3d_over_background", sizeof(ClSlice3dOverBackgroundParams) + 1 * sizeof(void*)},
         {"iso3d_finish", sizeof(ClIso3dFinishParams) + 2 * sizeof(void*)},
         {"iso3d_fused", sizeof(ClIso3dFusedParams) + 6 * sizeof(void*)},
@@ -140,6 +141,7 @@ TEST(Layout, EveryParamsStructFitsTheKernelArgumentSpace)
     EXPECT_EQ(sizeof(ClBlendParams), 256u);
     EXPECT_EQ(sizeof(ClHarcParams), 192u);
     EXPECT_EQ(sizeof(ClSphericalParams), 192u);
+    EXPECT_EQ(sizeof(ClSphericalFusedParams), 288u);
     EXPECT_EQ(sizeof(ClSlice3dOverBackgroundParams), 32u);
     EXPECT_EQ(sizeof(ClTetsliceCompositeParams), 112u);
     EXPECT_EQ(sizeof(ClTetisoParams), 32u);

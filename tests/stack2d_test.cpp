@@ -204,21 +204,21 @@ void expectErrorFallsWithIntermediateSlices(const Camera& camera)
 {
     const int size = 64;
     for (const char* path : {"fused", "raster"}) {
-    double previousMean = 1e30;
-    for (const int intermediate : {0, 1, 3}) {
-        const Measured m = measure(camera, size, intermediate, path);
-        EXPECT_EQ(m.error.nanCount, 0u);
-        // Tolerance (docs/stack2d.md): a ray entering or leaving through a side face of the box (parallel
-        // to the slices) gains or loses at most one slab's opacity there, max <= 2 (1 - exp(-tau_max
-        // Delta_max)); the mean is first order in the slab, c tau_max Delta_max with c = 0.02 as slice3d's.
-        const double maxTolerance = 2.0 * (1.0 - std::exp(-kTauMax * m.deltaMax));
-        const double meanTolerance = 0.02 * kTauMax * m.deltaMax;
-        EXPECT_LE(maxChannel(m.error.maxAbs), maxTolerance) << path << ", intermediate " << intermediate;
-        EXPECT_LE(maxChannel(m.error.meanAbs), meanTolerance) << path << ", intermediate " << intermediate;
-        // The artifact of plain stacks: the error falls as intermediate slices are added.
-        EXPECT_LT(maxChannel(m.error.meanAbs), previousMean) << path << ", intermediate " << intermediate;
-        previousMean = maxChannel(m.error.meanAbs);
-    }
+        double previousMean = 1e30;
+        for (const int intermediate : {0, 1, 3}) {
+            const Measured m = measure(camera, size, intermediate, path);
+            EXPECT_EQ(m.error.nanCount, 0u);
+            // Tolerance (docs/stack2d.md): a ray entering or leaving through a side face of the box (parallel
+            // to the slices) gains or loses at most one slab's opacity there, max <= 2 (1 - exp(-tau_max
+            // Delta_max)); the mean is first order in the slab, c tau_max Delta_max with c = 0.02 as slice3d's.
+            const double maxTolerance = 2.0 * (1.0 - std::exp(-kTauMax * m.deltaMax));
+            const double meanTolerance = 0.02 * kTauMax * m.deltaMax;
+            EXPECT_LE(maxChannel(m.error.maxAbs), maxTolerance) << path << ", intermediate " << intermediate;
+            EXPECT_LE(maxChannel(m.error.meanAbs), meanTolerance) << path << ", intermediate " << intermediate;
+            // The artifact of plain stacks: the error falls as intermediate slices are added.
+            EXPECT_LT(maxChannel(m.error.meanAbs), previousMean) << path << ", intermediate " << intermediate;
+            previousMean = maxChannel(m.error.meanAbs);
+        }
     }
 }
 
@@ -296,31 +296,31 @@ TEST(Stack2dShaded, MatchesShadedReferenceAndErrorFallsWithIntermediateSlices)
     const int size = 40;
     for (const Camera& camera : {perspectiveCamera(), parallelCamera()})
         for (const char* path : {"fused", "raster"}) {
-        double previousMean = 1e30;
-        Scene first;
-        for (const int intermediate : {0, 3}) {
-            const Scene scene =
-                shadedScene(camera, {{"intermediate", intermediate}, {"reflectance_map_size", 256}, {"path", path}});
-            if (intermediate == 0)
-                first = scene;
-            FrameStats stats;
-            const Image4f image = test::renderScene(scene, sphere33(), &stats);
-            EXPECT_EQ(stats.extra["shaded"], true);
-            const Image4d expected = shadedReference(first);
-            const test::ImageError e = test::imageError(image, expected);
-            const double deltaMax = 2.0 / 32.0 / (intermediate + 1) / minCos(camera, size, stackAxis(camera));
-            std::printf("[ measured ] shaded %s, %s, intermediate %d: max %.3g %.3g %.3g %.3g, mean %.2g %.2g %.2g %.2g, "
-                        "Delta_max %.4f\n",
-                        path, camera.parallel ? "parallel" : "perspective", intermediate, e.maxAbs.r, e.maxAbs.g, e.maxAbs.b,
-                        e.maxAbs.a, e.meanAbs.r, e.meanAbs.g, e.meanAbs.b, e.meanAbs.a, deltaMax);
-            const double slab = 1.0 - std::exp(-6.0 * deltaMax);
-            const double mapBound = reflectanceMapBound(scene.lighting, 256);
-            EXPECT_TRUE(test::imagesNear(image, expected, {.maxAbs = 2.0 * 1.65 * slab + mapBound,
-                                                           .meanAbs = 1.65 * 0.02 * 6.0 * deltaMax}))
-                << path << ", " << (camera.parallel ? "parallel" : "perspective") << ", intermediate " << intermediate;
-            EXPECT_LT(maxChannel(e.meanAbs), previousMean);
-            previousMean = maxChannel(e.meanAbs);
-        }
+            double previousMean = 1e30;
+            Scene first;
+            for (const int intermediate : {0, 3}) {
+                const Scene scene =
+                    shadedScene(camera, {{"intermediate", intermediate}, {"reflectance_map_size", 256}, {"path", path}});
+                if (intermediate == 0)
+                    first = scene;
+                FrameStats stats;
+                const Image4f image = test::renderScene(scene, sphere33(), &stats);
+                EXPECT_EQ(stats.extra["shaded"], true);
+                const Image4d expected = shadedReference(first);
+                const test::ImageError e = test::imageError(image, expected);
+                const double deltaMax = 2.0 / 32.0 / (intermediate + 1) / minCos(camera, size, stackAxis(camera));
+                std::printf("[ measured ] shaded %s, %s, intermediate %d: max %.3g %.3g %.3g %.3g, mean %.2g %.2g %.2g %.2g, "
+                            "Delta_max %.4f\n",
+                            path, camera.parallel ? "parallel" : "perspective", intermediate, e.maxAbs.r, e.maxAbs.g, e.maxAbs.b,
+                            e.maxAbs.a, e.meanAbs.r, e.meanAbs.g, e.meanAbs.b, e.meanAbs.a, deltaMax);
+                const double slab = 1.0 - std::exp(-6.0 * deltaMax);
+                const double mapBound = reflectanceMapBound(scene.lighting, 256);
+                EXPECT_TRUE(test::imagesNear(image, expected, {.maxAbs = 2.0 * 1.65 * slab + mapBound,
+                                                               .meanAbs = 1.65 * 0.02 * 6.0 * deltaMax}))
+                    << path << ", " << (camera.parallel ? "parallel" : "perspective") << ", intermediate " << intermediate;
+                EXPECT_LT(maxChannel(e.meanAbs), previousMean);
+                previousMean = maxChannel(e.meanAbs);
+            }
         }
 }
 
@@ -354,44 +354,44 @@ TEST(Stack2dIso, SphereSilhouetteAndShadeMatchTheAnalyticSurface)
     const glm::dvec3 light = glm::normalize(glm::dvec3(0.4, 0.6, 1.0));
     for (const Camera& camera : {perspectiveCamera(), parallelCamera()})
         for (const char* path : {"fused", "raster"}) {
-        Scene scene = makeScene(camera, 48, {{"intermediate", 3}, {"path", path}});
-        scene.transferFunction = TransferFunction();
-        scene.iso = test::isoSpec(0.5, {0.4, 0.6, 1.0}, ambient, diffuse);
-        FrameStats stats;
-        const Image4f image = test::renderScene(scene, sphere33(), &stats);
-        EXPECT_EQ(stats.extra["iso"], true);
-        int inside = 0, outside = 0;
-        double maxShadeError = 0.0, meanShadeError = 0.0;
-        for (int y = 0; y < 48; ++y)
-            for (int x = 0; x < 48; ++x) {
-                const glm::vec4 p = image.pixels()[static_cast<std::size_t>(y) * 48 + x];
-                const Ray ray = camera.ray(x, y, 48, 48);
-                const double tc = -glm::dot(ray.origin, ray.direction);  // closest approach to the center
-                const double d = glm::length(ray.origin + tc * ray.direction);
-                if (d > r + 0.03) {
-                    ++outside;
-                    EXPECT_EQ(p.a, 0.0f) << x << ", " << y;
-                    EXPECT_NEAR(p.b, 0.3, 1e-6) << x << ", " << y;
-                } else if (d < r - 0.03) {
-                    ASSERT_EQ(p.a, 1.0f) << x << ", " << y;
-                    if (d > 0.35)
-                        continue;  // near the silhouette the slab offset moves the normal most
-                    ++inside;
-                    const glm::dvec3 hit = ray.origin + (tc - std::sqrt(r * r - d * d)) * ray.direction;
-                    const double shade = ambient + diffuse * std::max(0.0, glm::dot(glm::normalize(hit), light));
-                    const double e = std::abs(p.r - shade);
-                    maxShadeError = std::max(maxShadeError, e);
-                    meanShadeError += e;
-                    EXPECT_EQ(p.r, p.b);  // white surface
+            Scene scene = makeScene(camera, 48    , {{"intermediate", 3}, {"path", path}});
+            scene.transferFunction = TransferFunction();
+            scene.iso = test::isoSpec(0.5, {0.4, 0.6, 1.0}, ambient, diffuse);
+            FrameStats stats;
+            const Image4f image = test::renderScene(scene, sphere33(), &stats);
+            EXPECT_EQ(stats.extra["iso"], true);
+            int inside = 0, outside = 0;
+            double maxShadeError = 0.0, meanShadeError = 0.0;
+            for (int y = 0; y < 48; ++y)
+                for (int x = 0; x < 48; ++x) {
+                    const glm::vec4 p = image.pixels()[static_cast<std::size_t>(y) * 48 + x];
+                    const Ray ray = camera.ray(x, y, 48, 48);
+                    const double tc = -glm::dot(ray.origin, ray.direction);  // closest approach to the center
+                    const double d = glm::length(ray.origin + tc * ray.direction);
+                    if (d > r + 0.03) {
+                        ++outside;
+                        EXPECT_EQ(p.a, 0.0f) << x << ", " << y;
+                        EXPECT_NEAR(p.b, 0.3, 1e-6) << x << ", " << y;
+                    } else if (d < r - 0.03) {
+                        ASSERT_EQ(p.a, 1.0f) << x << ", " << y;
+                        if (d > 0.35)
+                            continue;  // near the silhouette the slab offset moves the normal most
+                        ++inside;
+                        const glm::dvec3 hit = ray.origin + (tc - std::sqrt(r * r - d * d)) * ray.direction;
+                        const double shade = ambient + diffuse * std::max(0.0, glm::dot(glm::normalize(hit), light));
+                        const double e = std::abs(p.r - shade);
+                        maxShadeError = std::max(maxShadeError, e);
+                        meanShadeError += e;
+                        EXPECT_EQ(p.r, p.b);  // white surface
+                    }
                 }
-            }
-        meanShadeError /= std::max(inside, 1);
-        std::printf("[ measured ] iso %s, %s: %d inner pixels, shade error max %.3g mean %.3g; %d outside\n",
-                    path, camera.parallel ? "parallel" : "perspective", inside, maxShadeError, meanShadeError, outside);
-        EXPECT_GT(inside, 50);
-        EXPECT_GT(outside, 1000);
-        EXPECT_LT(maxShadeError, 0.04);
-        EXPECT_LT(meanShadeError, 0.01);
+            meanShadeError /= std::max(inside, 1);
+            std::printf("[ measured ] iso %s, %s: %d inner pixels, shade error max %.3g mean %.3g; %d outside\n",
+                        path, camera.parallel ? "parallel" : "perspective", inside, maxShadeError, meanShadeError, outside);
+            EXPECT_GT(inside, 50);
+            EXPECT_GT(outside, 1000);
+            EXPECT_LT(maxShadeError, 0.04);
+            EXPECT_LT(meanShadeError, 0.01);
         }
 }
 

@@ -17,6 +17,9 @@
 #include <string>
 
 namespace clvr {
+
+static_assert(sizeof(ClSphericalFusedParams) == 288, "also probed on the device by tests/layout_test.cpp");
+
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
@@ -75,6 +78,9 @@ TechniqueInfo sphericalTechnique()
         {"scale", {1, 1, 1, 1}, "", "pixel transfer scale, after the color matrix"},
         {"bias", {0, 0, 0, 0}, "", "pixel transfer bias, after the scale"},
         {"opacity", "path", "", "a shell's opacity from \"path\" (the ray's length in its slab) or \"radial\""},
+        {"path", "fused", "", "\"fused\" (each pixel meets the exact spheres in one kernel) or \"raster\" (the "
+                              "tessellated shells pass by pass)"},
+        earlyTerminationInfo(1.0),
     };
     t.makeForVolume = makeSphericalRenderer;
     return t;
@@ -118,10 +124,17 @@ SphericalOptions parseSphericalOptions(const nlohmann::json& options)
                 o.opacity = SphericalOptions::Opacity::Radial;
             else
                 badOption(key, "must be \"path\" or \"radial\", got " + value.dump());
+        } else if (key == "path") {
+            o.path = choiceOption(key, value, {"fused", "raster"}) == 0 ? SphericalOptions::Path::Fused
+                                                                       : SphericalOptions::Path::Raster;
+        } else if (key == "early_termination") {
+            o.earlyTermination = earlyTerminationOption(value);
         } else {
             unparsedOption(info, key);
         }
     });
+    if (o.earlyTermination < 1.0 && o.path == SphericalOptions::Path::Raster)
+        badOption("early_termination", "is only available on the fused path (the blending stage cannot stop a pixel)");
     if (!(o.domain.rMax > o.domain.rMin))
         badOption("r_max", "must be greater than r_min (" + std::to_string(o.domain.rMin) + "), got " +
                                std::to_string(o.domain.rMax));
@@ -246,6 +259,56 @@ SphericalRenderer::SphericalRenderer(Device& device, const Scene& scene, const V
     const double nearZ = camera_.parallel ? 0.0 : (dMin > 0.0 ? 0.5 * dMin : 1e-4 * std::max(dMax, 1e-30));
     const double farZ = 2.0 * std::max(dMax, 0.0) + 1.0;
     viewProjection_ = camera_.projectionMatrix(imageSpec_.width, imageSpec_.height, nearZ, farZ) * camera_.viewMatrix();
+
+    if (options_.path == SphericalOptions::Path::Fused) {
+        std::vector<glm::vec4> table;
+        for (const Shell& shell : shells_)
+            table.emplace_back(glm::dvec4(shell.radius, shell.rLo, shell.rHi, (shell.radius - d.rMin) / (d.rMax - d.rMin)));
+        shellTable_ = device_.upload("spherical shell table", table);
+        residentBytes_ += table.size() * sizeof(glm::vec4);
+        fused_ = device_.kernel("spherical.cl", "spherical_fused");
+        fusedSamples_ = device_.buffer("spherical fused samples per pixel",
+                                       static_cast<std::size_t>(imageSpec_.width) * imageSpec_.height * sizeof(cl_uint),
+                                       CL_MEM_WRITE_ONLY);
+    }
+}
+
+// The fused path: spherical_fused leaves the finished image (over the background) in image()'s color.
+// Returns the shell hits taken.
+std::uint64_t SphericalRenderer::renderFused()
+{
+    ClSphericalFusedParams p{};
+    p.camera = toClCamera(camera_, imageSpec_.width, imageSpec_.height);
+    p.tex = texture_->toCl();
+    const glm::mat4& m = texturedTransfer_.colorMatrix;  // glm is column-major: row r is (m[0][r], ..., m[3][r])
+    for (int r = 0; r < 4; ++r)
+        p.matrix_row[r] = cl_float4{{m[0][r], m[1][r], m[2][r], m[3][r]}};
+    const glm::vec4 scale = texturedTransfer_.scale, bias = texturedTransfer_.bias;
+    p.scale = cl_float4{{scale.x, scale.y, scale.z, scale.w}};
+    p.bias = cl_float4{{bias.x, bias.y, bias.z, bias.w}};
+    p.center = f4(options_.domain.center);
+    p.background = f4(glm::dvec3(imageSpec_.background));
+    p.width = imageSpec_.width;
+    p.height = imageSpec_.height;
+    p.tf_count = tf_.count();
+    p.shells = static_cast<cl_int>(shells_.size());
+    p.phi_s0 = 0.5f / dims_.x;
+    p.phi_period = (dims_.x - 1.0f) / dims_.x;
+    p.ert_alpha = options_.earlyTermination < 1.0 ? static_cast<float>(options_.earlyTermination) : 2.0f;
+    p.radial = options_.opacity == SphericalOptions::Opacity::Radial ? 1 : 0;
+    int a = 0;
+    fused_.setArg(a++, image_->color());
+    fused_.setArg(a++, fusedSamples_);
+    fused_.setArg(a++, texture_->buffer());
+    fused_.setArg(a++, tf_.buffer());
+    fused_.setArg(a++, shellTable_);
+    fused_.setArg(a++, p);
+    device_.launch("spherical: fused shells", fused_, static_cast<std::size_t>(imageSpec_.width),
+                   static_cast<std::size_t>(imageSpec_.height));
+    std::uint64_t samples = 0;
+    for (const cl_uint n : device_.download<cl_uint>(fusedSamples_, image_->pixelCount()))
+        samples += n;
+    return samples;
 }
 
 void SphericalRenderer::setTransferFunction(const TransferFunction& tf)
@@ -312,6 +375,19 @@ Image4f SphericalRenderer::render(FrameStats& stats)
 {
     const FrameClock clock;
     drawStats_ = {};
+    if (options_.path == SphericalOptions::Path::Fused) {
+        const std::uint64_t samples = renderFused();
+        Image4f image = image_->readColor(device_);
+        finishFrame(device_, clock, stats);
+        stats.samples = samples;  // one texture sample per shell hit
+        stats.extra["path"] = "fused";
+        stats.extra["shells"] = shells_.size();
+        stats.extra["opacity"] = options_.opacity == SphericalOptions::Opacity::Path ? "path" : "radial";
+        stats.extra["early_termination"] = options_.earlyTermination;
+        stats.extra["voxels"] = static_cast<std::uint64_t>(dims_.x) * dims_.y * dims_.z;
+        stats.extra["resident_bytes"] = residentBytes_;
+        return image;
+    }
     image_->clearColor(device_, glm::vec4(0.0f));
     // Back to front along every ray: the far hits of concentric spheres lie beyond all near hits
     // and grow with the radius, the near hits shrink with it. So: back hemispheres from the
@@ -326,6 +402,7 @@ Image4f SphericalRenderer::render(FrameStats& stats)
     Image4f image = image_->readColor(device_);
     finishFrame(device_, clock, stats);
     stats.samples = drawStats_.fragments;  // one texture sample per covered pixel of a hemisphere
+    stats.extra["path"] = "raster";
     stats.extra["shells"] = shells_.size();
     stats.extra["segments"] = options_.segments;
     stats.extra["triangles"] = drawStats_.triangles;

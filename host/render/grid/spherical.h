@@ -6,7 +6,9 @@
 // coordinate frame buffer, raster::applyPixelTransfer (the paper's b + s·CM·p: the user's color
 // matrix, scale and bias, composed with the map of normalized coordinates to texel centers), then
 // kernels/spherical.cl: the pixel texture fetch of the volume, classification, opacity for the
-// shell's slab and the "over" blend into the image. docs/spherical.md.
+// shell's slab and the "over" blend into the image ("path": "raster"). The fused path ("path": "fused",
+// the default; kernels/spherical.cl spherical_fused) meets the exact spheres per pixel in one kernel and
+// computes the coordinates at each hit. docs/spherical.md.
 #pragma once
 
 #include "host/model/camera.h"
@@ -45,6 +47,10 @@ struct SphericalOptions {
     // approach, so no path is lost at silhouettes); Radial: r_hi - r_lo for every pixel (the paper's
     // plain blending; too transparent wherever rays are oblique).
     enum class Opacity { Path, Radial } opacity = Opacity::Path;
+    // Raster: the shells drawn pass by pass (the paper's technique, the specification). Fused: each pixel's
+    // ray meets the exact spheres in one kernel, front to back (no tessellation: `segments` is unused).
+    enum class Path { Fused, Raster } path = Path::Fused;
+    double earlyTermination = 1.0;  // fused path: stop a ray once its opacity reaches this (1: off)
 };
 
 // Its registry entry (host/render/renderer.h): name, data kind, one line, options with defaults.
@@ -109,6 +115,10 @@ private:
     cl::Kernel shellKernel_;
     OverBackground overBackground_;
     raster::DrawStats drawStats_;
+    // The fused path: its kernel, the shell table (radius, r_lo, r_hi, w) and the samples per pixel.
+    cl::Kernel fused_;
+    cl::Buffer shellTable_, fusedSamples_;
+    std::uint64_t renderFused();
 };
 
 // Renderer for "spherical": uploads the volume as a one-channel float 3D texture and the packed
