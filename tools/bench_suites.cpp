@@ -43,6 +43,7 @@ std::vector<std::string> benchSuiteScenes(const std::string& suite)
         regular.push_back(std::string("reg-cliptex-") + volume + ".json");
     }
     regular.push_back("reg-spherical-atmosphere.json");
+    regular.push_back("reg-spherical-atmosphere-raster.json");
     // The cell-face techniques (tools/make_tetfaces_bench.py): seeds/000's Table 1 and cellular automaton,
     // each beside harc on the same scene.
     std::vector<std::string> tetfaces;

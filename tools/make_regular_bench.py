@@ -25,7 +25,8 @@ Per volume:
   reg-cliptex-V          the same clipped by a clip texture of the same sphere (seeds/003's stencil texture)
 and on the engine also reg-iso3d-engine-gradientless (the pixel-texture shading of §3); and
 reg-spherical-atmosphere, the spherical technique on the generated atmosphere (seeds/000 §2.2; a
-spherical domain has no counterpart among the three volumes).
+spherical domain has no counterpart among the three volumes), its default fused path, and
+reg-spherical-atmosphere-raster, the same through the raster stage (the shells pass by pass).
 """
 import os
 import sys
@@ -105,6 +106,9 @@ def scenes():
         out.append(("reg-cliptex-%s.json" % volume,
                     translucent_scene(volume, "slice3d", {"slices": 256, "clip_texture": clip_texture})))
     out.append(("reg-spherical-atmosphere.json", spherical_scene()))
+    raster = spherical_scene()
+    raster["options"]["path"] = "raster"
+    out.append(("reg-spherical-atmosphere-raster.json", raster))
     return out
 
 
