@@ -35,6 +35,7 @@ CLVR_LAYOUT_FIELD(ClSlice3dParams, part_offset)
 CLVR_LAYOUT_FIELD(ClSlice3dParams, own_lo)
 CLVR_LAYOUT_FIELD(ClSlice3dParams, own_hi)
 CLVR_LAYOUT_FIELD(ClSlice3dParams, grid_hi)
+CLVR_LAYOUT_FIELD(ClSlice3dParams, clip_mesh)
 
 CLVR_LAYOUT_SIZE(ClSlice3dOverBackgroundParams)
 CLVR_LAYOUT_FIELD(ClSlice3dOverBackgroundParams, background)

@@ -39,6 +39,28 @@ float slice3d_slab_log2e(const float z, const float delta_s, const float chord_i
 
 #ifndef CLVR_SLICE3D_FRAGMENT
 
+#ifdef SLICE3D_CLIP_MESH
+/* Clipping with a closed mesh on the fused path (docs/slice3d.md, "Clipping with closed meshes"): the
+ * mesh's surfaces along this pixel's ray, peeled by kernels/clip_layers.cl, layers[l * stride] =
+ * (eye depth, 1 if front-facing) for l < count in increasing depth ((+inf, 1) past the pixel's last
+ * surface). The sample at eye depth z is inside iff the first surface beyond it is a back face (two-pass:
+ * the stencil passes' rule), or iff any surface beyond it is a back face (naive: Figure 2's rule). *next is
+ * the first layer beyond the previous sample, moved to this one's (z only grows or only shrinks along a
+ * loop, so this is one or two steps at most per layer). Returns 1 when the sample is drawn. */
+int slice3d_mesh_keep(global const float4* layers, const size_t stride, const int4 mesh, const int last_back,
+                      int* next, const float z)
+{
+    int n = *next;
+    while (n < mesh.x && layers[(size_t)n * stride].x <= z)
+        ++n;
+    while (n > 0 && layers[(size_t)(n - 1) * stride].x > z)
+        --n;
+    *next = n;
+    const int inside = mesh.z ? n <= last_back : (n < mesh.x && layers[(size_t)n * stride].y == 0.0f);
+    return inside != mesh.y;
+}
+#endif
+
 /* The volume's type on the device for the fused kernel: float by default; the host builds with
  * -DSLICE3D_VOXEL=uchar -DSLICE3D_TRILINEAR=clvr_trilinear_uchar (or ushort) when every value is an
  * integer in that type's range (the same interpolated values, bit for bit). */
@@ -70,6 +92,9 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
 #ifdef SLICE3D_CLIP_TEXTURE
                           global const float* clip_texels,
 #endif
+#ifdef SLICE3D_CLIP_MESH
+                          global const float4* clip_layers,
+#endif
 #ifdef SLICE3D_PREINTEGRATED
                           global const float* psi,
 #endif
@@ -99,6 +124,18 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
     const float3 uo = (float3)(dot(clip_row0.xyz, o) + clip_row0.w, dot(clip_row1.xyz, o) + clip_row1.w,
                                dot(clip_row2.xyz, o) + clip_row2.w);
     const float3 ud = (float3)(dot(clip_row0.xyz, d), dot(clip_row1.xyz, d), dot(clip_row2.xyz, d));
+#endif
+#ifdef SLICE3D_CLIP_MESH
+    /* This pixel's mesh layers (one per image-sized layer), the deepest back face among them (naive), and the
+     * first layer beyond the current sample (the loops below keep it). */
+    const int4 mesh = p.clip_mesh;
+    const size_t mesh_stride = (size_t)p.width * (size_t)p.height;
+    global const float4* layers = clip_layers + ((size_t)y * p.width + x);
+    int last_back = -1;
+    for (int l = 0; l < mesh.x; ++l)
+        if (layers[(size_t)l * mesh_stride].y == 0.0f)
+            last_back = l;
+    int mesh_next = 0;
 #endif
 
     /* Depth interval of the ray inside the owned box (slab test), widened by one slice each way; each
@@ -192,6 +229,10 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
             if (!clvr_clip_keep(clip_texels, p.clip_tex, uo + (depth0 + (float)k * delta_s) * ud, p.clip_inverse))
                 continue;
 #endif
+#ifdef SLICE3D_CLIP_MESH
+            if (!slice3d_mesh_keep(layers, mesh_stride, mesh, last_back, &mesh_next, depth0 + (float)k * delta_s))
+                continue;
+#endif
             const float4 ct = clvr_tf_eval(tf, tf_count, SLICE3D_TRILINEAR(volume, dims, gl));
             const float slab = slice3d_slab_log2e(depth0 + (float)k * delta_s, delta_s, chord_in, chord_out,
                                                   neg_delta_log2e, neg_stretch_log2e);
@@ -222,6 +263,10 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
             ++taken;
 #ifdef SLICE3D_CLIP_TEXTURE
             if (!clvr_clip_keep(clip_texels, p.clip_tex, uo + (depth0 + (float)k * delta_s) * ud, p.clip_inverse))
+                continue;
+#endif
+#ifdef SLICE3D_CLIP_MESH
+            if (!slice3d_mesh_keep(layers, mesh_stride, mesh, last_back, &mesh_next, depth0 + (float)k * delta_s))
                 continue;
 #endif
             const float4 ct = clvr_tf_eval(tf, tf_count, SLICE3D_TRILINEAR(volume, dims, gl));

@@ -42,7 +42,8 @@ typedef struct {
     cl_float4 grid_hi;       /* the next float above the full grid's last point, n - 1 per axis in full-grid
                               * coordinates: the box whose chord the slabs at its faces are clipped to
                               * (kernels/slice3d.cl), w = 0 */
-} ClSlice3dParams;           /* 368 bytes */
+    cl_int4 clip_mesh;       /* SLICE3D_CLIP_MESH builds: (layers, 1 if inverse, 1 if naive, 0) */
+} ClSlice3dParams;           /* 384 bytes */
 
 typedef struct {
     cl_float4 background;    /* image background, w = 0 */

@@ -374,9 +374,9 @@ TEST(BenchRegular, ScenesAreValidAndPairsDifferOnlyWhereTheyShould)
     std::sort(listed.begin(), listed.end());
     EXPECT_EQ(listed, present);
     // 3 volumes x (iso3d fused and raster, bricked iso3d, 4 stacks, raster baseline, clip mesh, fused
-    // baseline, clip texture) + the gradientless engine + the clipped stack on the engine + spherical fused
-    // and raster
-    ASSERT_EQ(files.size(), 37u);
+    // baseline, fused clip mesh, clip texture) + the gradientless engine + the clipped stack on the engine +
+    // spherical fused and raster
+    ASSERT_EQ(files.size(), 40u);
     for (const auto& file : files) {
         const clvr::Scene scene = clvr::loadScene(file);
         const std::string name = file.filename().string();
@@ -396,6 +396,8 @@ TEST(BenchRegular, ScenesAreValidAndPairsDifferOnlyWhereTheyShould)
         };
         if (name.starts_with("reg-clip-"))
             differsOnlyIn("reg-slice3d-raster-" + name.substr(9), "/clip");
+        if (name.starts_with("reg-clipmesh-"))
+            differsOnlyIn("reg-slice3d-" + name.substr(13), "/clip");
         if ((name.starts_with("reg-iso3d-") || name.starts_with("reg-stack2d-") || name.starts_with("reg-spherical-")) &&
             name.ends_with("-raster.json"))
             differsOnlyIn(name.substr(0, name.size() - 12) + ".json", "/path");

@@ -40,6 +40,7 @@ std::vector<std::string> benchSuiteScenes(const std::string& suite)
         regular.push_back(std::string("reg-slice3d-raster-") + volume + ".json");
         regular.push_back(std::string("reg-clip-") + volume + ".json");
         regular.push_back(std::string("reg-slice3d-") + volume + ".json");
+        regular.push_back(std::string("reg-clipmesh-") + volume + ".json");
         regular.push_back(std::string("reg-cliptex-") + volume + ".json");
     }
     regular.push_back("reg-spherical-atmosphere.json");

@@ -21,7 +21,9 @@ Per volume:
   reg-stack2d-engine-k1-cliptex  (engine only) reg-stack2d-engine-k1 clipped by the clip texture below
   reg-slice3d-raster-V   slice3d through the raster stage, 256 slices: the baseline of the clip rows
   reg-clip-V             the same with a sphere clip mesh, two-pass stencil (seeds/000 §2.1)
-  reg-slice3d-V          slice3d's default fused path, 256 slices: the baseline of the next row
+  reg-slice3d-V          slice3d's default fused path, 256 slices: the baseline of the next two rows
+  reg-clipmesh-V         the same clipped by the sphere clip mesh on the fused path (the mesh peeled into
+                         depth layers once, each sample tested against them)
   reg-cliptex-V          the same clipped by a clip texture of the same sphere (seeds/003's stencil texture)
 and on the engine also reg-iso3d-engine-gradientless (the pixel-texture shading of §3); and
 reg-spherical-atmosphere, the spherical technique on the generated atmosphere (seeds/000 §2.2; a
@@ -102,6 +104,8 @@ def scenes():
         out.append(("reg-clip-%s.json" % volume,
                     translucent_scene(volume, "slice3d", {"slices": 256, "path": "raster", "clip": clip})))
         out.append(("reg-slice3d-%s.json" % volume, translucent_scene(volume, "slice3d", {"slices": 256})))
+        out.append(("reg-clipmesh-%s.json" % volume,
+                    translucent_scene(volume, "slice3d", {"slices": 256, "clip": clip})))
         clip_texture = {"shape": "sphere", "center": center, "radius": radius, "inverse": True}
         out.append(("reg-cliptex-%s.json" % volume,
                     translucent_scene(volume, "slice3d", {"slices": 256, "clip_texture": clip_texture})))

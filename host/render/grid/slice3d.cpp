@@ -40,6 +40,7 @@ private:
     Image4f renderRaster(FrameStats& stats);
     raster::DrawStats drawClipped(const std::vector<raster::Vertex>& slices, const std::vector<std::size_t>& firsts,
                                   const raster::DrawState& sliceState, const glm::dmat4& viewProjection);
+    void peelClipMesh();
 
     Device& device_;
     Slice3dOptions options_;
@@ -70,9 +71,13 @@ private:
     raster::Rasterizer rasterizer_{device_};      // slice polygons: its stats are the frame's samples
     raster::Rasterizer clipRasterizer_{device_};  // the clip mesh's stencil passes, not counted
     std::optional<OverBackground> overBackground_;  // the raster path's last pass
-    // Clipping (raster path): the closed mesh and its farthest eye depth.
+    // Clipping with a closed mesh: the mesh and its farthest eye depth; on the fused path its surfaces along
+    // each pixel's ray, peeled once into depth layers (kernels/clip_layers.cl), and the time that took.
     std::optional<ClipMesh> clipMesh_;
     double clipDepthMax_ = 0.0;
+    cl::Buffer clipLayers_;
+    int clipLayerCount_ = -1;  // -1: not peeled yet
+    double clipPeelMs_ = 0.0;
     // Clip texture (both paths): the texture, its device copy, and world -> texture coordinates.
     std::optional<ClipTexture> clipTexture_;
     std::unique_ptr<raster::Texture> clipTexels_;
@@ -89,7 +94,7 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
     // the samples it owns (host/model/volume.h's GridPart): the parts' images composite to the full one.
     part_ = volume.gridPart();
     if (volume.part && options_.path != Slice3dOptions::Path::Fused)
-        throw InputError("slice3d: the raster path (options.path \"raster\", clip meshes) does not render a part "
+        throw InputError("slice3d: the raster path (options.path \"raster\") does not render a part "
                          "of a volume; use --distribution sort-first or frames");
     origin_ = part_.fullOrigin;
     lo_ = part_.fullBoundsMin();
@@ -142,6 +147,8 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
         residentBytes_ += clipTexels_->bytes();
         trilinearOptions += " -DSLICE3D_CLIP_TEXTURE=1";
     }
+    if (clipMesh_ && fused)
+        trilinearOptions += " -DSLICE3D_CLIP_MESH=1";
     if (options_.preintegrated) {
         if (volume.part)
             throw InputError("slice3d: \"integration\": \"preintegrated\" renders the whole grid, not a part of it "
@@ -168,6 +175,8 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
         emptyBrickCount_ = static_cast<std::uint64_t>(std::count(flags.begin(), flags.end(), cl_uchar(1)));
         emptyBricks_ = device_.upload("slice3d empty-space radii", emptySpaceRadii(grid.dims, flags));
         residentBytes_ += flags.size();
+        if (clipMesh_)  // the peeling draws
+            framebuffer_ = std::make_unique<raster::Framebuffer>(device_, image_.width, image_.height);
     } else {
         framebuffer_ = std::make_unique<raster::Framebuffer>(device_, image_.width, image_.height);
         overBackground_.emplace(device_);
@@ -294,6 +303,13 @@ Image4f Slice3dRenderer::renderFused(FrameStats& stats)
                                        clipCoordinates_[3][r]);
         params.clip_inverse = options_.clipTexture->inverse ? 1 : 0;
     }
+    if (clipMesh_) {
+        if (clipLayerCount_ < 0)
+            peelClipMesh();  // once: the layers depend only on the camera and the mesh
+        fused_.setArg(a++, clipLayers_);
+        params.clip_mesh = cl_int4{{clipLayerCount_, options_.clip->inverse ? 1 : 0,
+                                    options_.clip->method == Slice3dClip::Method::Naive ? 1 : 0, 0}};
+    }
     if (options_.preintegrated) {
         fused_.setArg(a++, psi_);
         params.psi_n = static_cast<cl_int>(psiTable().size);
@@ -312,7 +328,81 @@ Image4f Slice3dRenderer::renderFused(FrameStats& stats)
     stats.extra["bricks"] = {brickDims_.x, brickDims_.y, brickDims_.z};
     stats.extra["empty_bricks"] = emptyBrickCount_;
     stats.extra["brick_setup_ms"] = brickSetupMs_;
+    if (clipMesh_) {
+        stats.extra["clip_layers"] = clipLayerCount_;
+        stats.extra["clip_peel_ms"] = clipPeelMs_;
+    }
     return image;
+}
+
+// The fused path's clip mesh (docs/slice3d.md, "Clipping with closed meshes"): its surfaces along each
+// pixel's ray as depth layers, by depth peeling — the whole mesh drawn once per layer with the depth test
+// LESS, kernels/clip_layers.cl discarding every fragment at or in front of the previous layer's window
+// depth at its pixel — until a draw leaves no fragment. Layer l, one float4 per pixel (eye depth of the
+// (l+1)-th surface, 1 if it is front-facing; +inf where the ray has fewer surfaces), is the frame buffer's
+// color after draw l. The fused kernel then asks, per sample, whether the first surface beyond it is a back
+// face: the stencil passes' rule, without drawing the mesh per slice.
+void Slice3dRenderer::peelClipMesh()
+{
+    constexpr int kMaxLayers = 64;
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
+    // The raster path's projection (renderRaster): surfaces nearer than its near plane lie in front of every
+    // slice, where the rule never looks; the far plane lies beyond the mesh.
+    const double nearZ = 0.5 * plan_.depth(0);
+    const double farZ = 2.0 * std::max(plan_.depthMax, clipDepthMax_) + 1.0;
+    const glm::dmat4 viewProjection =
+        camera_.projectionMatrix(image_.width, image_.height, nearZ, farZ) * camera_.viewMatrix();
+    std::vector<raster::Vertex> mesh;
+    mesh.reserve(clipMesh_->triangles.size() * 3);
+    for (const auto& t : clipMesh_->triangles)
+        for (std::uint32_t i : t) {
+            raster::Vertex v;
+            v.position = glm::vec4(viewProjection * glm::dvec4(clipMesh_->points[i], 1.0));
+            v.attributes[0] = glm::vec4(glm::vec3(clipMesh_->points[i]), 1.0f);
+            mesh.push_back(v);
+        }
+    raster::FragmentProgram peel;
+    peel.source = "#define CLVR_CLIP_LAYERS_FRAGMENT 1\n" + std::string(embeddedKernelSource("clip_layers.cl"));
+    peel.attributes = 1;
+    const glm::dvec3 eye = camera_.position, forward = camera_.forward();
+    peel.uniforms = {glm::vec4(glm::vec3(eye), static_cast<float>(image_.width)), glm::vec4(glm::vec3(forward), 0.0f)};
+    cl::Buffer previous = device_.upload("slice3d clip mesh: previous layer's depth", std::vector<float>(pixels, -1.0f));
+    peel.buffers[0] = previous;
+    raster::DrawState state;
+    state.fragment.depth.test = true;
+    state.fragment.depth.func = raster::CompareFunc::Less;
+    state.fragment.depth.write = true;
+    std::vector<cl::Buffer> layers;
+    for (;;) {
+        framebuffer_->clearDepth(device_, 1.0f);
+        // +inf where a ray has no surface left, marked front-facing: nothing beyond a sample there makes it inside
+        framebuffer_->clearColor(device_, glm::vec4(std::numeric_limits<float>::infinity(), 1.0f, 0.0f, 0.0f));
+        raster::draw(device_, *framebuffer_, state, raster::Topology::Triangles, mesh, peel);
+        const std::vector<float> depth = device_.download<float>(framebuffer_->depth(), pixels);
+        if (std::none_of(depth.begin(), depth.end(), [](float d) { return d < 1.0f; }))
+            break;  // no surface left along any ray
+        if (static_cast<int>(layers.size()) == kMaxLayers)
+            throw InputError("options.clip.mesh: some pixel's ray crosses the clip mesh more than " +
+                             std::to_string(kMaxLayers) + " times; use \"path\": \"raster\"");
+        layers.push_back(device_.buffer("slice3d clip mesh layer", pixels * sizeof(cl_float4)));
+        device_.queue().enqueueCopyBuffer(framebuffer_->color(), layers.back(), 0, 0, pixels * sizeof(cl_float4));
+        device_.queue().enqueueCopyBuffer(framebuffer_->depth(), previous, 0, 0, pixels * sizeof(float));
+    }
+    // One buffer, layer after layer (one float4 per pixel each); a mesh no ray meets still gets one layer
+    // of +inf, so that the kernel has a buffer to read.
+    const std::size_t bytes = std::max<std::size_t>(layers.size(), 1) * pixels * sizeof(cl_float4);
+    clipLayers_ = device_.buffer("slice3d clip mesh layers", bytes);
+    if (layers.empty())
+        device_.queue().enqueueFillBuffer(clipLayers_, cl_float4{{std::numeric_limits<float>::infinity(), 1.0f, 0.0f, 0.0f}},
+                                          0, bytes);
+    for (std::size_t l = 0; l < layers.size(); ++l)
+        device_.queue().enqueueCopyBuffer(layers[l], clipLayers_, 0, l * pixels * sizeof(cl_float4),
+                                          pixels * sizeof(cl_float4));
+    device_.queue().finish();
+    clipLayerCount_ = static_cast<int>(layers.size());
+    residentBytes_ += bytes;
+    clipPeelMs_ = msSince(t0);
 }
 
 Image4f Slice3dRenderer::renderRaster(FrameStats& stats)
@@ -565,17 +655,13 @@ Slice3dOptions parseSlice3dOptions(const nlohmann::json& options)
             unparsedOption(info, key);
         }
     });
-    if (o.clip) {
-        // The stencil passes run per slice, between the slice polygons: only the raster path has them.
-        if (options.contains("path") && o.path == Slice3dOptions::Path::Fused)
-            badOption("clip", "needs \"path\": \"raster\" (the clip mesh is drawn into the stencil buffer per slice; "
-                              "the fused kernel has no stencil), got \"path\": \"fused\"");
-        o.path = Slice3dOptions::Path::Raster;
-    }
     checkSlicesOrSpacing(options);
     if (o.preintegrated && o.path == Slice3dOptions::Path::Raster)
         badOption("integration", "\"preintegrated\" is only available on the fused path (a fragment sees one "
-                                 "slice, not the slab behind it); clip meshes need the raster path");
+                                 "slice, not the slab behind it)");
+    if (o.preintegrated && o.clip)
+        badOption("integration", "\"preintegrated\" does not combine with clip yet (a slab would be cut inside; "
+                                 "docs/slice3d.md)");
     if (o.preintegrated && o.clipTexture)
         badOption("integration", "\"preintegrated\" does not combine with clip_texture yet (a slab would be cut "
                                  "inside; docs/slice3d.md)");
