@@ -23,6 +23,7 @@
 #include "tools/bench_raster.h"
 #include "tools/ceiling.h"
 #include "tools/ceiling_harc.h"
+#include "tools/ceiling_spherical.h"
 
 #if __has_include("raster/rasterizer.h")
 #include "raster/rasterizer.h"
@@ -161,20 +162,33 @@ const Image4d& referenceImage(std::map<std::string, Image4d>& cache, const Scene
     return cache.emplace(k, std::move(image)).first->second;
 }
 
-// The plain C++ ceiling loop on the same scene (slice3d only). Its frames are interleaved with clvr's
-// (see bench()), so that both see the same load on a shared machine.
-std::unique_ptr<Ceiling> makeCeiling(const Scene& scene, const Volume& volume, const Camera& camera)
+// The plain C++ ceiling loop on the same scene, where there is one: slice3d's fused path with per-sample
+// classification (the raster path counts fragments, not samples; pre-integrated slabs and clip meshes are
+// other loops), spherical's fused path. Its frames are interleaved with clvr's (see bench()), so that both
+// see the same load on a shared machine.
+std::unique_ptr<VolumeCeiling> makeCeiling(const Scene& scene, const Volume& volume, const Camera& camera)
 {
-    CeilingScene cs;
-    cs.camera = camera;
-    cs.width = scene.image.width;
-    cs.height = scene.image.height;
-    cs.background = scene.image.background;
-    cs.options = parseSlice3dOptions(scene.options);
-    return std::make_unique<Ceiling>(volume, scene.transferFunction, cs);
+    if (scene.technique == slice3dTechnique().name) {
+        CeilingScene cs;
+        cs.camera = camera;
+        cs.width = scene.image.width;
+        cs.height = scene.image.height;
+        cs.background = scene.image.background;
+        cs.options = parseSlice3dOptions(scene.options);
+        if (cs.options.path != Slice3dOptions::Path::Fused || cs.options.preintegrated || cs.options.clip)
+            return nullptr;
+        return std::make_unique<Ceiling>(volume, scene.transferFunction, cs);
+    }
+    if (scene.technique == sphericalTechnique().name) {
+        const SphericalOptions options = parseSphericalOptions(scene.options);
+        if (options.path != SphericalOptions::Path::Fused)
+            return nullptr;
+        return std::make_unique<SphericalCeiling>(volume, scene.transferFunction, camera, scene.image, options);
+    }
+    return nullptr;
 }
 
-nlohmann::json ceilingReport(const Ceiling& ceiling, int threads, const CeilingResult& result,
+nlohmann::json ceilingReport(const VolumeCeiling& ceiling, int threads, const CeilingResult& result,
                              const std::vector<double>& ms, const Image4f& clvrImage, double clvrSamplesPerS,
                              const fs::path& imagePath)
 {
@@ -182,18 +196,18 @@ nlohmann::json ceilingReport(const Ceiling& ceiling, int threads, const CeilingR
     const double samplesPerS = result.samples / (s.median * 1e-3);
     writeImage(imagePath.string(), result.image);
     const ImageDiff d = imageDiff(clvrImage, result.image);
-    return {{"threads", threads},
-            {"frame_ms", s.median},
-            {"frame_ms_min", s.min},
-            {"frame_ms_max", s.max},
-            {"frame_ms_all", ms},
-            {"samples", result.samples},
-            {"samples_per_s", samplesPerS},
-            {"clvr_ratio", clvrSamplesPerS / samplesPerS},
-            {"slices", ceiling.plan().count},
-            {"slice_spacing", ceiling.plan().deltaS},
-            {"image", imagePath.string()},
-            {"image_diff_vs_clvr", {{"mean", d.mean}, {"max", d.max}}}};
+    nlohmann::json r = {{"threads", threads},
+                        {"frame_ms", s.median},
+                        {"frame_ms_min", s.min},
+                        {"frame_ms_max", s.max},
+                        {"frame_ms_all", ms},
+                        {"samples", result.samples},
+                        {"samples_per_s", samplesPerS},
+                        {"clvr_ratio", clvrSamplesPerS / samplesPerS},
+                        {"image", imagePath.string()},
+                        {"image_diff_vs_clvr", {{"mean", d.mean}, {"max", d.max}}}};
+    r.update(ceiling.describe());
+    return r;
 }
 
 // tools/peer_vtk.py under xvfb-run on the same scene; its figures, and its image against clvr's PNG.
@@ -619,12 +633,7 @@ int bench(const BenchOptions& options)
         const double compileMs = device.compileMs() - compile0;
 
         // The ceiling's first frame warms its caches; then clvr and ceiling frames alternate.
-        // The ceiling mirrors slice3d's fused path with per-sample classification only (the raster path
-        // counts fragments, not samples; pre-integrated slabs are another loop).
-        const bool isSlice3d = scene.technique == slice3dTechnique().name;
-        const Slice3dOptions sliceOptions = isSlice3d ? parseSlice3dOptions(scene.options) : Slice3dOptions{};
-        const bool ceilingFits = isSlice3d && sliceOptions.path == Slice3dOptions::Path::Fused && !sliceOptions.preintegrated;
-        const std::unique_ptr<Ceiling> ceiling = ceilingFits ? makeCeiling(scene, volume, camera) : nullptr;
+        const std::unique_ptr<VolumeCeiling> ceiling = makeCeiling(scene, volume, camera);
         const int threads = threadBudget();
         CeilingResult ceilingResult;
         if (ceiling)
