@@ -14,12 +14,8 @@ namespace clvr::tools {
 
 Ceiling::Ceiling(const Volume& volume, const TransferFunction& tf, const CeilingScene& scene)
     : volume_(volume), scene_(scene),
-      plan_(planSlices(scene.camera, volume.boundsMin(), volume.boundsMax(), scene.options))
+      plan_(planSlices(scene.camera, volume.boundsMin(), volume.boundsMax(), scene.options)), classify_(volume, tf)
 {
-    for (const ControlPoint& p : tf.points()) {
-        tfS_.push_back(static_cast<float>(p.s));
-        tfValue_.emplace_back(glm::vec3(p.color), static_cast<float>(p.tau));
-    }
 }
 
 CeilingResult Ceiling::render(int threads) const
@@ -55,39 +51,12 @@ std::uint64_t Ceiling::renderRow(int y, Image4f& image) const
     const glm::vec3 origin(volume_.origin), invSpacing(1.0 / volume_.spacing);
     const glm::ivec3 n = volume_.dims;
     const glm::vec3 last(n - 1);
-    const float* v = volume_.values.data();
-    const std::size_t nx = static_cast<std::size_t>(n.x), nxy = nx * n.y;
     const float depth0 = static_cast<float>(plan_.depth(0)), deltaS = static_cast<float>(plan_.deltaS);
     const int sliceCount = plan_.count;
     const bool frontToBack = scene_.options.order == Slice3dOptions::Order::FrontToBack;
     const float ertAlpha = scene_.options.earlyTermination < 1.0 ? static_cast<float>(scene_.options.earlyTermination) : 2.0f;
     const glm::vec3 background(scene_.background);
-    const int tfCount = static_cast<int>(tfS_.size());
-    const float* tfS = tfS_.data();
-    const glm::vec4* tfValue = tfValue_.data();
-
-    auto sample = [&](const glm::vec3& g) {  // clvr_trilinear, then clvr_tf_eval
-        const int i = std::min(static_cast<int>(g.x), n.x - 2);
-        const int j = std::min(static_cast<int>(g.y), n.y - 2);
-        const int k = std::min(static_cast<int>(g.z), n.z - 2);
-        const float fx = g.x - i, fy = g.y - j, fz = g.z - k;
-        const float* p = v + k * nxy + j * nx + i;
-        const float c00 = p[0] + fx * (p[1] - p[0]);
-        const float c10 = p[nx] + fx * (p[nx + 1] - p[nx]);
-        const float c01 = p[nxy] + fx * (p[nxy + 1] - p[nxy]);
-        const float c11 = p[nxy + nx] + fx * (p[nxy + nx + 1] - p[nxy + nx]);
-        const float c0 = c00 + fy * (c10 - c00), c1 = c01 + fy * (c11 - c01);
-        const float s = c0 + fz * (c1 - c0);
-        if (!(s > tfS[0]))
-            return tfValue[0];
-        if (s >= tfS[tfCount - 1])
-            return tfValue[tfCount - 1];
-        int m = 1;
-        while (tfS[m] <= s)
-            ++m;
-        const float t = (s - tfS[m - 1]) / (tfS[m] - tfS[m - 1]);
-        return tfValue[m - 1] + t * (tfValue[m] - tfValue[m - 1]);  // (r, g, b, tau)
-    };
+    const CeilingClassifier& sample = classify_;  // clvr_trilinear, then clvr_tf_eval
     auto inside = [&](const glm::vec3& g) {
         return g.x >= 0.0f && g.y >= 0.0f && g.z >= 0.0f && g.x <= last.x && g.y <= last.y && g.z <= last.z;
     };

@@ -15,6 +15,7 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -30,6 +31,51 @@ struct CeilingScene {
 struct CeilingResult {
     Image4f image;              // I + (1 - A) background, alpha = A
     std::uint64_t samples = 0;  // samples taken inside the grid bounds (slice3d's stats.samples)
+};
+
+// The fused kernels' per-sample classification in plain C++: kernels/volume_sampling.h's clvr_trilinear on the
+// volume's floats at grid coordinates g (checked inside by the caller), then kernels/transfer_function.h's
+// clvr_tf_eval (the exact piecewise-linear transfer function): (r, g, b, tau). Inline, as the loops need it.
+class CeilingClassifier {
+public:
+    CeilingClassifier(const Volume& volume, const TransferFunction& tf) : volume_(volume)
+    {
+        for (const ControlPoint& p : tf.points()) {
+            s_.push_back(static_cast<float>(p.s));
+            value_.emplace_back(glm::vec3(p.color), static_cast<float>(p.tau));
+        }
+    }
+    glm::vec4 operator()(const glm::vec3& g) const
+    {
+        const glm::ivec3 n = volume_.dims;
+        const std::size_t nx = static_cast<std::size_t>(n.x), nxy = nx * n.y;
+        const int i = std::min(static_cast<int>(g.x), n.x - 2);
+        const int j = std::min(static_cast<int>(g.y), n.y - 2);
+        const int k = std::min(static_cast<int>(g.z), n.z - 2);
+        const float fx = g.x - i, fy = g.y - j, fz = g.z - k;
+        const float* p = volume_.values.data() + k * nxy + j * nx + i;
+        const float c00 = p[0] + fx * (p[1] - p[0]);
+        const float c10 = p[nx] + fx * (p[nx + 1] - p[nx]);
+        const float c01 = p[nxy] + fx * (p[nxy + 1] - p[nxy]);
+        const float c11 = p[nxy + nx] + fx * (p[nxy + nx + 1] - p[nxy + nx]);
+        const float c0 = c00 + fy * (c10 - c00), c1 = c01 + fy * (c11 - c01);
+        const float s = c0 + fz * (c1 - c0);
+        const int count = static_cast<int>(s_.size());
+        if (!(s > s_[0]))
+            return value_[0];
+        if (s >= s_[count - 1])
+            return value_[count - 1];
+        int m = 1;
+        while (s_[m] <= s)
+            ++m;
+        const float t = (s - s_[m - 1]) / (s_[m] - s_[m - 1]);
+        return value_[m - 1] + t * (value_[m] - value_[m - 1]);
+    }
+
+private:
+    const Volume& volume_;
+    std::vector<float> s_;          // control points' s, increasing
+    std::vector<glm::vec4> value_;  // their (r, g, b, tau)
 };
 
 // A ceiling loop for a regular-grid technique's fused kernel (slice3d's below, spherical's in
@@ -57,8 +103,7 @@ private:
     const Volume& volume_;
     CeilingScene scene_;
     SlicePlan plan_;
-    std::vector<float> tfS_;          // control points' s, increasing
-    std::vector<glm::vec4> tfValue_;  // their (r, g, b, tau)
+    CeilingClassifier classify_;
 };
 
 }  // namespace clvr::tools

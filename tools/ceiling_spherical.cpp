@@ -44,7 +44,7 @@ SphericalCeiling::SphericalCeiling(const Volume& volume, const TransferFunction&
       background_(glm::vec3(image.background)), center_(glm::vec3(options.domain.center)),
       phiS0_(0.5f / volume.dims.x), phiPeriod_((volume.dims.x - 1.0f) / volume.dims.x),
       ertAlpha_(options.earlyTermination < 1.0 ? static_cast<float>(options.earlyTermination) : 2.0f),
-      radial_(options.opacity == SphericalOptions::Opacity::Radial)
+      radial_(options.opacity == SphericalOptions::Opacity::Radial), classify_(volume, tf)
 {
     const SphericalDomain& d = options.domain;
     for (const Shell& shell : planShells(options))
@@ -53,10 +53,6 @@ SphericalCeiling::SphericalCeiling(const Volume& volume, const TransferFunction&
     matrix_ = t.colorMatrix;
     scale_ = t.scale;
     bias_ = t.bias;
-    for (const ControlPoint& p : tf.points()) {
-        tfS_.push_back(static_cast<float>(p.s));
-        tfValue_.emplace_back(glm::vec3(p.color), static_cast<float>(p.tau));
-    }
 }
 
 CeilingResult SphericalCeiling::render(int threads) const
@@ -90,33 +86,8 @@ std::uint64_t SphericalCeiling::renderRow(int y, Image4f& image) const
     const float aspect = static_cast<float>(width_) / static_cast<float>(height_);
     const glm::ivec3 n = volume_.dims;
     const glm::vec3 texels(n), top(n - 1);
-    const float* v = volume_.values.data();
-    const std::size_t nx = static_cast<std::size_t>(n.x), nxy = nx * n.y;
-    const int shellCount = static_cast<int>(shells_.size()), tfCount = static_cast<int>(tfS_.size());
+    const int shellCount = static_cast<int>(shells_.size());
     const float invTwoPi = 0.15915494309189535f, invPi = 0.3183098861837907f;
-
-    auto classify = [&](const glm::vec3& g) {  // clvr_trilinear, then clvr_tf_eval
-        const int i = std::min(static_cast<int>(g.x), n.x - 2);
-        const int j = std::min(static_cast<int>(g.y), n.y - 2);
-        const int k = std::min(static_cast<int>(g.z), n.z - 2);
-        const float fx = g.x - i, fy = g.y - j, fz = g.z - k;
-        const float* p = v + k * nxy + j * nx + i;
-        const float c00 = p[0] + fx * (p[1] - p[0]);
-        const float c10 = p[nx] + fx * (p[nx + 1] - p[nx]);
-        const float c01 = p[nxy] + fx * (p[nxy + 1] - p[nxy]);
-        const float c11 = p[nxy + nx] + fx * (p[nxy + nx + 1] - p[nxy + nx]);
-        const float c0 = c00 + fy * (c10 - c00), c1 = c01 + fy * (c11 - c01);
-        const float s = c0 + fz * (c1 - c0);
-        if (!(s > tfS_[0]))
-            return tfValue_[0];
-        if (s >= tfS_[tfCount - 1])
-            return tfValue_[tfCount - 1];
-        int m = 1;
-        while (tfS_[m] <= s)
-            ++m;
-        const float t = (s - tfS_[m - 1]) / (tfS_[m] - tfS_[m - 1]);
-        return tfValue_[m - 1] + t * (tfValue_[m] - tfValue_[m - 1]);  // (r, g, b, tau)
-    };
 
     std::uint64_t taken = 0;
     for (int x = 0; x < width_; ++x) {
@@ -158,7 +129,7 @@ std::uint64_t SphericalCeiling::renderRow(int y, Image4f& image) const
                 const float w = (q.x - phiS0_) / phiPeriod_;
                 q.x = phiS0_ + (w - std::floor(w)) * phiPeriod_;
                 ++taken;
-                const glm::vec4 ct = classify(glm::clamp(glm::vec3(q) * texels - 0.5f, glm::vec3(0.0f), top));
+                const glm::vec4 ct = classify_(glm::clamp(glm::vec3(q) * texels - 0.5f, glm::vec3(0.0f), top));
                 float len = shell.z - shell.y;
                 if (!radial_) {  // kernels/spherical.cl's clvr_spherical_slab
                     const float rInner = k > 0 ? shells_[k - 1].x : -1.0f;

@@ -44,8 +44,7 @@ private:
     glm::vec4 scale_, bias_;
     float phiS0_, phiPeriod_, ertAlpha_;
     bool radial_;
-    std::vector<float> tfS_;          // control points' s, increasing
-    std::vector<glm::vec4> tfValue_;  // their (r, g, b, tau)
+    CeilingClassifier classify_;
 };
 
 }  // namespace clvr::tools

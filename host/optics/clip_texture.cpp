@@ -232,6 +232,14 @@ double shapeSignedDistance(const ClipTextureSpec& s, const glm::dvec3& p)
     return std::numeric_limits<double>::infinity();
 }
 
+void addClipTextureStats(nlohmann::json& extra, const ClipTexture& texture, const ClipTextureSpec& spec)
+{
+    const glm::ivec3 n = texture.dims();
+    extra["clip_texture"] = texture.source;
+    extra["clip_texture_dims"] = {n.x, n.y, n.z};
+    extra["clip_texture_inverse"] = spec.inverse;
+}
+
 ClipTexture makeClipTexture(const ClipTextureSpec& spec, const fs::path& baseDir)
 {
     ClipTexture t;

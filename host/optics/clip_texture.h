@@ -60,6 +60,10 @@ struct ClipTexture {
 // file, NaN values included, naming it).
 ClipTexture makeClipTexture(const ClipTextureSpec& spec, const std::filesystem::path& baseDir);
 
+// The `--stats` extras of a renderer with a clip texture (slice3d, stack2d): clip_texture (its source),
+// clip_texture_dims, clip_texture_inverse.
+void addClipTextureStats(nlohmann::json& extra, const ClipTexture& texture, const ClipTextureSpec& spec);
+
 // World position -> normalized texture coordinates (GL's: texel i centered at (i + 0.5) / n) for the
 // texture placed by offset and matrix; affine, acting on (p, 1).
 glm::dmat4 clipTextureCoordinates(const ClipTexture& texture, const glm::dvec3& offset, const glm::dmat3& matrix);

@@ -27,6 +27,22 @@ static_assert(sizeof(ClSlice3dOverBackgroundParams) == 32, "also probed on the d
 
 namespace {
 
+// The clip mesh as a triangle list for raster::draw: clip-space positions, attribute 0 the world position
+// (read by the fused path's peeling, kernels/clip_layers.cl; the stencil passes draw no attributes).
+std::vector<raster::Vertex> clipMeshVertices(const ClipMesh& mesh, const glm::dmat4& viewProjection)
+{
+    std::vector<raster::Vertex> vertices;
+    vertices.reserve(mesh.triangles.size() * 3);
+    for (const auto& t : mesh.triangles)
+        for (std::uint32_t i : t) {
+            raster::Vertex v;
+            v.position = glm::vec4(viewProjection * glm::dvec4(mesh.points[i], 1.0));
+            v.attributes[0] = glm::vec4(glm::vec3(mesh.points[i]), 1.0f);
+            vertices.push_back(v);
+        }
+    return vertices;
+}
+
 class Slice3dRenderer final : public Renderer {
 public:
     Slice3dRenderer(Device& device, const Scene& scene, const Volume& volume);
@@ -231,12 +247,8 @@ Image4f Slice3dRenderer::render(FrameStats& stats)
     stats.extra["voxels"] = static_cast<std::uint64_t>(dims_.x) * dims_.y * dims_.z;
     stats.extra["resident_bytes"] = residentBytes_;
     stats.extra["voxel_type"] = voxelType_;
-    if (clipTexture_) {
-        const glm::ivec3 n = clipTexture_->dims();
-        stats.extra["clip_texture"] = clipTexture_->source;
-        stats.extra["clip_texture_dims"] = {n.x, n.y, n.z};
-        stats.extra["clip_texture_inverse"] = options_.clipTexture->inverse;
-    }
+    if (clipTexture_)
+        addClipTextureStats(stats.extra, *clipTexture_, *options_.clipTexture);
     return image;
 }
 
@@ -353,15 +365,7 @@ void Slice3dRenderer::peelClipMesh()
     const double farZ = 2.0 * std::max(plan_.depthMax, clipDepthMax_) + 1.0;
     const glm::dmat4 viewProjection =
         camera_.projectionMatrix(image_.width, image_.height, nearZ, farZ) * camera_.viewMatrix();
-    std::vector<raster::Vertex> mesh;
-    mesh.reserve(clipMesh_->triangles.size() * 3);
-    for (const auto& t : clipMesh_->triangles)
-        for (std::uint32_t i : t) {
-            raster::Vertex v;
-            v.position = glm::vec4(viewProjection * glm::dvec4(clipMesh_->points[i], 1.0));
-            v.attributes[0] = glm::vec4(glm::vec3(clipMesh_->points[i]), 1.0f);
-            mesh.push_back(v);
-        }
+    const std::vector<raster::Vertex> mesh = clipMeshVertices(*clipMesh_, viewProjection);
     raster::FragmentProgram peel;
     peel.source = "#define CLVR_CLIP_LAYERS_FRAGMENT 1\n" + std::string(embeddedKernelSource("clip_layers.cl"));
     peel.attributes = 1;
@@ -485,14 +489,7 @@ raster::DrawStats Slice3dRenderer::drawClipped(const std::vector<raster::Vertex>
     const bool frontToBack = options_.order == Slice3dOptions::Order::FrontToBack;
     const bool twoPass = options_.clip->method == Slice3dClip::Method::TwoPass;
     const bool inverse = options_.clip->inverse;
-    std::vector<raster::Vertex> mesh;
-    mesh.reserve(clipMesh_->triangles.size() * 3);
-    for (const auto& t : clipMesh_->triangles)
-        for (std::uint32_t i : t) {
-            raster::Vertex v;
-            v.position = glm::vec4(viewProjection * glm::dvec4(clipMesh_->points[i], 1.0));
-            mesh.push_back(v);
-        }
+    const std::vector<raster::Vertex> mesh = clipMeshVertices(*clipMesh_, viewProjection);
 
     raster::DrawState back;  // pass 1: no color writes, only stencil (and depth for pass 2)
     back.fragment.colorMask = {false, false, false, false};

@@ -375,12 +375,8 @@ Image4f Stack2dRenderer::render(FrameStats& stats)
         stats.extra["fragments"] = drawStats.fragments;
         stats.extra["triangles"] = drawStats.triangles;
     }
-    if (clipTexture_) {
-        const glm::ivec3 n = clipTexture_->dims();
-        stats.extra["clip_texture"] = clipTexture_->source;
-        stats.extra["clip_texture_dims"] = {n.x, n.y, n.z};
-        stats.extra["clip_texture_inverse"] = options_.clipTexture->inverse;
-    }
+    if (clipTexture_)
+        addClipTextureStats(stats.extra, *clipTexture_, *options_.clipTexture);
     return image;
 }
 
