@@ -8,6 +8,7 @@
 #include "tools/ceiling.cpp"
 #include "tools/ceiling_harc.cpp"
 #include "tools/ceiling_spherical.cpp"
+#include "tools/ceiling_stack2d.cpp"
 
 #include "host/runtime/errors.h"
 #include "host/io/generators.h"
@@ -121,6 +122,56 @@ TEST(SphericalCeiling, DoesTheFusedKernelsWork)
         EXPECT_LE(std::abs(static_cast<double>(result.samples) - static_cast<double>(stats.samples)),
                   1e-4 * static_cast<double>(stats.samples) + 2.0);
     }
+}
+
+// stack2d's ceiling loop (tools/ceiling_stack2d.h) does the fused kernel's work in plain C++ (without the
+// empty-space skipping, which leaves the kernel's image bit for bit): the same image up to float rounding and
+// the same planes met in the box. Perspective (z stack, 1 intermediate slice), parallel (x stack, plain), a
+// camera inside the box (3 intermediate slices, early termination).
+TEST(Stack2dCeiling, DoesTheFusedKernelsWork)
+{
+    const clvr::Volume volume = clvr::generateVolume("marschner-lobb", {41, 37, 33});
+    clvr::Camera inside;
+    inside.position = {0.35, 0.45, 0.55};
+    inside.focalPoint = {0.0, -0.1, 0.0};
+    inside.viewAngle = 70.0;
+    struct Case {
+        clvr::Camera camera;
+        nlohmann::json options;
+    };
+    for (const Case& c : {Case{clvr::test::obliquePerspectiveCamera(40.0), {{"intermediate", 1}}},
+                          Case{clvr::test::obliqueParallelCamera(1.8), {{"intermediate", 0}}},
+                          Case{inside, {{"intermediate", 3}, {"early_termination", 0.9}}}}) {
+        clvr::Scene scene;
+        scene.technique = "stack2d";
+        scene.camera = c.camera;
+        scene.image = clvr::ImageSpec{48, 40, {0.1, 0.2, 0.3}};
+        scene.transferFunction = testTransferFunction();
+        scene.options = c.options;
+        clvr::FrameStats stats;
+        const clvr::Image4f kernel = clvr::test::renderScene(scene, volume, &stats);
+        const clvr::Stack2dOptions options = clvr::parseStack2dOptions(scene.options);
+        ASSERT_TRUE(clvr::tools::stack2dCeilingFits(scene, options));
+        const clvr::tools::Stack2dCeiling ceiling(volume, scene.transferFunction, *scene.camera, scene.image, options);
+        const clvr::tools::CeilingResult result = ceiling.render(2);
+        clvr::Image4d want(kernel.width(), kernel.height());
+        for (std::size_t i = 0; i < kernel.pixelCount(); ++i)
+            want.pixels()[i] = glm::dvec4(kernel.pixels()[i]);
+        const clvr::test::ImageError e = clvr::test::imageError(result.image, want);
+        std::printf("[ measured ] stack2d ceiling vs kernel (%s): max %.3g, mean %.3g; samples %llu vs %llu\n",
+                    c.options.dump().c_str(), std::max({e.maxAbs.r, e.maxAbs.g, e.maxAbs.b, e.maxAbs.a}),
+                    std::max({e.meanAbs.r, e.meanAbs.g, e.meanAbs.b, e.meanAbs.a}),
+                    static_cast<unsigned long long>(result.samples), static_cast<unsigned long long>(stats.samples));
+        EXPECT_TRUE(clvr::test::imagesNear(result.image, want, {.maxAbs = 1e-4, .meanAbs = 1e-6}));
+        EXPECT_GT(result.samples, 1000u);
+        if (!c.options.contains("early_termination")) {  // both count every plane met in the box
+            EXPECT_LE(std::abs(static_cast<double>(result.samples) - static_cast<double>(stats.samples)),
+                      1e-4 * static_cast<double>(stats.samples) + 2.0);
+        }
+    }
+    clvr::Scene shaded;
+    shaded.lighting = clvr::test::twoLightLighting();
+    EXPECT_FALSE(clvr::tools::stack2dCeilingFits(shaded, clvr::Stack2dOptions{}));
 }
 
 // ---------------------------------------------------------------------------------------------------

@@ -24,6 +24,7 @@
 #include "tools/ceiling.h"
 #include "tools/ceiling_harc.h"
 #include "tools/ceiling_spherical.h"
+#include "tools/ceiling_stack2d.h"
 
 #if __has_include("raster/rasterizer.h")
 #include "raster/rasterizer.h"
@@ -164,7 +165,8 @@ const Image4d& referenceImage(std::map<std::string, Image4d>& cache, const Scene
 
 // The plain C++ ceiling loop on the same scene, where there is one: slice3d's fused path with per-sample
 // classification (the raster path counts fragments, not samples; pre-integrated slabs and clip meshes are
-// other loops), spherical's fused path. Its frames are interleaved with clvr's (see bench()), so that both
+// other loops), stack2d's fused direct volume rendering (unshaded, no clip texture), spherical's fused
+// path. Its frames are interleaved with clvr's (see bench()), so that both
 // see the same load on a shared machine.
 std::unique_ptr<VolumeCeiling> makeCeiling(const Scene& scene, const Volume& volume, const Camera& camera)
 {
@@ -178,6 +180,12 @@ std::unique_ptr<VolumeCeiling> makeCeiling(const Scene& scene, const Volume& vol
         if (cs.options.path != Slice3dOptions::Path::Fused || cs.options.preintegrated || cs.options.clip)
             return nullptr;
         return std::make_unique<Ceiling>(volume, scene.transferFunction, cs);
+    }
+    if (scene.technique == stack2dTechnique().name) {
+        const Stack2dOptions options = parseStack2dOptions(scene.options);
+        if (!stack2dCeilingFits(scene, options))
+            return nullptr;
+        return std::make_unique<Stack2dCeiling>(volume, scene.transferFunction, camera, scene.image, options);
     }
     if (scene.technique == sphericalTechnique().name) {
         const SphericalOptions options = parseSphericalOptions(scene.options);
