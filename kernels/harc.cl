@@ -11,6 +11,7 @@
 #include "harc_params.h"
 #include "ray.h"
 #include "segment_integral.h"
+#include "transfer_function.h"
 
 /* Per tetrahedron, 5 float4 = 80 bytes (Table 1 of seeds/001 uses 96), host/render/tet/harc.h:
  *   [0..2] barycentric planes (h_i, k_i), i = 0, 1, 2: b_i(x) = dot(h_i, x) + k_i is 1 at vertex i and
@@ -25,6 +26,7 @@
 #define HARC_INTEGRATION_PARTIAL 0
 #define HARC_INTEGRATION_AVERAGE 1
 #define HARC_INTEGRATION_FULL 2
+#define HARC_INTEGRATION_SLICES 3
 
 /* The plain average-of-endpoints segment (the comparison of issue 3 part 6): constant C and τ, the
  * means of their values at s_f and s_b: C (1 - exp(-τ l)). */
@@ -36,6 +38,37 @@ void harc_segment_average(global const float* tf, const int n, const float s_f, 
     const float zeta = exp(-c.w * l);
     *color += *transmittance * (1.0f - zeta) * c.xyz;
     *transmittance *= zeta;
+}
+
+/* tetslice's fused path (HARC_INTEGRATION_SLICES; host/render/tet/tetslice.cpp): the slices of constant eye
+ * depth z_k = z0 + k ds (k < count) whose ray parameter λ_k = z_k / df lies in this cell's [seg_f, seg_b),
+ * each one sample of the cell's linear field s(x) = dot(grad, x) + g0 at e + λ_k d — the scalar
+ * seeds/000 §4.2 interpolates between the cell's two faces at the slice —, classified and composited front
+ * to back with alpha = 1 - exp(-tau ds / df) (ds / df: the ray's length between slices; df = dot(d, forward),
+ * the eye depth per unit λ). λ_k is the same expression in every cell, so a slice on a shared face is taken
+ * once, by the cell beyond it. Returns the slices taken. */
+uint harc_slices(global const float* tf, const int tf_count, const float4 slices, const float df, const float3 e,
+                 const float3 d, const float4 grad, const float seg_f, const float seg_b, float3* color,
+                 float* transmittance)
+{
+    const float z0 = slices.x, ds = slices.y;
+    const int count = (int)slices.z;
+    const float neg_log2e = -(ds / df) * M_LOG2E_F;
+    int k = max((int)ceil((seg_f * df - z0) / ds) - 1, 0); /* one before the first, for rounding */
+    uint taken = 0;
+    for (; k < count; ++k) {
+        const float lambda_k = (z0 + (float)k * ds) / df;
+        if (!(lambda_k < seg_b))
+            break;
+        if (lambda_k < seg_f)
+            continue;
+        const float4 ct = clvr_tf_eval(tf, tf_count, dot(grad.xyz, e + lambda_k * d) + grad.w);
+        const float alpha = 1.0f - clvr_exp2(ct.w * neg_log2e);
+        *color += (*transmittance * alpha) * ct.xyz;
+        *transmittance *= 1.0f - alpha;
+        ++taken;
+    }
+    return taken;
 }
 
 /* Full pre-integration: trilinear lookup of the segment (s_f -> s_b over length l) in the table of
@@ -68,7 +101,8 @@ float4 harc_full_lookup(global const float4* table, const int ns, const int nl, 
  * of pixel p's ray, sorted by ray parameter: (λ as float bits, tet * 4 + face), after (0, -1 - tet) when a
  * perspective eye lies inside tet. params.camera is
  * relative to the mesh's shifted origin. Ray e + λ d, |d| = 1 (kernels/ray.h's clvr_ray_unit, as
- * host/model/camera.cpp's Camera::ray). stats[p] = (steps, 1 if the step bound stopped the ray, pieces).
+ * host/model/camera.cpp's Camera::ray). stats[p] = (steps, 1 if the step bound stopped the ray, pieces;
+ * with HARC_INTEGRATION_SLICES the slices taken).
  * integration: HARC_INTEGRATION_*; full_table, full_ns, full_nl, full_params: harc_full_lookup's
  * table (a one-element dummy unless integration is full). With clip_box (a sort-last part, host/cluster/
  * partition.h) only the ray's part inside [box_lo, box_hi] is integrated: each segment is cut to it, the
@@ -175,6 +209,11 @@ kernel void harc_render(global float4* out, global uint* stats, global const flo
                     pieces += (uint)harc_segment_from(tf, tf_count, psi, psi_n, front, s_b, length, &color,
                                                       &transmittance, &carried);
                     carry = seg_b == lambda_exit;
+                } else if (integration == HARC_INTEGRATION_SLICES) {
+                    const float df = dot(d, params.camera.forward.xyz);
+                    if (df > 0.0f)
+                        pieces += harc_slices(tf, tf_count, params.slices, df, e, d, grad, seg_f, seg_b, &color,
+                                              &transmittance);
                 } else {
                     const float s_f = dot(grad.xyz, e + seg_f * d) + grad.w;
                     if (integration == HARC_INTEGRATION_FULL) {

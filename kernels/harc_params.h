@@ -23,6 +23,8 @@ typedef struct {
     cl_int pad1, pad2;
     cl_float4 box_lo;       /* the part's box, relative to the shifted origin, w = 0 */
     cl_float4 box_hi;
-} ClHarcParams;             /* 192 bytes */
+    cl_float4 slices;       /* HARC_INTEGRATION_SLICES (tetslice's fused path): (eye depth of slice 0, slice
+                             * spacing, slice count, 0) */
+} ClHarcParams;             /* 208 bytes */
 
 #endif

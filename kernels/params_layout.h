@@ -107,6 +107,7 @@ CLVR_LAYOUT_FIELD(ClHarcParams, pad1)
 CLVR_LAYOUT_FIELD(ClHarcParams, pad2)
 CLVR_LAYOUT_FIELD(ClHarcParams, box_lo)
 CLVR_LAYOUT_FIELD(ClHarcParams, box_hi)
+CLVR_LAYOUT_FIELD(ClHarcParams, slices)
 
 CLVR_LAYOUT_SIZE(ClSphericalParams)
 CLVR_LAYOUT_FIELD(ClSphericalParams, camera)

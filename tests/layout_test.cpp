@@ -139,7 +139,7 @@ TEST(Layout, EveryParamsStructFitsTheKernelArgumentSpace)
     EXPECT_EQ(sizeof(ClSlice3dParams), 384u);
     EXPECT_EQ(sizeof(ClPlanesParams), 288u);
     EXPECT_EQ(sizeof(ClBlendParams), 256u);
-    EXPECT_EQ(sizeof(ClHarcParams), 192u);
+    EXPECT_EQ(sizeof(ClHarcParams), 208u);
     EXPECT_EQ(sizeof(ClSphericalParams), 192u);
     EXPECT_EQ(sizeof(ClSphericalFusedParams), 288u);
     EXPECT_EQ(sizeof(ClSlice3dOverBackgroundParams), 32u);

@@ -29,7 +29,8 @@ namespace {
 
 class HarcRenderer final : public Renderer {
 public:
-    HarcRenderer(Device& device, const Scene& scene, const TetMesh& mesh, const TetTopology& topology);
+    HarcRenderer(Device& device, const Scene& scene, const TetMesh& mesh, const TetTopology& topology,
+                 const HarcOptions& options);
     Image4f render(FrameStats& stats) override;
     std::uint64_t residentBytes() const override { return residentBytes_; }
     void setTransferFunction(const TransferFunction& tf) override;
@@ -63,8 +64,9 @@ private:
     std::uint64_t fullBytes_ = 0;
 };
 
-HarcRenderer::HarcRenderer(Device& device, const Scene& scene, const TetMesh& mesh, const TetTopology& topology)
-    : device_(device), options_(parseHarcOptions(scene.options)), image_(scene.image), mesh_(mesh),
+HarcRenderer::HarcRenderer(Device& device, const Scene& scene, const TetMesh& mesh, const TetTopology& topology,
+                           const HarcOptions& options)
+    : device_(device), options_(options), image_(scene.image), mesh_(mesh),
       topology_(topology)
 {
     if (mesh.tets.empty())
@@ -159,6 +161,7 @@ Image4f HarcRenderer::render(FrameStats& stats)
     const cl_uint maxSteps = static_cast<cl_uint>(std::min<std::uint64_t>(maxSteps_, 0xffffffffu));
     const cl_int integration = options_.integration == HarcOptions::Integration::Average ? 1
                                : options_.integration == HarcOptions::Integration::Full  ? 2
+                               : options_.integration == HarcOptions::Integration::Slices ? 3
                                                                                           : 0;
     // The table's sample spacing as PreintegrationTable::lookup computes it (float), so host and device
     // interpolate alike.
@@ -178,6 +181,8 @@ Image4f HarcRenderer::render(FrameStats& stats)
     params.ert_alpha = ert;
     params.full_ns = ns;
     params.full_nl = nl;
+    params.slices = cl_float4{{static_cast<float>(options_.sliceDepth0), static_cast<float>(options_.sliceSpacing),
+                               static_cast<float>(options_.sliceCount), 0.0f}};
     if (part_) {
         params.clip_box = 1;
         params.box_lo = toCl4(part_->lo - shift_);
@@ -228,6 +233,7 @@ Image4f HarcRenderer::render(FrameStats& stats)
     switch (options_.integration) {
     case HarcOptions::Integration::Partial: stats.extra["integration"] = "partial"; break;
     case HarcOptions::Integration::Average: stats.extra["integration"] = "average"; break;
+    case HarcOptions::Integration::Slices: stats.extra["integration"] = "slices"; break;
     case HarcOptions::Integration::Full:
         stats.extra["integration"] = "full";
         stats.extra["full_table"] = std::to_string(ns) + "x" + std::to_string(ns) + "x" + std::to_string(nl);
@@ -565,7 +571,13 @@ void prependEyeEntry(HarcEntryLists& lists, std::uint32_t tet)
 std::unique_ptr<Renderer> makeHarcRenderer(Device& device, const Scene& scene, const TetMesh& mesh,
                                            const TetTopology& topology)
 {
-    return std::make_unique<HarcRenderer>(device, scene, mesh, topology);
+    return std::make_unique<HarcRenderer>(device, scene, mesh, topology, parseHarcOptions(scene.options));
+}
+
+std::unique_ptr<Renderer> makeHarcRenderer(Device& device, const Scene& scene, const TetMesh& mesh,
+                                           const TetTopology& topology, const HarcOptions& options)
+{
+    return std::make_unique<HarcRenderer>(device, scene, mesh, topology, options);
 }
 
 }  // namespace clvr

@@ -22,8 +22,12 @@
 namespace clvr {
 
 struct HarcOptions {
-    enum class Integration { Partial, Average, Full };
+    // Slices: not a harc option but tetslice's fused path (host/render/tet/tetslice.h): the walk samples the
+    // cells' linear field at slices of constant eye depth sliceDepth0 + k sliceSpacing, k < sliceCount.
+    enum class Integration { Partial, Average, Full, Slices };
     Integration integration = Integration::Partial;
+    double sliceDepth0 = 0.0, sliceSpacing = 0.0;
+    int sliceCount = 0;
     int fullScalarSamples = 64;     // "full_table": [NS, NL], the (s_f, s_b, l) table is NS x NS x NL
     int fullLengthSamples = 64;
     std::uint64_t maxSteps = 0;     // per ray; 0 = the default, 4 * cbrt(tets) + 10000
@@ -93,5 +97,8 @@ void prependEyeEntry(HarcEntryLists& lists, std::uint32_t tet);
 // for bad options or an empty mesh, DeviceError when the mesh does not fit on the device.
 std::unique_ptr<Renderer> makeHarcRenderer(Device& device, const Scene& scene, const TetMesh& mesh,
                                            const TetTopology& topology);
+// The same with the options given instead of read from scene.options (tetslice's fused path).
+std::unique_ptr<Renderer> makeHarcRenderer(Device& device, const Scene& scene, const TetMesh& mesh,
+                                           const TetTopology& topology, const HarcOptions& options);
 
 }  // namespace clvr

@@ -4,6 +4,7 @@
 #include "host/render/tet/tetslice.h"
 
 #include "host/render/tet/cell_faces.h"
+#include "host/render/tet/harc.h"
 
 #include "host/render/camera_args.h"
 #include "host/render/options_util.h"
@@ -279,6 +280,7 @@ Image4f TetsliceRenderer::render(FrameStats& stats)
     stats.extra["resident_bytes"] = residentBytes_;
     // The mesh stays on the host; each slice's faces go to the device through the raster stage.
     stats.extra["bytes_per_tet"] = static_cast<double>(residentBytes_) / static_cast<double>(cells);
+    stats.extra["path"] = "raster";
     stats.extra["slices"] = plan.count;
     stats.extra["slice_spacing"] = plan.deltaS;
     stats.extra["cells_listed"] = lists.cellsListed();
@@ -297,7 +299,9 @@ TechniqueInfo tetsliceTechnique()
     t.name = "tetslice";
     t.data = DataKind::Mesh;
     t.description = "direct slicing of tetrahedral grids through cell faces, seeds/000 §4.2 (docs/tetslice.md)";
-    t.options = {slicesInfo(), sliceSpacingInfo()};
+    t.options = {slicesInfo(), sliceSpacingInfo(),
+                 {"path", "fused", "", "\"fused\" (each ray walks the cells and samples the slices in them) or "
+                                       "\"raster\" (the face draws per slice through the raster stage)"}};
     t.makeForMesh = makeTetsliceRenderer;
     return t;
 }
@@ -312,14 +316,59 @@ TetsliceOptions parseTetsliceOptions(const nlohmann::json& options)
             o.slices = slicesOption(value);
         else if (key == "slice_spacing")
             o.sliceSpacing = sliceSpacingOption(value);
+        else if (key == "path")
+            o.path = choiceOption(key, value, {"fused", "raster"}) == 0 ? TetsliceOptions::Path::Fused
+                                                                       : TetsliceOptions::Path::Raster;
         else
             unparsedOption(info, key);
     });
     return o;
 }
 
+namespace {
+
+// The fused path: harc's renderer walking the cells with HARC_INTEGRATION_SLICES at the slices the raster path
+// plans (the same camera frame and mesh box, so the same eye depths), its stats named as tetslice's.
+class TetsliceFusedRenderer final : public Renderer {
+public:
+    TetsliceFusedRenderer(Device& device, const Scene& scene, const TetMesh& mesh)
+    {
+        const TetsliceOptions options = parseTetsliceOptions(scene.options);
+        const glm::dvec3 lo = mesh.boundsMin(), hi = mesh.boundsMax(), shift = 0.5 * (lo + hi);
+        Camera camera = frameCamera(scene, lo, hi);
+        camera.position -= shift;
+        camera.focalPoint -= shift;
+        plan_ = planSlices(camera, lo - shift, hi - shift, options.slices, options.sliceSpacing);
+        HarcOptions harc;
+        harc.integration = HarcOptions::Integration::Slices;
+        harc.sliceDepth0 = plan_.count ? plan_.depth(0) : 0.0;
+        harc.sliceSpacing = plan_.deltaS > 0.0 ? plan_.deltaS : 1.0;
+        harc.sliceCount = plan_.count;
+        walk_ = makeHarcRenderer(device, scene, mesh, buildTopology(mesh), harc);
+    }
+    Image4f render(FrameStats& stats) override
+    {
+        Image4f image = walk_->render(stats);
+        stats.samples = stats.extra["pieces"].get<std::uint64_t>();  // slices taken inside cells
+        stats.extra["path"] = "fused";
+        stats.extra["slices"] = plan_.count;
+        stats.extra["slice_spacing"] = plan_.deltaS;
+        return image;
+    }
+    std::uint64_t residentBytes() const override { return walk_->residentBytes(); }
+    void setTransferFunction(const TransferFunction& tf) override { walk_->setTransferFunction(tf); }
+
+private:
+    SlicePlan plan_;
+    std::unique_ptr<Renderer> walk_;
+};
+
+}  // namespace
+
 std::unique_ptr<Renderer> makeTetsliceRenderer(Device& device, const Scene& scene, const TetMesh& mesh)
 {
+    if (parseTetsliceOptions(scene.options).path == TetsliceOptions::Path::Fused)
+        return std::make_unique<TetsliceFusedRenderer>(device, scene, mesh);
     return std::make_unique<TetsliceRenderer>(device, scene, mesh);
 }
 

@@ -6,7 +6,8 @@
 // faces, alpha test <= the slice, depth test GREATER keeping the farthest, only where the stencil is
 // set. kernels/tetslice.cl interpolates the scalar at the slice between the two faces of one cell
 // (the paper's S = (R-d)/(R-B) G + (d-B)/(R-B) alpha), classifies it and blends the slab back to front.
-// docs/tetslice.md.
+// The fused path ("path": "fused", the default) walks each ray through the cells instead (harc's walk) and
+// samples the same slices. docs/tetslice.md.
 #pragma once
 
 #include "host/model/camera.h"
@@ -24,12 +25,17 @@ namespace clvr {
 struct TetsliceOptions {
     int slices = 256;           // slices across the mesh box's eye-depth range ...
     double sliceSpacing = 0.0;  // ... or, when > 0, this spacing in world units (then slices is derived)
+    // Raster: the face draws per slice (the paper's method, the specification). Fused: each pixel's ray walks
+    // the cells through their adjacency (harc's walk, kernels/harc.cl HARC_INTEGRATION_SLICES) and samples
+    // each cell's linear field at the slices inside it — the scalar the face draws interpolate.
+    enum class Path { Fused, Raster };
+    Path path = Path::Fused;
 };
 
 // Its registry entry (host/render/renderer.h).
 TechniqueInfo tetsliceTechnique();
 
-// Reads the scene's "options" for tetslice: "slices", "slice_spacing" (as slice3d's). InputError naming
+// Reads the scene's "options" for tetslice: "slices", "slice_spacing" (as slice3d's), "path". InputError naming
 // the key for unknown keys, wrong types and values out of range.
 TetsliceOptions parseTetsliceOptions(const nlohmann::json& options);
 
