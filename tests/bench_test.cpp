@@ -535,7 +535,8 @@ TEST(BenchTetfaces, ScenesAreValidAndHarcTwinsDifferOnlyInTheTechnique)
         present.push_back(file.filename().string());
     std::sort(listed.begin(), listed.end());
     EXPECT_EQ(listed, present);
-    ASSERT_EQ(files.size(), 11u);  // 4 meshes x (tetslice, harc) + the automaton x (tetiso, tetslice, harc)
+    // 4 meshes x (tetslice's face draws, its fused path, harc) + the automaton x (tetiso, the two tetslice, harc)
+    ASSERT_EQ(files.size(), 16u);
     for (const auto& file : files) {
         const clvr::Scene scene = clvr::loadScene(file);
         const std::string name = file.filename().string();
@@ -549,6 +550,17 @@ TEST(BenchTetfaces, ScenesAreValidAndHarcTwinsDifferOnlyInTheTechnique)
             EXPECT_TRUE(*scene.mesh == *other.mesh) << name;
             EXPECT_EQ(scene.camera->position, other.camera->position) << name;
             EXPECT_EQ(other.options["slices"].get<int>(), 400) << name;
+            EXPECT_EQ(other.options["path"], "raster") << name;  // seeds/000's method
+        }
+        if (name.ends_with("-fused-tetslice.json")) {  // its face-draw twin but for the path
+            std::string twin = name;
+            twin.replace(twin.find("-fused-tetslice.json"), std::string::npos, "-tetslice.json");
+            const clvr::Scene other = clvr::loadScene(file.parent_path() / twin);
+            EXPECT_TRUE(*scene.mesh == *other.mesh) << name;
+            EXPECT_EQ(scene.options["path"], "fused") << name;
+            nlohmann::json raster = scene.options;
+            raster["path"] = "raster";
+            EXPECT_EQ(raster, other.options) << name;
         }
     }
 }

@@ -49,9 +49,9 @@ std::vector<std::string> benchSuiteScenes(const std::string& suite)
     // each beside harc on the same scene.
     std::vector<std::string> tetfaces;
     for (const char* mesh : {"fedata0", "fedata1", "fedata2", "fedata3"})
-        for (const char* technique : {"tetslice", "harc"})
+        for (const char* technique : {"tetslice", "fused-tetslice", "harc"})
             tetfaces.push_back(std::string("tetfaces-") + mesh + "-" + technique + ".json");
-    for (const char* technique : {"tetiso", "tetslice", "harc"})
+    for (const char* technique : {"tetiso", "tetslice", "fused-tetslice", "harc"})
         tetfaces.push_back(std::string("tetfaces-automaton-") + technique + ".json");
     // seeds/002 Figure 9 on the engine (tools/make_cubefan_bench.py): error 0, 18 %, 48 %, the same with
     // each fragment's exact chord, then slice3d on the same view with 1024 slices (its full quality) and fewer.

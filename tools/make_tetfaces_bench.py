@@ -12,12 +12,14 @@ TetGen at load time to about 60k, 110k, 150k and 200k tetrahedra (max_volume bel
 the bench output and BENCHMARKS.md), with the "glowing kernel" field (generator "kernel",
 host/io/generators.h) and a transfer function from blue to yellow with rising temperature, as the
 paper's figure; 400 slices at 400x400, as the paper.
-  tetfaces-fedataN-tetslice   tetslice, 400 slices
-  tetfaces-fedataN-harc       harc on the same scene
+  tetfaces-fedataN-tetslice         tetslice, 400 slices, the paper's face draws ("path": "raster")
+  tetfaces-fedataN-fused-tetslice   the same on tetslice's fused path (the cells walked, the same slices)
+  tetfaces-fedataN-harc             harc on the same scene
 The binary cellular automaton: 8,000 living cells of a 40^3 lattice, 12 tetrahedra each, no shared
 vertices, value 1 at the centres and 0 at the corners (mesh generator "automaton"):
   tetfaces-automaton-tetiso     the iso-surface at 0.5 (tetiso)
-  tetfaces-automaton-tetslice   direct rendering, 400 slices (tetslice)
+  tetfaces-automaton-tetslice   direct rendering, 400 slices (tetslice, face draws)
+  tetfaces-automaton-fused-tetslice   the same on tetslice's fused path
   tetfaces-automaton-harc       harc on the same scene as tetslice
 """
 import os
@@ -47,22 +49,26 @@ def scenes():
     out = []
     for name, max_volume in FEDATA:
         mesh = {"surface": "../../surfaces/l-block.poly", "quality": 1.5, "max_volume": max_volume, "scalar": "kernel"}
-        for technique, options in (("tetslice", {"slices": 400}), ("harc", None)):
+        for label, technique, options in (("tetslice", "tetslice", {"slices": 400, "path": "raster"}),
+                                          ("fused-tetslice", "tetslice", {"slices": 400, "path": "fused"}),
+                                          ("harc", "harc", None)):
             scene = {"technique": technique, "mesh": mesh, "camera": FE_CAMERA, "image": IMAGE,
                      "transfer_function": FE_TF}
             if options:
                 scene["options"] = options
-            out.append(("tetfaces-%s-%s.json" % (name, technique), scene))
+            out.append(("tetfaces-%s-%s.json" % (name, label), scene))
     automaton = {"generator": "automaton", "cells": 8000, "grid": 40}
     out.append(("tetfaces-automaton-tetiso.json",
                 {"technique": "tetiso", "mesh": automaton, "camera": AUTOMATON_CAMERA, "image": IMAGE,
                  "transfer_function": AUTOMATON_TF, "iso": {"value": 0.5}}))
-    for technique, options in (("tetslice", {"slices": 400}), ("harc", None)):
+    for label, technique, options in (("tetslice", "tetslice", {"slices": 400, "path": "raster"}),
+                                      ("fused-tetslice", "tetslice", {"slices": 400, "path": "fused"}),
+                                      ("harc", "harc", None)):
         scene = {"technique": technique, "mesh": automaton, "camera": AUTOMATON_CAMERA, "image": IMAGE,
                  "transfer_function": AUTOMATON_TF}
         if options:
             scene["options"] = options
-        out.append(("tetfaces-automaton-%s.json" % technique, scene))
+        out.append(("tetfaces-automaton-%s.json" % label, scene))
     return out
 
 
