@@ -13,24 +13,24 @@
 namespace clvr::tools {
 
 Ceiling::Ceiling(const Volume& volume, const TransferFunction& tf, const CeilingScene& scene)
-    : volume_(volume), scene_(scene),
+    : VolumeCeiling(scene.width, scene.height), volume_(volume), scene_(scene),
       plan_(planSlices(scene.camera, volume.boundsMin(), volume.boundsMax(), scene.options)), classify_(volume, tf)
 {
 }
 
-CeilingResult Ceiling::render(int threads) const
+CeilingResult VolumeCeiling::render(int threads) const
 {
     if (threads <= 0)
         threads = threadBudget();
     CeilingResult result;
-    result.image = Image4f(scene_.width, scene_.height);
+    result.image = Image4f(width_, height_);
     std::atomic<int> nextRow{0};
     std::vector<std::uint64_t> samples(threads, 0);
     std::vector<std::thread> pool;
     for (int t = 0; t < threads; ++t)
         pool.emplace_back([&, t] {
             std::uint64_t count = 0;
-            for (int y; (y = nextRow.fetch_add(1)) < scene_.height;)
+            for (int y; (y = nextRow.fetch_add(1)) < height_;)
                 count += renderRow(y, result.image);
             samples[t] = count;
         });

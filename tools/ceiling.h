@@ -83,22 +83,28 @@ private:
 class VolumeCeiling {
 public:
     virtual ~VolumeCeiling() = default;
-    // Renders with `threads` threads taking rows from a shared counter (<= 0: the thread budget, host/runtime/parallel.h).
-    virtual CeilingResult render(int threads = 0) const = 0;
+    // Renders with `threads` threads taking rows from a shared counter (<= 0: the thread budget,
+    // host/runtime/parallel.h); the samples are renderRow's, summed.
+    CeilingResult render(int threads = 0) const;
     // What the bench report says about the loop's work (slice3d: slices and spacing; spherical: shells).
     virtual nlohmann::json describe() const = 0;
+
+protected:
+    VolumeCeiling(int width, int height) : width_(width), height_(height) {}
+    // Row y of the image (row 0 at the top); returns the samples taken.
+    virtual std::uint64_t renderRow(int y, Image4f& image) const = 0;
+    int width_, height_;
 };
 
 class Ceiling final : public VolumeCeiling {
 public:
     Ceiling(const Volume& volume, const TransferFunction& tf, const CeilingScene& scene);
-    CeilingResult render(int threads = 0) const override;
     nlohmann::json describe() const override { return {{"slices", plan_.count}, {"slice_spacing", plan_.deltaS}}; }
     // The slices, as slice3d plans them (planSlices).
     const SlicePlan& plan() const { return plan_; }
 
 private:
-    std::uint64_t renderRow(int y, Image4f& image) const;
+    std::uint64_t renderRow(int y, Image4f& image) const override;
 
     const Volume& volume_;
     CeilingScene scene_;

@@ -3,10 +3,7 @@
 // std::threads.
 #include "tools/ceiling_spherical.h"
 
-#include "host/runtime/parallel.h"
-
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <thread>
 
@@ -40,7 +37,7 @@ float atan2Poly(float y, float x)
 
 SphericalCeiling::SphericalCeiling(const Volume& volume, const TransferFunction& tf, const Camera& camera,
                                    const ImageSpec& image, const SphericalOptions& options)
-    : volume_(volume), camera_(camera), width_(image.width), height_(image.height),
+    : VolumeCeiling(image.width, image.height), volume_(volume), camera_(camera),
       background_(glm::vec3(image.background)), center_(glm::vec3(options.domain.center)),
       phiS0_(0.5f / volume.dims.x), phiPeriod_((volume.dims.x - 1.0f) / volume.dims.x),
       ertAlpha_(options.earlyTermination < 1.0 ? static_cast<float>(options.earlyTermination) : 2.0f),
@@ -53,29 +50,6 @@ SphericalCeiling::SphericalCeiling(const Volume& volume, const TransferFunction&
     matrix_ = t.colorMatrix;
     scale_ = t.scale;
     bias_ = t.bias;
-}
-
-CeilingResult SphericalCeiling::render(int threads) const
-{
-    if (threads <= 0)
-        threads = threadBudget();
-    CeilingResult result;
-    result.image = Image4f(width_, height_);
-    std::atomic<int> nextRow{0};
-    std::vector<std::uint64_t> samples(threads, 0);
-    std::vector<std::thread> pool;
-    for (int t = 0; t < threads; ++t)
-        pool.emplace_back([&, t] {
-            std::uint64_t count = 0;
-            for (int y; (y = nextRow.fetch_add(1)) < height_;)
-                count += renderRow(y, result.image);
-            samples[t] = count;
-        });
-    for (std::thread& th : pool)
-        th.join();
-    for (std::uint64_t s : samples)
-        result.samples += s;
-    return result;
 }
 
 std::uint64_t SphericalCeiling::renderRow(int y, Image4f& image) const

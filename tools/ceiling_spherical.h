@@ -27,16 +27,13 @@ public:
     // The volume and options as spherical renders them, the camera it uses (Session::camera), the image.
     SphericalCeiling(const Volume& volume, const TransferFunction& tf, const Camera& camera, const ImageSpec& image,
                      const SphericalOptions& options);
-    // Renders with `threads` threads taking rows from a shared counter (<= 0: the thread budget).
-    CeilingResult render(int threads = 0) const override;
     nlohmann::json describe() const override { return {{"shells", shells_.size()}}; }
 
 private:
-    std::uint64_t renderRow(int y, Image4f& image) const;
+    std::uint64_t renderRow(int y, Image4f& image) const override;
 
     const Volume& volume_;
     Camera camera_;
-    int width_, height_;
     glm::vec3 background_;
     std::vector<glm::vec4> shells_;  // (radius, r_lo, r_hi, w), as the kernel's shell table
     glm::vec3 center_;

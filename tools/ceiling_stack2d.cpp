@@ -3,10 +3,7 @@
 // std::threads.
 #include "tools/ceiling_stack2d.h"
 
-#include "host/runtime/parallel.h"
-
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <limits>
 #include <thread>
@@ -40,7 +37,7 @@ bool stack2dCeilingFits(const Scene& scene, const Stack2dOptions& options)
 
 Stack2dCeiling::Stack2dCeiling(const Volume& volume, const TransferFunction& tf, const Camera& camera,
                                const ImageSpec& image, const Stack2dOptions& options)
-    : stack_(stackVolume(volume, stackAxis(camera))), camera_(camera), width_(image.width), height_(image.height),
+    : VolumeCeiling(image.width, image.height), stack_(stackVolume(volume, stackAxis(camera))), camera_(camera),
       background_(glm::vec3(image.background)), axis_(stackAxis(camera)),
       planes_((volume.dims[axis_] - 1) * (options.intermediate + 1) + 1),
       step_(static_cast<float>(1.0 / (options.intermediate + 1))),
@@ -54,29 +51,6 @@ Stack2dCeiling::Stack2dCeiling(const Volume& volume, const TransferFunction& tf,
         toStack_[r][axes[r]] = static_cast<float>(1.0 / volume.spacing[axes[r]]);
         toStack_[r].w = static_cast<float>(-volume.origin[axes[r]] / volume.spacing[axes[r]]);
     }
-}
-
-CeilingResult Stack2dCeiling::render(int threads) const
-{
-    if (threads <= 0)
-        threads = threadBudget();
-    CeilingResult result;
-    result.image = Image4f(width_, height_);
-    std::atomic<int> nextRow{0};
-    std::vector<std::uint64_t> samples(threads, 0);
-    std::vector<std::thread> pool;
-    for (int t = 0; t < threads; ++t)
-        pool.emplace_back([&, t] {
-            std::uint64_t count = 0;
-            for (int y; (y = nextRow.fetch_add(1)) < height_;)
-                count += renderRow(y, result.image);
-            samples[t] = count;
-        });
-    for (std::thread& th : pool)
-        th.join();
-    for (std::uint64_t s : samples)
-        result.samples += s;
-    return result;
 }
 
 std::uint64_t Stack2dCeiling::renderRow(int y, Image4f& image) const

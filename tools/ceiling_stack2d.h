@@ -27,15 +27,13 @@ public:
     // texture: stack2dCeilingFits), the camera it uses (Session::camera), the image.
     Stack2dCeiling(const Volume& volume, const TransferFunction& tf, const Camera& camera, const ImageSpec& image,
                    const Stack2dOptions& options);
-    CeilingResult render(int threads = 0) const override;
     nlohmann::json describe() const override { return {{"axis", axis_}, {"planes", planes_}}; }
 
 private:
-    std::uint64_t renderRow(int y, Image4f& image) const;
+    std::uint64_t renderRow(int y, Image4f& image) const override;
 
     Volume stack_;  // the drawn stack as a volume of (b, c, axis) grid points, as the kernel reads it
     Camera camera_;
-    int width_, height_;
     glm::vec3 background_;
     int axis_, planes_;
     float step_, ertAlpha_;
