@@ -18,4 +18,15 @@ typedef struct {
     cl_float4 scale;   /* (l_max, tau_max, texture size N, 0): the texture's axes u = l / l_max, v = tau / tau_max */
 } ClCubefanUniforms;   /* 112 bytes */
 
+/* cubefan_fused's parameters (the fused path: each pixel's ray walks the selected cubes). */
+typedef struct {
+    ClCamera camera;        /* relative to the renderer's shifted origin (the cube field's centre) */
+    cl_float4 field_lo;     /* xyz: the cube field's low corner, relative to the same origin */
+    cl_float4 inv_spacing;  /* xyz: 1 / grid spacing: q = (p - field_lo) inv_spacing puts voxel i's cube at [i, i + 1) */
+    cl_float4 background;   /* rgb */
+    cl_int4 dims;           /* xyz: voxels per axis (the selection grid's) */
+    cl_int width, height, tf_count;
+    cl_float ert_alpha;     /* stop once the opacity reaches this; > 1: never */
+} ClCubefanFusedParams;     /* 160 bytes */
+
 #endif

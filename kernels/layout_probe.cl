@@ -2,6 +2,7 @@
 // them (kernels/params_layout.h's list, in its order), for tests/layout_test.cpp to compare with the
 // host's. The raster stage's layouts have their own probe in kernels/raster.cl.
 #include "blend_params.h"
+#include "cubefan_params.h"
 #include "harc_entry_params.h"
 #include "harc_params.h"
 #include "iso3d_params.h"

@@ -14,6 +14,7 @@
 #include "host/io/generators.h"
 #include "host/io/mesh_io.h"
 #include "host/reference/reference_integral.h"
+#include "host/render/grid/cubefan.h"
 #include "host/reference/tet_reference.h"
 #include "raster/reference/pixel_transfer.h"
 #include "host/render/renderer.h"
@@ -578,9 +579,9 @@ TEST(BenchCubefan, ScenesShareTheViewAndEachGroupStartsWithItsFullQualityScene)
         present.push_back(file.filename().string());
     std::sort(sorted.begin(), sorted.end());
     EXPECT_EQ(sorted, present);
-    ASSERT_EQ(listed.size(), 10u);
+    ASSERT_EQ(listed.size(), 13u);
     EXPECT_EQ(listed.front(), "cubefan-engine-e0.json");
-    EXPECT_EQ(listed[5], "cubefan-slice3d-1024.json");
+    EXPECT_EQ(listed[8], "cubefan-slice3d-1024.json");
     const clvr::Scene first = clvr::loadScene(files.front().parent_path() / listed.front());
     EXPECT_EQ(first.options["error"].get<double>(), 0.0);
     for (const std::string& name : listed) {
@@ -589,6 +590,11 @@ TEST(BenchCubefan, ScenesShareTheViewAndEachGroupStartsWithItsFullQualityScene)
         EXPECT_EQ(scene.camera->position, first.camera->position) << name;
         EXPECT_EQ(scene.transferFunction.points().size(), first.transferFunction.points().size()) << name;
         EXPECT_EQ(scene.technique, name.starts_with("cubefan-engine-") ? "cubefan" : "slice3d") << name;
+        if (name.starts_with("cubefan-engine-")) {  // e: the paper's fans, x: exact chords on the raster path, f: fused
+            const clvr::CubefanOptions o = clvr::parseCubefanOptions(scene.options);
+            EXPECT_EQ(o.path, name[15] == 'f' ? clvr::CubefanOptions::Path::Fused : clvr::CubefanOptions::Path::Raster) << name;
+            EXPECT_EQ(o.exactThickness, name[15] == 'x') << name;
+        }
     }
 }
 

@@ -438,5 +438,63 @@ TEST(CubefanOctree, SelectionIsWithinToleranceAndBackToFront)
     EXPECT_EQ(tree.select(1.0, tf, views[0].eye, forward, false).size(), tf(tree.value(tree.levels() - 1, glm::ivec3(0))).a > 0.0 ? 1u : 0u);
 }
 
+// The fused path's selection grid holds the same selection as select(): every selected cube's voxels carry
+// its level and value, every other voxel (and the bricks' padding beyond the grid) is marked transparent,
+// and the counts agree. Checked voxel by voxel through selectionGridIndex, which must be a one-to-one map
+// into the grid.
+TEST(CubefanOctree, SelectionGridHoldsTheSelectedCubes)
+{
+    const Volume v = randomVolume({9, 6, 7}, 5);
+    const CubeOctree tree(v);
+    const TransferFunction tf({{0.0, glm::dvec3(0.0), 0.0}, {0.3, glm::dvec3(0.0), 0.0}, {0.5, glm::dvec3(1.0), 2.0},
+                               {1.0, glm::dvec3(1.0), 3.0}});
+    for (const double tolerance : {0.0, 0.3, 0.6, 1.0}) {
+        SelectionStats listed, gridded;
+        const std::vector<Cube> cubes = tree.select(tolerance, tf, glm::dvec3(6.0, -3.0, 9.0), glm::dvec3(0, 0, 1), false, &listed);
+        const CubeOctree::SelectionGrid grid = tree.selectGrid(tolerance, tf, &gridded);
+        ASSERT_EQ(grid.level.size(), std::size_t(3 * 2 * 2 * 64));  // 9 x 6 x 7 voxels in bricks of 4^3
+        ASSERT_EQ(grid.value.size(), grid.level.size());
+        EXPECT_EQ(gridded.selected, listed.selected);
+        EXPECT_EQ(gridded.transparent, listed.transparent);
+        EXPECT_EQ(gridded.visited, listed.visited);
+        EXPECT_EQ(gridded.largestDiagonal, listed.largestDiagonal);
+        std::vector<int> owner(grid.level.size(), -1);  // the selected cube holding each entry
+        for (std::size_t c = 0; c < cubes.size(); ++c) {
+            const glm::ivec3 first = cubes[c].index * (1 << cubes[c].level);
+            const glm::ivec3 end = glm::min(first + (1 << cubes[c].level), v.dims);
+            glm::ivec3 p;
+            for (p.z = first.z; p.z < end.z; ++p.z)
+                for (p.y = first.y; p.y < end.y; ++p.y)
+                    for (p.x = first.x; p.x < end.x; ++p.x) {
+                        const std::size_t at = selectionGridIndex(p, v.dims);
+                        ASSERT_LT(at, owner.size());
+                        EXPECT_EQ(owner[at], -1) << "two cubes on one voxel";
+                        owner[at] = static_cast<int>(c);
+                    }
+        }
+        std::size_t entries = 0;
+        glm::ivec3 p;
+        for (p.z = 0; p.z < v.dims.z; ++p.z)
+            for (p.y = 0; p.y < v.dims.y; ++p.y)
+                for (p.x = 0; p.x < v.dims.x; ++p.x, ++entries) {
+                    const std::size_t at = selectionGridIndex(p, v.dims);
+                    const int c = owner[at];
+                    owner[at] = -2;  // seen: a second voxel on this entry would find -2
+                    ASSERT_NE(c, -2) << "two voxels on one entry";
+                    if (c < 0) {
+                        EXPECT_TRUE(grid.level[at] & CubeOctree::kTransparent);
+                        continue;
+                    }
+                    EXPECT_EQ(grid.level[at], cubes[c].level);
+                    EXPECT_EQ(grid.value[at], cubes[c].value);
+                }
+        EXPECT_EQ(entries, std::size_t(9 * 6 * 7));
+        for (std::size_t at = 0; at < owner.size(); ++at)  // the padding: transparent
+            if (owner[at] == -1) {
+                EXPECT_TRUE(grid.level[at] & CubeOctree::kTransparent) << at;
+            }
+    }
+}
+
 }  // namespace
 }  // namespace clvr::cubefan

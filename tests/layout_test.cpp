@@ -6,6 +6,7 @@
 #include "tests/support/test_util.h"
 
 #include "kernels/blend_params.h"
+#include "kernels/cubefan_params.h"
 #include "kernels/harc_entry_params.h"
 #include "kernels/harc_params.h"
 #include "kernels/iso3d_params.h"

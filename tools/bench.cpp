@@ -455,7 +455,7 @@ void printCubefanTable(const nlohmann::json& scenes)
         table << std::left << std::setw(26) << r["name"].get<std::string>() << std::right << std::setw(7)
               << (cubefan ? fixed(100.0 * e["error"].get<double>(), 0) + " %" : std::string("-")) << std::setw(10)
               << (cubefan ? si(e["cubes"].get<double>()) : std::string("-")) << std::setw(11)
-              << (cubefan ? si(e["triangles"].get<double>()) : std::string("-")) << std::setw(11)
+              << (cubefan && e.contains("triangles") ? si(e["triangles"].get<double>()) : std::string("-")) << std::setw(11)
               << (cubefan ? fixed(selection, 1) : std::string("-")) << std::setw(11)
               << fixed(r["frame_ms"].get<double>() - selection, 1) << std::setw(10) << fixed(r["frame_ms"].get<double>(), 1);
         if (r.contains("image_diff_vs_group_first"))
@@ -769,8 +769,10 @@ int bench(const BenchOptions& options)
             // seeds/002 Figure 9: rendering time excludes the selection, as the paper's does.
             const nlohmann::json& e = stats.extra;
             std::cout << "  figure 9     error " << fixed(100.0 * e["error"].get<double>(), 0) << " %: "
-                      << si(e["cubes"].get<double>()) << " cubes, " << si(e["triangles"].get<double>())
-                      << " triangles, selection " << fixed(e["selection_ms"].get<double>(), 1) << " ms, rendering "
+                      << si(e["cubes"].get<double>()) << " cubes, "
+                      << (e.contains("triangles") ? si(e["triangles"].get<double>()) + " triangles"
+                                                  : si(e["cubes_crossed"].get<double>()) + " cube chords (fused)")
+                      << ", selection " << fixed(e["selection_ms"].get<double>(), 1) << " ms, rendering "
                       << fixed(s.median - e["selection_ms"].get<double>(), 1) << " ms; hierarchy built in "
                       << fixed(e["hierarchy_ms"].get<double>(), 0) << " ms\n";
         }

@@ -53,10 +53,11 @@ std::vector<std::string> benchSuiteScenes(const std::string& suite)
             tetfaces.push_back(std::string("tetfaces-") + mesh + "-" + technique + ".json");
     for (const char* technique : {"tetiso", "tetslice", "fused-tetslice", "harc"})
         tetfaces.push_back(std::string("tetfaces-automaton-") + technique + ".json");
-    // seeds/002 Figure 9 on the engine (tools/make_cubefan_bench.py): error 0, 18 %, 48 %, the same with
-    // each fragment's exact chord, then slice3d on the same view with 1024 slices (its full quality) and fewer.
+    // seeds/002 Figure 9 on the engine (tools/make_cubefan_bench.py): error 0, 18 %, 48 % (the fans), 0 and
+    // 18 % with each fragment's exact chord, the fused path at the three tolerances, then slice3d on the same
+    // view with 1024 slices (its full quality) and fewer.
     std::vector<std::string> cubefan;
-    for (const char* run : {"e0", "e18", "e48", "x0", "x18"})
+    for (const char* run : {"e0", "e18", "e48", "x0", "x18", "f0", "f18", "f48"})
         cubefan.push_back(std::string("cubefan-engine-") + run + ".json");
     for (const char* slices : {"1024", "256", "128", "64", "32"})
         cubefan.push_back(std::string("cubefan-slice3d-") + slices + ".json");

@@ -9,8 +9,10 @@ view beside them.
 
 The engine block (256x256x128 here; the paper's is 256x256x110) at 512x512 in perspective, with the camera
 and transfer function of data/scenes/engine.json (unshaded):
-  cubefan-engine-e0, -e18, -e48   cubefan at 0 %, 18 % and 48 % error tolerance (the paper's three images)
+  cubefan-engine-e0, -e18, -e48   cubefan at 0 %, 18 % and 48 % error tolerance (the paper's three images:
+                                  its triangle fans, "path": "raster")
   cubefan-engine-x0, -x18         the same at 0 % and 18 % with "thickness": "exact" (each fragment's chord)
+  cubefan-engine-f0, -f18, -f48   the fused path (each pixel's ray walks the selected cubes) at 0, 18, 48 %
   cubefan-slice3d-1024            slice3d (fused) on the same view with 1024 slices: its full quality
   cubefan-slice3d-256, -128, -64, -32   slice3d with fewer slices
 clvr bench compares every scene with the first of its group (the name up to its last '-'): the cubefan
@@ -44,10 +46,13 @@ def scene(technique, options):
 def scenes():
     out = []
     for run, error, thickness in [("e0", 0.0, None), ("e18", 0.18, None), ("e48", 0.48, None),
-                                  ("x0", 0.0, "exact"), ("x18", 0.18, "exact")]:
+                                  ("x0", 0.0, "exact"), ("x18", 0.18, "exact"),
+                                  ("f0", 0.0, None), ("f18", 0.18, None), ("f48", 0.48, None)]:
         options = {"error": error}
         if thickness:
             options["thickness"] = thickness
+        elif run[0] == "e":
+            options["path"] = "raster"
         out.append(("cubefan-engine-" + run + ".json", scene("cubefan", options)))
     for slices in [1024, 256, 128, 64, 32]:
         out.append(("cubefan-slice3d-%d.json" % slices, scene("slice3d", {"slices": slices})))

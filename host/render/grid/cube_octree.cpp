@@ -89,6 +89,17 @@ void CubeOctree::box(int level, const glm::ivec3& i, glm::dvec3& lo, glm::dvec3&
     }
 }
 
+CubeOctree::Verdict CubeOctree::verdict(int level, const glm::ivec3& i, double allowed, const TransferFunction& tf) const
+{
+    const Level& l = levels_[level];
+    const std::size_t j = at(level, i);
+    if (tauZeroOn(tf, l.min[j], l.max[j]))
+        return Verdict::Transparent;  // the whole subtree
+    if (level == 0 || error(level, i) <= allowed)
+        return tf(l.mean[j]).a <= 0.0 ? Verdict::Transparent : Verdict::Take;
+    return Verdict::Descend;
+}
+
 std::vector<Cube> CubeOctree::select(double tolerance, const TransferFunction& tf, const glm::dvec3& eye,
                                      const glm::dvec3& forward, bool parallel, SelectionStats* stats) const
 {
@@ -98,21 +109,16 @@ std::vector<Cube> CubeOctree::select(double tolerance, const TransferFunction& t
     // Recursion depth is the level count (at most 32 for any int dims), so plain recursion is bounded.
     auto visit = [&](auto&& self, int level, const glm::ivec3& i) -> void {
         ++s.visited;
-        const Level& l = levels_[level];
-        const std::size_t j = at(level, i);
-        if (tauZeroOn(tf, l.min[j], l.max[j])) {
+        const Verdict v = verdict(level, i, allowed, tf);
+        if (v == Verdict::Transparent) {
             ++s.transparent;
             return;
         }
-        if (level == 0 || error(level, i) <= allowed) {
-            if (tf(l.mean[j]).a <= 0.0) {
-                ++s.transparent;
-                return;
-            }
+        if (v == Verdict::Take) {
             Cube c;
             c.level = level;
             c.index = i;
-            c.value = l.mean[j];
+            c.value = value(level, i);
             box(level, i, c.lo, c.hi);
             s.largestDiagonal = std::max(s.largestDiagonal, glm::length(c.hi - c.lo));
             out.push_back(c);
@@ -139,6 +145,56 @@ std::vector<Cube> CubeOctree::select(double tolerance, const TransferFunction& t
     if (stats)
         *stats = s;
     return out;
+}
+
+CubeOctree::SelectionGrid CubeOctree::selectGrid(double tolerance, const TransferFunction& tf, SelectionStats* stats) const
+{
+    SelectionGrid grid;
+    const glm::ivec3 bricks = (voxels_ + 3) / 4;
+    const std::size_t count = static_cast<std::size_t>(bricks.x) * bricks.y * bricks.z * 64;
+    grid.level.assign(count, kTransparent);  // the bricks' padding beyond the grid adds nothing
+    grid.value.assign(count, 0.0f);
+    SelectionStats s;
+    const double allowed = tolerance * range_;
+    // Writes the cube's level (and flag) and value into every voxel below it.
+    auto fill = [&](int level, const glm::ivec3& i, std::uint8_t code, float v) {
+        const glm::ivec3 first = i * (1 << level);
+        const glm::ivec3 end = glm::min(first + (1 << level), voxels_);
+        glm::ivec3 p;
+        for (p.z = first.z; p.z < end.z; ++p.z)
+            for (p.y = first.y; p.y < end.y; ++p.y)
+                for (p.x = first.x; p.x < end.x; ++p.x) {
+                    const std::size_t at = selectionGridIndex(p, voxels_);
+                    grid.level[at] = code;
+                    grid.value[at] = v;
+                }
+    };
+    auto visit = [&](auto&& self, int level, const glm::ivec3& i) -> void {
+        ++s.visited;
+        const Verdict v = verdict(level, i, allowed, tf);
+        if (v == Verdict::Descend) {
+            const glm::ivec3 childDims = levels_[level - 1].dims;
+            for (int m = 0; m < 8; ++m) {
+                const glm::ivec3 ci = 2 * i + glm::ivec3(m & 1, (m >> 1) & 1, (m >> 2) & 1);
+                if (glm::all(glm::lessThan(ci, childDims)))
+                    self(self, level - 1, ci);
+            }
+            return;
+        }
+        const bool transparent = v == Verdict::Transparent;
+        s.transparent += transparent ? 1 : 0;
+        if (!transparent) {
+            ++s.selected;
+            glm::dvec3 lo, hi;
+            box(level, i, lo, hi);
+            s.largestDiagonal = std::max(s.largestDiagonal, glm::length(hi - lo));
+        }
+        fill(level, i, static_cast<std::uint8_t>(level | (transparent ? kTransparent : 0)), value(level, i));
+    };
+    visit(visit, levels() - 1, glm::ivec3(0));
+    if (stats)
+        *stats = s;
+    return grid;
 }
 
 }  // namespace clvr::cubefan

@@ -33,6 +33,17 @@ struct SelectionStats {
     double largestDiagonal = 0.0;   // of the selected cubes, world units
 };
 
+// Voxel v's place in a selection grid over `dims` voxels: bricks of 4 x 4 x 4 (64 entries, the level bytes
+// of one cache line), the bricks x fastest and the voxels inside each x fastest; the grid has
+// ceil(dims / 4) bricks per axis (kernels/cubefan.cl's cubefan_at).
+inline std::size_t selectionGridIndex(const glm::ivec3& v, const glm::ivec3& dims)
+{
+    const glm::ivec3 bricks = (dims + 3) / 4;
+    const std::size_t brick =
+        (static_cast<std::size_t>(v.z >> 2) * bricks.y + static_cast<std::size_t>(v.y >> 2)) * bricks.x + (v.x >> 2);
+    return (brick << 6) | static_cast<std::size_t>(((v.z & 3) << 4) | ((v.y & 3) << 2) | (v.x & 3));
+}
+
 class CubeOctree {
 public:
     // Level 0 has the volume's dims; level k+1 has ceil(dims_k / 2) per axis, up to a single cube.
@@ -58,7 +69,23 @@ public:
     std::vector<Cube> select(double tolerance, const TransferFunction& tf, const glm::dvec3& eye,
                              const glm::dvec3& forward, bool parallel, SelectionStats* stats = nullptr) const;
 
+    // The same selection as a grid over the voxels, for the fused path's ray walk (no order: each ray
+    // finds its own): per voxel the level of the selected cube that holds it, with kTransparent set where
+    // that cube (or a transparent subtree skipped whole, its level given) adds nothing, and the cube's
+    // value. The cube holding voxel v at level L is index v >> L on that level. Laid out in bricks of
+    // 4 x 4 x 4 voxels (selectionGridIndex), the layout kernels/cubefan.cl reads.
+    static constexpr std::uint8_t kTransparent = 0x80;
+    struct SelectionGrid {
+        std::vector<std::uint8_t> level;
+        std::vector<float> value;
+    };
+    SelectionGrid selectGrid(double tolerance, const TransferFunction& tf, SelectionStats* stats = nullptr) const;
+
 private:
+    // The selection's verdict on one cube: drawn whole, transparent (skipped with its subtree), or split.
+    enum class Verdict { Take, Transparent, Descend };
+    Verdict verdict(int level, const glm::ivec3& i, double allowed, const TransferFunction& tf) const;
+
     struct Level {
         glm::ivec3 dims{0};
         std::vector<float> mean, min, max;

@@ -8,6 +8,7 @@
 #include "host/render/fragment_uniforms.h"
 #include "host/render/grid/cube_fans.h"
 #include "host/render/grid/cube_octree.h"
+#include "host/render/grid/slice3d.h"  // emptySpaceRadii
 #include "host/render/options_util.h"
 #include "host/render/scaffold.h"
 #include "host/render/transfer_function_upload.h"
@@ -198,17 +199,30 @@ void projectCubes(const ProjectionContext& c, const cubefan::Cube* begin, const 
 class CubefanRenderer final : public Renderer {
 public:
     CubefanRenderer(Device& device, const Scene& scene, const Volume& volume);
-    Image4f render(FrameStats& stats) override;
+    Image4f render(FrameStats& stats) override
+    {
+        Image4f image = options_.path == CubefanOptions::Path::Fused ? renderFused(stats) : renderRaster(stats);
+        stats.extra["path"] = options_.path == CubefanOptions::Path::Fused ? "fused" : "raster";
+        stats.extra["error"] = options_.error;
+        stats.extra["hierarchy_ms"] = hierarchyMs_;
+        stats.extra["hierarchy_levels"] = octree_->levels();
+        stats.extra["resident_bytes"] = residentBytes_;
+        return image;
+    }
     std::uint64_t residentBytes() const override { return residentBytes_; }
     void setTransferFunction(const TransferFunction& tf) override
     {
         tfHost_ = tf;
         tf_.replace(device_, "cubefan transfer function", tf, residentBytes_);
         textureK_ = -1.0;  // tau_max may have changed
+        gridCurrent_ = false;  // which cubes are transparent may have changed
     }
 
 private:
+    Image4f renderRaster(FrameStats& stats);
+    Image4f renderFused(FrameStats& stats);
     void updateTexture(double k);
+    double updateSelectionGrid();
 
     Device& device_;
     CubefanOptions options_;
@@ -228,6 +242,15 @@ private:
     raster::FragmentProgram fan_, box_;
     OverBackground overBackground_;
     std::array<ProjectedChunk, 2> chunks_;  // the chunk being drawn and the next; kept: pages touched once
+    // The fused path: the selection as a grid over the voxels (level and value per voxel, on the device),
+    // current for options_.error and tfHost_ when gridCurrent_, and the kernel's per-pixel counts.
+    glm::ivec3 dims_{0};
+    glm::dvec3 spacing_{1.0};
+    cl::Kernel fused_;
+    cl::Buffer gridLevel_, gridValue_, gridSpace_, fusedSteps_, fusedSkipped_;
+    bool gridCurrent_ = false;
+    cubefan::SelectionStats gridStats_;
+    std::uint64_t gridEmptyBricks_ = 0;  // bricks of 4^3 voxels with nothing to add
     std::uint64_t residentBytes_ = 0;
 };
 
@@ -251,6 +274,24 @@ CubefanRenderer::CubefanRenderer(Device& device, const Scene& scene, const Volum
     hierarchyMs_ = msSince(t0);
     tf_.upload(device_, "cubefan transfer function", tfHost_);
     residentBytes_ = tf_.bytes();
+    dims_ = volume.dims;
+    spacing_ = volume.spacing;
+    if (options_.path == CubefanOptions::Path::Fused) {
+        // The selection grid: a level byte and a float value per voxel, on the host while it is built.
+        // Bricks of 4^3 (cube_octree.h): the dims rounded up to multiples of 4.
+        const glm::u64vec3 padded = glm::u64vec3((volume.dims + 3) / 4) * std::uint64_t(4);
+        const std::uint64_t entries = padded.x * padded.y * padded.z;
+        checkHostMemory(volume.source + ": cubefan's selection grid", entries * 5);
+        gridLevel_ = device_.buffer("cubefan selection grid (levels)", entries, CL_MEM_READ_ONLY);
+        gridValue_ = device_.buffer("cubefan selection grid (values)", entries * sizeof(float), CL_MEM_READ_ONLY);
+        gridSpace_ = device_.buffer("cubefan selection grid (empty space)", entries / 64, CL_MEM_READ_ONLY);
+        residentBytes_ += entries * 5 + entries / 64;
+        const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
+        fusedSteps_ = device_.buffer("cubefan cubes crossed per pixel", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
+        fusedSkipped_ = device_.buffer("cubefan cubes stepped over per pixel", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
+        fused_ = device_.kernel("cubefan.cl", "cubefan_fused");
+        return;
+    }
     fan_.source = programSource("CLVR_CUBEFAN_FAN");
     fan_.attributes = 1;  // (l / l_max or alpha, value)
     box_.source = programSource("CLVR_CUBEFAN_BOX");
@@ -271,7 +312,81 @@ void CubefanRenderer::updateTexture(double k)
     textureMs_ = msSince(t0);
 }
 
-Image4f CubefanRenderer::render(FrameStats& stats)
+// Builds the selection grid for the current tolerance and transfer function and uploads it; returns its
+// milliseconds (0 when it was current).
+double CubefanRenderer::updateSelectionGrid()
+{
+    if (gridCurrent_)
+        return 0.0;
+    const auto t0 = std::chrono::steady_clock::now();
+    const cubefan::CubeOctree::SelectionGrid grid = octree_->selectGrid(options_.error, tfHost_, &gridStats_);
+    // Empty space: per brick of 4^3 voxels (the grid's 64 entries), 0 where a voxel adds color, else r + 1
+    // where every brick within Chebyshev distance r is transparent throughout (kernels/empty_space.h).
+    const glm::ivec3 bricks = (dims_ + 3) / 4;
+    std::vector<cl_uchar> empty(grid.level.size() / 64);
+    for (std::size_t b = 0; b < empty.size(); ++b) {
+        const std::uint8_t* code = grid.level.data() + 64 * b;
+        empty[b] = std::all_of(code, code + 64, [](std::uint8_t c) { return (c & cubefan::CubeOctree::kTransparent) != 0; });
+    }
+    const std::vector<cl_uchar> space = emptySpaceRadii(bricks, empty);
+    gridEmptyBricks_ = static_cast<std::uint64_t>(std::count(empty.begin(), empty.end(), cl_uchar(1)));
+    device_.queue().enqueueWriteBuffer(gridLevel_, CL_FALSE, 0, grid.level.size(), grid.level.data());
+    device_.queue().enqueueWriteBuffer(gridSpace_, CL_FALSE, 0, space.size(), space.data());
+    device_.queue().enqueueWriteBuffer(gridValue_, CL_TRUE, 0, grid.value.size() * sizeof(float), grid.value.data());
+    gridCurrent_ = true;
+    return msSince(t0);
+}
+
+// The fused path: cubefan_fused walks every pixel's ray through the selected cubes (kernels/cubefan.cl).
+Image4f CubefanRenderer::renderFused(FrameStats& stats)
+{
+    const FrameClock clock;
+    const double gridMs = updateSelectionGrid();
+    ClCubefanFusedParams p{};
+    p.camera = toClCamera(camera_, image_.width, image_.height, shift_);
+    p.field_lo = toCl4(lo_ - shift_, 0.0);
+    p.inv_spacing = toCl4(1.0 / spacing_, 0.0);
+    p.background = toCl4(glm::dvec3(image_.background), 0.0);
+    p.dims = cl_int4{{dims_.x, dims_.y, dims_.z, 0}};
+    p.width = image_.width;
+    p.height = image_.height;
+    p.tf_count = static_cast<cl_int>(tf_.count());
+    p.ert_alpha = options_.earlyTermination < 1.0 ? static_cast<float>(options_.earlyTermination) : 2.0f;
+    int a = 0;
+    fused_.setArg(a++, fb_.color());
+    fused_.setArg(a++, fusedSteps_);
+    fused_.setArg(a++, fusedSkipped_);
+    fused_.setArg(a++, gridLevel_);
+    fused_.setArg(a++, gridValue_);
+    fused_.setArg(a++, gridSpace_);
+    fused_.setArg(a++, tf_.buffer());
+    fused_.setArg(a++, p);
+    device_.launch("cubefan: fused cube walk", fused_, image_.width, image_.height);
+    const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
+    std::uint64_t crossed = 0, steppedOver = 0;
+    for (const cl_uint n : device_.download<cl_uint>(fusedSteps_, pixels))
+        crossed += n;
+    for (const cl_uint n : device_.download<cl_uint>(fusedSkipped_, pixels))
+        steppedOver += n;
+    Image4f image = readImage(device_, fb_.color(), image_.width, image_.height);
+    std::vector<PassTime> hostPasses;
+    if (gridMs > 0.0)
+        hostPasses.push_back({"cubefan: selection grid (host, when the tolerance or transfer function changes)", gridMs});
+    finishFrame(device_, clock, stats, std::move(hostPasses));
+    stats.samples = crossed;
+    stats.extra["selection_ms"] = gridMs;
+    stats.extra["selection_visited"] = gridStats_.visited;
+    stats.extra["cubes"] = gridStats_.selected;
+    stats.extra["cubes_transparent"] = gridStats_.transparent;
+    stats.extra["cubes_crossed"] = crossed;
+    stats.extra["cubes_stepped_over"] = steppedOver;
+    stats.extra["empty_bricks"] = gridEmptyBricks_;
+    stats.extra["early_termination"] = options_.earlyTermination;
+    return image;
+}
+
+// The raster path: the selected cubes projected as fans (or back faces) through the raster stage.
+Image4f CubefanRenderer::renderRaster(FrameStats& stats)
 {
     const FrameClock clock;
     const glm::dvec3 eye = camera_.position, forward = camera_.forward();
@@ -368,13 +483,9 @@ Image4f CubefanRenderer::render(FrameStats& stats)
     if (textureMs_ > 0.0)
         hostPasses.push_back({"cubefan: exp-opacity texture (host)", textureMs_});
     finishFrame(device_, clock, stats, std::move(hostPasses));
-    stats.extra["resident_bytes"] = residentBytes_;
-    stats.extra["error"] = options_.error;
     stats.extra["opacity"] = options_.exactThickness ? "exp" : opacityName(options_.opacity);
     stats.extra["thickness"] = options_.exactThickness ? "exact" : "interpolated";
     stats.extra["cubes_as_back_faces"] = total.boxCubes;
-    stats.extra["hierarchy_ms"] = hierarchyMs_;
-    stats.extra["hierarchy_levels"] = octree_->levels();
     stats.extra["selection_ms"] = selectionMs;
     stats.extra["selection_visited"] = selection.visited;
     stats.extra["cubes"] = selection.selected;
@@ -413,6 +524,11 @@ TechniqueInfo cubefanTechnique()
         {"thickness", "interpolated", "",
          "\"interpolated\" (at the fans' vertices, across each triangle: seeds/002 §7) or \"exact\" (each "
          "fragment's own chord through its cube, drawn as back faces)"},
+        {"path", "fused", "",
+         "\"fused\" (each pixel's ray walks the selected cubes in one kernel, every chord exact) or \"raster\" "
+         "(the paper's triangle fans through the raster stage); opacity, texture_size or thickness other than "
+         "their defaults take \"raster\""},
+        earlyTerminationInfo(1.0),
     };
     t.makeForVolume = [](Device& device, const Scene& scene, const Volume& volume) -> std::unique_ptr<Renderer> {
         return makeCubefanRenderer(device, scene, volume);
@@ -444,10 +560,31 @@ CubefanOptions parseCubefanOptions(const nlohmann::json& options)
             o.exactThickness = s == "exact";
         } else if (key == "texture_size") {
             o.textureSize = integerOption(key, value, 2, 4096);
+        } else if (key == "path") {
+            o.path = choiceOption(key, value, {"fused", "raster"}) == 0 ? CubefanOptions::Path::Fused
+                                                                       : CubefanOptions::Path::Raster;
+        } else if (key == "early_termination") {
+            o.earlyTermination = earlyTerminationOption(value);
         } else {
             unparsedOption(info, key);
         }
     });
+    // The fans' options describe the raster path: one away from its default takes it, unless the scene asks
+    // for fused (the listed defaults change nothing).
+    const CubefanOptions defaults;
+    const std::pair<const char*, bool> fans[] = {{"opacity", o.opacity != defaults.opacity},
+                                                 {"texture_size", o.textureSize != defaults.textureSize},
+                                                 {"thickness", o.exactThickness != defaults.exactThickness}};
+    for (const auto& [key, changed] : fans) {
+        if (!changed)
+            continue;
+        if (options.contains("path") && o.path == CubefanOptions::Path::Fused)
+            badOption(key, "describes the raster path's triangle fans; the fused path computes every chord exactly: "
+                           "give \"path\": \"raster\" or leave path out");
+        o.path = CubefanOptions::Path::Raster;
+    }
+    if (o.earlyTermination < 1.0 && o.path == CubefanOptions::Path::Raster)
+        badOption("early_termination", "is only available on the fused path (the blending stage cannot stop a pixel)");
     return o;
 }
 

@@ -32,6 +32,13 @@ struct CubefanOptions {
     // its own ray with the cube (the chord exact in perspective too; opacity 1 - exp(-tau l) per fragment,
     // so `opacity` does not apply). Cubes at the near plane are drawn that way in either mode.
     bool exactThickness = false;
+    // "fused" (default): each pixel's ray walks the selected cubes in one kernel, every chord exact (the
+    // image of exact thickness, without fans or the raster stage); "raster": the paper's fans through
+    // the raster stage. opacity, texture_size and thickness describe the fans: one of them away from its
+    // default, without a path, takes "raster".
+    enum class Path { Fused, Raster };
+    Path path = Path::Fused;
+    double earlyTermination = 1.0;  // fused path: stop a ray once its opacity reaches this (1 = off)
 };
 
 const char* opacityName(CubefanOptions::Opacity opacity);
@@ -40,7 +47,8 @@ const char* opacityName(CubefanOptions::Opacity opacity);
 TechniqueInfo cubefanTechnique();
 
 // Reads the scene's "options" for cubefan: "error" (a number in [0, 1]), "opacity" ("texture" | "exp" |
-// "linear"), "texture_size" (an integer in [2, 4096]), "thickness" ("interpolated" | "exact"). InputError naming the key otherwise.
+// "linear"), "texture_size" (an integer in [2, 4096]), "thickness" ("interpolated" | "exact"), "path"
+// ("fused" | "raster"), "early_termination" (in (0, 1], fused path). InputError naming the key otherwise.
 CubefanOptions parseCubefanOptions(const nlohmann::json& options);
 
 // The exp-opacity texture of §7, N x N floats, x fastest: texel (i, j) = 1 - exp(-k u v) with
