@@ -774,7 +774,10 @@ int bench(const BenchOptions& options)
                                                   : si(e["cubes_crossed"].get<double>()) + " cube chords (fused)")
                       << ", selection " << fixed(e["selection_ms"].get<double>(), 1) << " ms, rendering "
                       << fixed(s.median - e["selection_ms"].get<double>(), 1) << " ms; hierarchy built in "
-                      << fixed(e["hierarchy_ms"].get<double>(), 0) << " ms\n";
+                      << fixed(e["hierarchy_ms"].get<double>(), 0) << " ms";
+            if (e.contains("selection_grid_ms"))  // the fused path selects when the tolerance or transfer function changes
+                std::cout << ", selection grid in " << fixed(e["selection_grid_ms"].get<double>(), 0) << " ms";
+            std::cout << '\n';
         }
         std::cout << '\n';
         report["scenes"].push_back(r);

@@ -251,6 +251,7 @@ private:
     bool gridCurrent_ = false;
     cubefan::SelectionStats gridStats_;
     std::uint64_t gridEmptyBricks_ = 0;  // bricks of 4^3 voxels with nothing to add
+    double gridMs_ = 0.0;                // the last build of the grid (selection, empty space, upload)
     std::uint64_t residentBytes_ = 0;
 };
 
@@ -334,7 +335,8 @@ double CubefanRenderer::updateSelectionGrid()
     device_.queue().enqueueWriteBuffer(gridSpace_, CL_FALSE, 0, space.size(), space.data());
     device_.queue().enqueueWriteBuffer(gridValue_, CL_TRUE, 0, grid.value.size() * sizeof(float), grid.value.data());
     gridCurrent_ = true;
-    return msSince(t0);
+    gridMs_ = msSince(t0);
+    return gridMs_;
 }
 
 // The fused path: cubefan_fused walks every pixel's ray through the selected cubes (kernels/cubefan.cl).
@@ -375,6 +377,7 @@ Image4f CubefanRenderer::renderFused(FrameStats& stats)
     finishFrame(device_, clock, stats, std::move(hostPasses));
     stats.samples = crossed;
     stats.extra["selection_ms"] = gridMs;
+    stats.extra["selection_grid_ms"] = gridMs_;
     stats.extra["selection_visited"] = gridStats_.visited;
     stats.extra["cubes"] = gridStats_.selected;
     stats.extra["cubes_transparent"] = gridStats_.transparent;
