@@ -27,6 +27,7 @@
 #define HARC_INTEGRATION_AVERAGE 1
 #define HARC_INTEGRATION_FULL 2
 #define HARC_INTEGRATION_SLICES 3
+#define HARC_INTEGRATION_ISO 4
 
 /* The plain average-of-endpoints segment (the comparison of issue 3 part 6): constant C and τ, the
  * means of their values at s_f and s_b: C (1 - exp(-τ l)). */
@@ -71,6 +72,39 @@ uint harc_slices(global const float* tf, const int tf_count, const float4 slices
     return taken;
 }
 
+/* tetiso's fused path (HARC_INTEGRATION_ISO; host/render/tet/tetiso.cpp): the cell's linear field crosses the
+ * iso-value between its entry point (scalar s_f, at λ seg_f) and exit point (s_b, at seg_b) — upwards where
+ * s_f <= iso < s_b, downwards where s_f >= iso > s_b, the alpha tests of the raster path's back and front
+ * faces (seeds/000 §4.1) — at q = (iso - s_f) / (s_b - s_f). The shade is the raster path's (1 - q) I_f +
+ * q I_b: I at a point is color (ambient + diffuse <light, N>) with N the vertex normals interpolated
+ * barycentrically (Gouraud on the cell's faces), linear in N, so the blend of the two shades is the shade
+ * of the blended normal. normals: the cell's 3 float4, the x, y, z of its four vertex normals in vertex
+ * order. Returns 1 and sets *color and *q on a crossing, else 0. */
+int harc_iso_hit(const ClHarcParams* params, global const float4* normals, const float4 planes[4], const float3 e,
+                 const float3 d, const float seg_f, const float seg_b, const float s_f, const float s_b,
+                 float3* color, float* q)
+{
+    const float iso = params->iso.x;
+    if (!((s_f <= iso && s_b > iso) || (s_f >= iso && s_b < iso)))
+        return 0;
+    *q = (iso - s_f) / (s_b - s_f);
+    const int flags = (int)params->iso.w;
+    if (!(flags & HARC_ISO_SHADED)) {
+        *color = clamp(params->iso_color.xyz, 0.0f, 1.0f);
+        return 1;
+    }
+    const float w = (flags & HARC_ISO_EQUAL_WEIGHTS) ? 0.5f : *q;
+    const float3 pf = e + seg_f * d, pb = e + seg_b * d;
+    const float4 bf = (float4)(dot(planes[0].xyz, pf) + planes[0].w, dot(planes[1].xyz, pf) + planes[1].w,
+                               dot(planes[2].xyz, pf) + planes[2].w, dot(planes[3].xyz, pf) + planes[3].w);
+    const float4 bb = (float4)(dot(planes[0].xyz, pb) + planes[0].w, dot(planes[1].xyz, pb) + planes[1].w,
+                               dot(planes[2].xyz, pb) + planes[2].w, dot(planes[3].xyz, pb) + planes[3].w);
+    const float4 b = (1.0f - w) * bf + w * bb;
+    const float3 n = (float3)(dot(normals[0], b), dot(normals[1], b), dot(normals[2], b));
+    *color = clamp(params->iso_color.xyz * (params->iso.y + params->iso.z * dot(params->iso_light.xyz, n)), 0.0f, 1.0f);
+    return 1;
+}
+
 /* Full pre-integration: trilinear lookup of the segment (s_f -> s_b over length l) in the table of
  * host/optics/preintegration_table.h, table[(k * ns + j) * ns + i] = (premultiplied rgb, α) at s_f sample i,
  * s_b sample j, l sample k. params = (s of sample 0, samples per unit s, samples per unit l); s is
@@ -102,7 +136,9 @@ float4 harc_full_lookup(global const float4* table, const int ns, const int nl, 
  * perspective eye lies inside tet. params.camera is
  * relative to the mesh's shifted origin. Ray e + λ d, |d| = 1 (kernels/ray.h's clvr_ray_unit, as
  * host/model/camera.cpp's Camera::ray). stats[p] = (steps, 1 if the step bound stopped the ray, pieces;
- * with HARC_INTEGRATION_SLICES the slices taken).
+ * with HARC_INTEGRATION_SLICES the slices taken; with HARC_INTEGRATION_ISO the hit's λ as float bits,
+ * +infinity without one). iso_normals: HARC_INTEGRATION_ISO's vertex normals, 3 float4 per cell (a one-element
+ * dummy otherwise).
  * integration: HARC_INTEGRATION_*; full_table, full_ns, full_nl, full_params: harc_full_lookup's
  * table (a one-element dummy unless integration is full). With clip_box (a sort-last part, host/cluster/
  * partition.h) only the ray's part inside [box_lo, box_hi] is integrated: each segment is cut to it, the
@@ -110,7 +146,8 @@ float4 harc_full_lookup(global const float4* table, const int ns, const int nl, 
  * Out: (I + T background, 1 - T). */
 kernel void harc_render(global float4* out, global uint* stats, global const float4* tets,
                         global const uint* offsets, global const int2* entries, global const float* tf,
-                        global const float* psi, global const float4* full_table, const ClHarcParams params)
+                        global const float* psi, global const float4* full_table, global const float4* iso_normals,
+                        const ClHarcParams params)
 {
     CLVR_GUARD_2D(params.width, params.height);
     const int x = (int)get_global_id(0), y = (int)get_global_id(1);
@@ -147,6 +184,7 @@ kernel void harc_render(global float4* out, global uint* stats, global const flo
     float transmittance = 1.0f;
     uint steps = 0, bounded = 0, pieces = 0;
     float lambda_done = -INFINITY;  /* where the ray last left the mesh */
+    float iso_lambda = INFINITY;    /* HARC_INTEGRATION_ISO: the hit */
     const uint end = clip_lo <= clip_hi ? offsets[p + 1] : offsets[p];  /* a ray that misses the box: nothing */
     for (uint k = offsets[p]; k < end && !bounded; ++k) {
         const int2 entry = entries[k];
@@ -209,6 +247,16 @@ kernel void harc_render(global float4* out, global uint* stats, global const flo
                     pieces += (uint)harc_segment_from(tf, tf_count, psi, psi_n, front, s_b, length, &color,
                                                       &transmittance, &carried);
                     carry = seg_b == lambda_exit;
+                } else if (integration == HARC_INTEGRATION_ISO) {
+                    const float s_f = dot(grad.xyz, e + seg_f * d) + grad.w;
+                    float q;
+                    if (harc_iso_hit(&params, iso_normals + (size_t)t * 3, planes, e, d, seg_f, seg_b, s_f, s_b,
+                                     &color, &q)) {
+                        iso_lambda = seg_f + q * (seg_b - seg_f);
+                        transmittance = 0.0f;
+                        k = end; /* the first crossing ends the ray */
+                        break;
+                    }
                 } else if (integration == HARC_INTEGRATION_SLICES) {
                     const float df = dot(d, params.camera.forward.xyz);
                     if (df > 0.0f)
@@ -250,5 +298,5 @@ kernel void harc_render(global float4* out, global uint* stats, global const flo
     out[p] = (float4)(color + transmittance * params.background.xyz, 1.0f - transmittance);
     stats[3 * p + 0] = steps;
     stats[3 * p + 1] = bounded;
-    stats[3 * p + 2] = pieces;
+    stats[3 * p + 2] = integration == HARC_INTEGRATION_ISO ? as_uint(iso_lambda) : pieces;
 }

@@ -25,6 +25,13 @@ typedef struct {
     cl_float4 box_hi;
     cl_float4 slices;       /* HARC_INTEGRATION_SLICES (tetslice's fused path): (eye depth of slice 0, slice
                              * spacing, slice count, 0) */
-} ClHarcParams;             /* 208 bytes */
+    cl_float4 iso;          /* HARC_INTEGRATION_ISO (tetiso's fused path): (iso-value, ambient, diffuse, flags:
+                             * HARC_ISO_SHADED | HARC_ISO_EQUAL_WEIGHTS) */
+    cl_float4 iso_light;    /* towards the light, unit, w = 0 */
+    cl_float4 iso_color;    /* the surface color, w = 0 */
+} ClHarcParams;             /* 256 bytes */
+
+#define HARC_ISO_SHADED 1        /* color (ambient + diffuse <light, N>); else the color */
+#define HARC_ISO_EQUAL_WEIGHTS 2 /* the entry and exit shades averaged (seeds/000 Figure 9, left); else q-weighted */
 
 #endif

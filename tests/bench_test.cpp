@@ -536,8 +536,9 @@ TEST(BenchTetfaces, ScenesAreValidAndHarcTwinsDifferOnlyInTheTechnique)
         present.push_back(file.filename().string());
     std::sort(listed.begin(), listed.end());
     EXPECT_EQ(listed, present);
-    // 4 meshes x (tetslice's face draws, its fused path, harc) + the automaton x (tetiso, the two tetslice, harc)
-    ASSERT_EQ(files.size(), 16u);
+    // 4 meshes x (tetslice's face draws, its fused path, harc) + the automaton x (the two tetiso, the two
+    // tetslice, harc)
+    ASSERT_EQ(files.size(), 17u);
     for (const auto& file : files) {
         const clvr::Scene scene = clvr::loadScene(file);
         const std::string name = file.filename().string();
@@ -552,6 +553,13 @@ TEST(BenchTetfaces, ScenesAreValidAndHarcTwinsDifferOnlyInTheTechnique)
             EXPECT_EQ(scene.camera->position, other.camera->position) << name;
             EXPECT_EQ(other.options["slices"].get<int>(), 400) << name;
             EXPECT_EQ(other.options["path"], "raster") << name;  // seeds/000's method
+        }
+        if (name.ends_with("-fused-tetiso.json")) {  // its face-draw twin but for the path
+            const clvr::Scene other = clvr::loadScene(file.parent_path() / "tetfaces-automaton-tetiso.json");
+            EXPECT_TRUE(*scene.mesh == *other.mesh) << name;
+            EXPECT_EQ(scene.iso->value, other.iso->value) << name;
+            EXPECT_EQ(scene.options["path"], "fused") << name;
+            EXPECT_EQ(other.options["path"], "raster") << name;
         }
         if (name.ends_with("-fused-tetslice.json")) {  // its face-draw twin but for the path
             std::string twin = name;

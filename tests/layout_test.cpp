@@ -116,7 +116,7 @@ TEST(Layout, EveryParamsStructFitsTheKernelArgumentSpace)
         {"slice3d_fused", sizeof(ClSlice3dParams) + 8 * sizeof(void*)},
         {"planes_render", sizeof(ClPlanesParams) + 7 * sizeof(void*)},
         {"blend_render", sizeof(ClBlendParams) + 6 * sizeof(void*)},
-        {"harc_render", sizeof(ClHarcParams) + 8 * sizeof(void*)},
+        {"harc_render", sizeof(ClHarcParams) + 9 * sizeof(void*)},
         {"spherical_shell", sizeof(ClSphericalParams) + 5 * sizeof(void*)},
         {"spherical_fused", sizeof(ClSphericalFusedParams) + 5 * sizeof(void*)},
         {"slice3d_over_background", sizeof(ClSlice3dOverBackgroundParams) + 1 * sizeof(void*)},
@@ -140,7 +140,7 @@ TEST(Layout, EveryParamsStructFitsTheKernelArgumentSpace)
     EXPECT_EQ(sizeof(ClSlice3dParams), 384u);
     EXPECT_EQ(sizeof(ClPlanesParams), 288u);
     EXPECT_EQ(sizeof(ClBlendParams), 256u);
-    EXPECT_EQ(sizeof(ClHarcParams), 208u);
+    EXPECT_EQ(sizeof(ClHarcParams), 256u);
     EXPECT_EQ(sizeof(ClSphericalParams), 192u);
     EXPECT_EQ(sizeof(ClSphericalFusedParams), 288u);
     EXPECT_EQ(sizeof(ClSlice3dOverBackgroundParams), 32u);

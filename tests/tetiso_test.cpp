@@ -35,6 +35,9 @@ TEST(TetisoOptions, ParsesAndRejects)
     EXPECT_THROW(parseTetisoOptions(json{{"weights", "average"}}), InputError);
     EXPECT_THROW(parseTetisoOptions(json{{"intervals", 0}}), InputError);
     EXPECT_THROW(parseTetisoOptions(json{{"slices", 64}}), InputError);
+    EXPECT_EQ(parseTetisoOptions(json::object()).path, TetisoOptions::Path::Fused);
+    EXPECT_EQ(parseTetisoOptions(json{{"path", "raster"}}).path, TetisoOptions::Path::Raster);
+    EXPECT_THROW(parseTetisoOptions(json{{"path", "faces"}}), InputError);
 }
 
 // Each interval's decoded stream holds exactly the cells whose range meets the interval.
@@ -177,12 +180,15 @@ Comparison compare(const Scene& scene, const TetMesh& mesh, glm::dvec3 (*normal)
             }
         }
     c.meanShadeError = c.bothHit ? shadeSum / c.bothHit : 0.0;
-    std::printf("tetiso (%s): %zu hits, coverage differs %zu (%zu not at a silhouette), max |dz| %.3g, shade "
-                "max %.3g mean %.3g; %llu of %llu cells drawn, bit-streams %.2f bytes/tet\n",
-                stats.extra["weights"].get<std::string>().c_str(), c.bothHit, c.coverageDiffers, c.coverageDiffersInside,
-                c.maxDepthError, c.maxShadeError, c.meanShadeError,
-                static_cast<unsigned long long>(stats.extra["cells_drawn"].get<std::uint64_t>()),
-                static_cast<unsigned long long>(mesh.tets.size()), stats.extra["bitstream_bytes_per_tet"].get<double>());
+    std::printf("tetiso (%s, %s): %zu hits, coverage differs %zu (%zu not at a silhouette), max |dz| %.3g, shade "
+                "max %.3g mean %.3g",
+                stats.extra["path"].get<std::string>().c_str(), stats.extra["weights"].get<std::string>().c_str(),
+                c.bothHit, c.coverageDiffers, c.coverageDiffersInside, c.maxDepthError, c.maxShadeError, c.meanShadeError);
+    if (stats.extra.contains("cells_drawn"))
+        std::printf("; %llu of %llu cells drawn, bit-streams %.2f bytes/tet",
+                    static_cast<unsigned long long>(stats.extra["cells_drawn"].get<std::uint64_t>()),
+                    static_cast<unsigned long long>(mesh.tets.size()), stats.extra["bitstream_bytes_per_tet"].get<double>());
+    std::printf("\n");
     return c;
 }
 
@@ -193,8 +199,9 @@ glm::dvec3 coneNormal(const glm::dvec3& p)
     return glm::normalize(p - kConeCenter);  // -grad s = (p - c) / |p - c|
 }
 
-Scene isoScene(const Camera& camera, int size, double iso, json options = json::object())
+Scene isoScene(const Camera& camera, int size, double iso, json options = json::object(), const char* path = "raster")
 {
+    options["path"] = path;
     Scene s = test::meshScene("tetiso", camera,
                               TransferFunction({{0.0, {1.0, 0.8, 0.6}, 1.0}, {1.0, {1.0, 0.8, 0.6}, 1.0}}), size,
                               std::move(options));
@@ -213,16 +220,20 @@ TEST(Tetiso, ConeSphereMatchesTheExactFirstCrossingBothCameras)
             camera.parallel = true;
             camera.parallelScale = 0.55;
         }
-        const Comparison c = compare(isoScene(camera, 64, 0.6), mesh, coneNormal);
-        ASSERT_GT(c.bothHit, 1000u);
-        EXPECT_EQ(c.coverageDiffersInside, 0u);
-        EXPECT_LE(c.coverageDiffers, 16u);  // measured 0; a grazing ray at the silhouette may differ
-        // The crossing is interpolated exactly between the two faces, but the faces' vertices are snapped
-        // to 1/256 pixel, which moves S_f and S_b a little; q = (iso - S_f) / (S_b - S_f) magnifies that
-        // where the ray runs nearly along the surface. Measured max 6.9e-4 (cells of edge 1/12): < 2% of a cell.
-        EXPECT_LT(c.maxDepthError, 0.02 / 12.0);
-        EXPECT_LT(c.meanShadeError, 0.012);  // measured 8.7e-3: Gouraud from averaged vertex gradients
-        EXPECT_LT(c.maxShadeError, 0.03);    // measured 0.020
+        for (const char* path : {"raster", "fused"}) {
+            const bool fused = std::string(path) == "fused";
+            const Comparison c = compare(isoScene(camera, 64, 0.6, json::object(), path), mesh, coneNormal);
+            ASSERT_GT(c.bothHit, 1000u);
+            EXPECT_EQ(c.coverageDiffersInside, 0u);
+            EXPECT_LE(c.coverageDiffers, 16u);  // measured 0; a grazing ray at the silhouette may differ
+            // The crossing is interpolated exactly between the two faces, but the raster path's faces have
+            // their vertices snapped to 1/256 pixel, which moves S_f and S_b a little; q = (iso - S_f) / (S_b -
+            // S_f) magnifies that where the ray runs nearly along the surface. Measured max 6.9e-4 (cells of
+            // edge 1/12): < 2% of a cell. The fused path intersects each ray with its cells in float: 1e-5.
+            EXPECT_LT(c.maxDepthError, fused ? 1e-4 : 0.02 / 12.0) << path;
+            EXPECT_LT(c.meanShadeError, 0.012) << path;  // measured 8.7e-3: Gouraud from averaged vertex gradients
+            EXPECT_LT(c.maxShadeError, 0.03) << path;    // measured 0.020
+        }
     }
 }
 
@@ -232,13 +243,15 @@ TEST(Tetiso, WeightsBeatEqualBlendingAndRefinementHelps)
 {
     const Camera camera = perspective({1.7, 1.3, 2.4}, {0.5, 0.5, 0.5}, 30.0);
     const TetMesh coarse = coneMesh(6, kConeCenter), fine = coneMesh(12, kConeCenter);
-    const Comparison weighted = compare(isoScene(camera, 64, 0.6), coarse, coneNormal);
-    const Comparison equal = compare(isoScene(camera, 64, 0.6, json{{"weights", "equal"}}), coarse, coneNormal);
-    const Comparison refined = compare(isoScene(camera, 64, 0.6), fine, coneNormal);
-    EXPECT_LT(weighted.meanShadeError, equal.meanShadeError);  // measured 0.039 vs 0.042 (max 0.079 vs 0.166)
-    EXPECT_LT(weighted.maxShadeError, equal.maxShadeError);
-    EXPECT_LT(refined.meanShadeError, weighted.meanShadeError);
-    EXPECT_EQ(equal.coverageDiffers, weighted.coverageDiffers);  // the weights change the shade, not what is hit
+    for (const char* path : {"raster", "fused"}) {
+        const Comparison weighted = compare(isoScene(camera, 64, 0.6, json::object(), path), coarse, coneNormal);
+        const Comparison equal = compare(isoScene(camera, 64, 0.6, json{{"weights", "equal"}}, path), coarse, coneNormal);
+        const Comparison refined = compare(isoScene(camera, 64, 0.6, json::object(), path), fine, coneNormal);
+        EXPECT_LT(weighted.meanShadeError, equal.meanShadeError) << path;  // measured 0.039 vs 0.042 (max 0.079 vs 0.166)
+        EXPECT_LT(weighted.maxShadeError, equal.maxShadeError) << path;
+        EXPECT_LT(refined.meanShadeError, weighted.meanShadeError) << path;
+        EXPECT_EQ(equal.coverageDiffers, weighted.coverageDiffers) << path;  // the weights change the shade, not what is hit
+    }
 }
 
 // The same sphere with the field negated (rays enter above the iso-value and cross it downwards) gives the
@@ -249,17 +262,20 @@ TEST(TetisoDirections, CrossingsDownwardsAreFoundToo)
     for (double& s : mesh.scalars)
         s = 1.0 - s;
     const Camera camera = perspective({1.7, 1.3, 2.4}, {0.5, 0.5, 0.5}, 30.0);
-    const Comparison c = compare(isoScene(camera, 48, 0.4), mesh, nullptr);
-    ASSERT_GT(c.bothHit, 500u);
-    EXPECT_EQ(c.coverageDiffersInside, 0u);
-    EXPECT_LT(c.maxDepthError, 0.02 / 8.0);  // measured 1.6e-3 (cells of edge 1/8)
-    // A linear field through a box, seen from the high side and from the low side.
     const TetMesh ramp = test::boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, 4}}, {0.5, 0.3, 0.2}, 0.0);
-    for (const glm::dvec3 eye : {glm::dvec3(2.0, 1.6, 1.8), glm::dvec3(-1.0, -0.6, -0.8)}) {
-        const Comparison r = compare(isoScene(perspective(eye, {0.5, 0.5, 0.5}, 40.0), 48, 0.5), ramp, nullptr);
-        ASSERT_GT(r.bothHit, 300u);
-        EXPECT_EQ(r.coverageDiffersInside, 0u);
-        EXPECT_LT(r.maxDepthError, 1e-4);  // measured 1.6e-5: a global linear field, only snapping
+    for (const char* path : {"raster", "fused"}) {
+        const Comparison c = compare(isoScene(camera, 48, 0.4, json::object(), path), mesh, nullptr);
+        ASSERT_GT(c.bothHit, 500u);
+        EXPECT_EQ(c.coverageDiffersInside, 0u) << path;
+        EXPECT_LT(c.maxDepthError, 0.02 / 8.0) << path;  // raster measured 1.6e-3 (cells of edge 1/8)
+        // A linear field through a box, seen from the high side and from the low side.
+        for (const glm::dvec3 eye : {glm::dvec3(2.0, 1.6, 1.8), glm::dvec3(-1.0, -0.6, -0.8)}) {
+            const Comparison r = compare(isoScene(perspective(eye, {0.5, 0.5, 0.5}, 40.0), 48, 0.5, json::object(), path),
+                                         ramp, nullptr);
+            ASSERT_GT(r.bothHit, 300u);
+            EXPECT_EQ(r.coverageDiffersInside, 0u) << path;
+            EXPECT_LT(r.maxDepthError, 1e-4) << path;  // raster measured 1.6e-5: a global linear field, only snapping
+        }
     }
 }
 
@@ -304,12 +320,123 @@ TEST(TetisoMeshes, PostMatchesTheExactFirstCrossing)
     const glm::dvec2 range = mesh.scalarRange();
     const double radius = 0.5 * glm::length(mesh.boundsMax() - mesh.boundsMin());
     const Camera camera = test::meshCamera(mesh);
-    const Comparison c = compare(isoScene(camera, 64, range.x + 0.55 * (range.y - range.x)), mesh, nullptr);
-    ASSERT_GT(c.bothHit, 100u);                           // measured 132
-    EXPECT_LE(c.coverageDiffersInside * 100, c.bothHit);  // at most 1% (measured 0)
-    // Measured 0.018 = 0.45% of the half-diagonal: the snapping magnified by q on near-tangent rays, as
-    // on the cone sphere; the post's cells are smaller than the pixels there.
-    EXPECT_LT(c.maxDepthError, 6e-3 * radius);
+    for (const char* path : {"raster", "fused"}) {
+        const Comparison c =
+            compare(isoScene(camera, 64, range.x + 0.55 * (range.y - range.x), json::object(), path), mesh, nullptr);
+        ASSERT_GT(c.bothHit, 100u);                                   // measured 132
+        EXPECT_LE(c.coverageDiffersInside * 100, c.bothHit) << path;  // at most 1% (measured 0)
+        // Raster measured 0.018 = 0.45% of the half-diagonal: the snapping magnified by q on near-tangent
+        // rays, as on the cone sphere; the post's cells are smaller than the pixels there.
+        EXPECT_LT(c.maxDepthError, (std::string(path) == "fused" ? 1e-4 : 6e-3) * radius) << path;
+    }
+}
+
+// The fused path (harc's walk stopping at the first crossing) against the raster path's face draws, pixel
+// by pixel: the same pixels hit (but at the silhouette), and the same shade — both are Gouraud from the
+// vertex normals, blended by q; they differ by the raster path's 1/256-pixel vertex snapping (its q and
+// its interpolated normals).
+TEST(TetisoFused, MatchesTheFaceDrawsImage)
+{
+    const TetMesh mesh = coneMesh(12, kConeCenter);
+    for (const bool parallel : {false, true}) {
+        Camera camera = perspective({1.7, 1.3, 2.4}, {0.5, 0.5, 0.5}, 30.0);
+        if (parallel) {
+            camera.parallel = true;
+            camera.parallelScale = 0.55;
+        }
+        for (const char* weights : {"interpolated", "equal"}) {
+            FrameStats fusedStats, rasterStats;
+            const Image4f fused = makeTetisoRenderer(test::device(), isoScene(camera, 64, 0.6, json{{"weights", weights}}, "fused"), mesh)
+                                      ->render(fusedStats);
+            const Image4f raster = makeTetisoRenderer(test::device(), isoScene(camera, 64, 0.6, json{{"weights", weights}}), mesh)
+                                       ->render(rasterStats);
+            EXPECT_EQ(fusedStats.extra["path"], "fused");
+            EXPECT_EQ(rasterStats.extra["path"], "raster");
+            std::size_t both = 0, differ = 0;
+            double maxDiff = 0.0, sumDiff = 0.0;
+            for (std::size_t i = 0; i < fused.pixels().size(); ++i) {
+                const glm::vec4 a = fused.pixels()[i], b = raster.pixels()[i];
+                if ((a.a > 0.5f) != (b.a > 0.5f)) {
+                    ++differ;
+                    continue;
+                }
+                if (a.a > 0.5f) {
+                    ++both;
+                    const double d = glm::length(glm::dvec3(a) - glm::dvec3(b)) / std::sqrt(3.0);
+                    maxDiff = std::max(maxDiff, d);
+                    sumDiff += d;
+                } else {
+                    EXPECT_EQ(a, b) << i;  // the background, unchanged
+                }
+            }
+            std::printf("fused vs raster (%s, %s): %zu pixels hit by both, %zu differ in coverage, shade |diff| max "
+                        "%.3g mean %.3g\n",
+                        parallel ? "parallel" : "perspective", weights, both, differ, maxDiff, sumDiff / std::max<std::size_t>(both, 1));
+            ASSERT_GT(both, 1000u);
+            EXPECT_LE(differ, 8u);
+            // Interpolated weights are continuous across cells (measured max 1.1e-3); equal blending jumps
+            // from cell to cell (the cells show, Figure 9 left), so where the snapped faces and the walk pick
+            // neighbouring cells for a crossing near a face, one pixel differs by the jump (measured 0.033).
+            const bool equal = std::string(weights) == "equal";
+            EXPECT_LT(maxDiff, equal ? 0.05 : 0.005) << weights;
+            EXPECT_LT(sumDiff / both, 2e-4) << weights;
+        }
+    }
+}
+
+// Behind a gap of a non-convex mesh: two boxes one above the other, the surface only in the lower one. The
+// raster path's nearest back face past the surface can belong to the upper box (docs/tetiso.md); the walk
+// re-enters at the lower box's entry face and finds the crossing. Every reference hit, gap or not, against
+// the fused path's depth.
+TEST(TetisoFused, FindsTheSurfaceBehindAGap)
+{
+    // s = 0.1 + 0.3 x + 0.5 y + z: the upper box (z in [0.7, 1.1]) lies above 0.8, the lower box (z in [0, 0.4])
+    // is cut by s = 0.6 along a tilted plane.
+    const std::vector<test::Box> boxes = {{{0.0, 0.0, 0.0}, {1.0, 1.0, 0.4}, 3}, {{0.0, 0.0, 0.7}, {1.0, 1.0, 1.1}, 3}};
+    const TetMesh mesh = test::boxMesh(boxes, {0.3, 0.5, 1.0}, 0.1);
+    const Camera camera = perspective({0.9, 0.7, 3.2}, {0.5, 0.5, 0.5}, 40.0);
+    const int size = 48;
+    const Scene scene = isoScene(camera, size, 0.6, json::object(), "fused");
+    auto renderer = makeTetisoRenderer(test::device(), scene, mesh);
+    FrameStats stats;
+    renderer->render(stats);
+    const std::vector<double> z = renderer->hitDepth();
+    const IsoReference ref = isoReference(mesh, camera, size, 0.6);
+    std::size_t behindGap = 0, differ = 0;
+    double maxDepthError = 0.0;
+    for (std::size_t i = 0; i < z.size(); ++i) {
+        const bool want = std::isfinite(ref.depth[i]), got = std::isfinite(z[i]);
+        if (want != got) {
+            ++differ;
+            continue;
+        }
+        if (want) {
+            behindGap += ref.noGapBefore[i] ? 0 : 1;
+            maxDepthError = std::max(maxDepthError, std::abs(z[i] - ref.depth[i]));
+        }
+    }
+    std::printf("behind a gap: %zu hits behind it, %zu differ in coverage, max |dz| %.3g\n", behindGap, differ, maxDepthError);
+    EXPECT_GT(behindGap, 200u);
+    EXPECT_LE(differ, 4u);  // a grazing ray at an edge at most
+    EXPECT_LT(maxDepthError, 1e-4);
+}
+
+// Two frames give the same bits; a new transfer function changes the surface's color as a new renderer would.
+TEST(TetisoFused, IdenticalBitsTwiceAndTheColorFromTheTransferFunction)
+{
+    const TetMesh mesh = coneMesh(6, kConeCenter);
+    const Scene scene = isoScene(perspective({1.7, 1.3, 2.4}, {0.5, 0.5, 0.5}, 30.0), 32, 0.6, json::object(), "fused");
+    auto renderer = makeTetisoRenderer(test::device(), scene, mesh);
+    FrameStats stats;
+    const Image4f a = renderer->render(stats);
+    EXPECT_TRUE(a.pixels() == renderer->render(stats).pixels());
+    const TransferFunction green({{0.0, {0.1, 0.9, 0.2}, 1.0}, {1.0, {0.1, 0.9, 0.2}, 1.0}});
+    renderer->setTransferFunction(green);
+    const Image4f edited = renderer->render(stats);
+    Scene fresh = scene;
+    fresh.transferFunction = green;
+    EXPECT_TRUE(edited.pixels() == makeTetisoRenderer(test::device(), fresh, mesh)->render(stats).pixels());
+    EXPECT_FALSE(edited.pixels() == a.pixels());
 }
 
 }  // namespace

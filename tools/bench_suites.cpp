@@ -51,7 +51,7 @@ std::vector<std::string> benchSuiteScenes(const std::string& suite)
     for (const char* mesh : {"fedata0", "fedata1", "fedata2", "fedata3"})
         for (const char* technique : {"tetslice", "fused-tetslice", "harc"})
             tetfaces.push_back(std::string("tetfaces-") + mesh + "-" + technique + ".json");
-    for (const char* technique : {"tetiso", "tetslice", "fused-tetslice", "harc"})
+    for (const char* technique : {"tetiso", "fused-tetiso", "tetslice", "fused-tetslice", "harc"})
         tetfaces.push_back(std::string("tetfaces-automaton-") + technique + ".json");
     // seeds/002 Figure 9 on the engine (tools/make_cubefan_bench.py): error 0, 18 %, 48 % (the fans), 0 and
     // 18 % with each fragment's exact chord, the fused path at the three tolerances, then slice3d on the same

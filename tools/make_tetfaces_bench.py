@@ -17,7 +17,8 @@ paper's figure; 400 slices at 400x400, as the paper.
   tetfaces-fedataN-harc             harc on the same scene
 The binary cellular automaton: 8,000 living cells of a 40^3 lattice, 12 tetrahedra each, no shared
 vertices, value 1 at the centres and 0 at the corners (mesh generator "automaton"):
-  tetfaces-automaton-tetiso     the iso-surface at 0.5 (tetiso)
+  tetfaces-automaton-tetiso     the iso-surface at 0.5 (tetiso, face draws: "path": "raster")
+  tetfaces-automaton-fused-tetiso   the same on tetiso's fused path (the cells walked to the first crossing)
   tetfaces-automaton-tetslice   direct rendering, 400 slices (tetslice, face draws)
   tetfaces-automaton-fused-tetslice   the same on tetslice's fused path
   tetfaces-automaton-harc       harc on the same scene as tetslice
@@ -58,9 +59,10 @@ def scenes():
                 scene["options"] = options
             out.append(("tetfaces-%s-%s.json" % (name, label), scene))
     automaton = {"generator": "automaton", "cells": 8000, "grid": 40}
-    out.append(("tetfaces-automaton-tetiso.json",
-                {"technique": "tetiso", "mesh": automaton, "camera": AUTOMATON_CAMERA, "image": IMAGE,
-                 "transfer_function": AUTOMATON_TF, "iso": {"value": 0.5}}))
+    for label, path in (("tetiso", "raster"), ("fused-tetiso", "fused")):
+        out.append(("tetfaces-automaton-%s.json" % label,
+                    {"technique": "tetiso", "mesh": automaton, "camera": AUTOMATON_CAMERA, "image": IMAGE,
+                     "transfer_function": AUTOMATON_TF, "iso": {"value": 0.5}, "options": {"path": path}}))
     for label, technique, options in (("tetslice", "tetslice", {"slices": 400, "path": "raster"}),
                                       ("fused-tetslice", "tetslice", {"slices": 400, "path": "fused"}),
                                       ("harc", "harc", None)):

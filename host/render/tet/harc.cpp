@@ -26,6 +26,11 @@
 namespace clvr {
 namespace {
 
+// The iso-surface's color (Integration::Iso): the transfer function's at the value, white without one.
+glm::dvec3 isoColorOf(const TransferFunction& tf, double value)
+{
+    return tf.points().empty() ? glm::dvec3(1.0) : glm::dvec3(tf(value));
+}
 
 class HarcRenderer final : public Renderer {
 public:
@@ -34,6 +39,8 @@ public:
     Image4f render(FrameStats& stats) override;
     std::uint64_t residentBytes() const override { return residentBytes_; }
     void setTransferFunction(const TransferFunction& tf) override;
+    // Integration::Iso: the last frame's hits as eye depths (harcIsoHitDepth).
+    std::vector<double> isoHitDepth() const;
 
 private:
     void buildFullTable(const TransferFunction& tf);
@@ -50,6 +57,9 @@ private:
     TransferFunctionUpload tf_;
     std::uint64_t maxSteps_ = 0;
     cl::Buffer tets_, psi_, out_, stats_;
+    cl::Buffer isoNormals_;              // Integration::Iso: 3 float4 per cell (else one dummy)
+    std::vector<float> isoHitLambda_;    // Integration::Iso: the last frame's hit per pixel (+inf: none)
+    glm::dvec3 isoColor_{1.0};           // Integration::Iso: the transfer function's color at the iso-value
     cl::Kernel kernel_;
     std::unique_ptr<HarcRasterEntries> rasterEntries_;  // options_.entry == Raster
     std::uint64_t residentBytes_ = 0;
@@ -103,6 +113,22 @@ HarcRenderer::HarcRenderer(Device& device, const Scene& scene, const TetMesh& me
         full_ = device_.buffer("harc full table (unused)", sizeof(cl_float4));  // no zero-size buffers
     }
 
+    if (options_.integration == HarcOptions::Integration::Iso) {
+        isoColor_ = isoColorOf(scene.transferFunction, options_.iso.value);
+        // Per cell the x, y and z of its four vertex normals, in the order of its barycentric planes.
+        if (options_.iso.normals.size() != mesh.points.size())
+            throw InternalError(mesh.source + ": harc iso needs one normal per point");
+        std::vector<cl_float4> normals(mesh.tets.size() * 3);
+        for (std::size_t t = 0; t < mesh.tets.size(); ++t)
+            for (int axis = 0; axis < 3; ++axis)
+                for (int v = 0; v < 4; ++v)
+                    normals[3 * t + axis].s[v] = static_cast<float>(options_.iso.normals[mesh.tets[t][v]][axis]);
+        isoNormals_ = device_.upload("harc iso vertex normals (48 bytes per tet)", normals);
+        residentBytes_ += normals.size() * sizeof(cl_float4);
+    } else {
+        isoNormals_ = device_.buffer("harc iso normals (unused)", sizeof(cl_float4));  // no zero-size buffers
+    }
+
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
     out_ = device_.buffer("harc image", pixels * sizeof(cl_float4), CL_MEM_WRITE_ONLY);
     stats_ = device_.buffer("harc ray counts", pixels * 3 * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
@@ -136,6 +162,7 @@ void HarcRenderer::setTransferFunction(const TransferFunction& tf)
 
     // Partial pre-integration needs no table that depends on the transfer function: only the packed
     // control points change (the ψ table is the same for every transfer function).
+    isoColor_ = isoColorOf(tf, options_.iso.value);
     tf_.replace(device_, "harc transfer function", tf, residentBytes_);
 }
 
@@ -162,6 +189,7 @@ Image4f HarcRenderer::render(FrameStats& stats)
     const cl_int integration = options_.integration == HarcOptions::Integration::Average ? 1
                                : options_.integration == HarcOptions::Integration::Full  ? 2
                                : options_.integration == HarcOptions::Integration::Slices ? 3
+                               : options_.integration == HarcOptions::Integration::Iso    ? 4
                                                                                           : 0;
     // The table's sample spacing as PreintegrationTable::lookup computes it (float), so host and device
     // interpolate alike.
@@ -183,6 +211,14 @@ Image4f HarcRenderer::render(FrameStats& stats)
     params.full_nl = nl;
     params.slices = cl_float4{{static_cast<float>(options_.sliceDepth0), static_cast<float>(options_.sliceSpacing),
                                static_cast<float>(options_.sliceCount), 0.0f}};
+    if (options_.integration == HarcOptions::Integration::Iso) {
+        const HarcOptions::HarcIso& iso = options_.iso;
+        const int flags = (iso.shaded ? HARC_ISO_SHADED : 0) | (iso.equalWeights ? HARC_ISO_EQUAL_WEIGHTS : 0);
+        params.iso = cl_float4{{static_cast<float>(iso.value), static_cast<float>(iso.ambient),
+                                static_cast<float>(iso.diffuse), static_cast<float>(flags)}};
+        params.iso_light = toCl4(iso.light);
+        params.iso_color = toCl4(isoColor_);
+    }
     if (part_) {
         params.clip_box = 1;
         params.box_lo = toCl4(part_->lo - shift_);
@@ -197,6 +233,7 @@ Image4f HarcRenderer::render(FrameStats& stats)
     kernel_.setArg(a++, tf_.buffer());
     kernel_.setArg(a++, psi_);
     kernel_.setArg(a++, full_);
+    kernel_.setArg(a++, isoNormals_);
     kernel_.setArg(a++, params);
     device_.launch(kHarcWalkPass, kernel_, image_.width, image_.height);
 
@@ -204,10 +241,18 @@ Image4f HarcRenderer::render(FrameStats& stats)
     Image4f image = readImage(device_, out_, image_.width, image_.height);
     const std::vector<cl_uint> counts = device_.download<cl_uint>(stats_, pixels * 3);
     std::uint64_t steps = 0, bounded = 0, pieces = 0;
+    const bool iso = options_.integration == HarcOptions::Integration::Iso;
+    if (iso)
+        isoHitLambda_.resize(pixels);
     for (std::size_t p = 0; p < pixels; ++p) {
         steps += counts[3 * p];
         bounded += counts[3 * p + 1];
-        pieces += counts[3 * p + 2];
+        if (iso) {  // the hit's λ as float bits: pieces counts the hits
+            std::memcpy(&isoHitLambda_[p], &counts[3 * p + 2], sizeof(float));
+            pieces += std::isfinite(isoHitLambda_[p]) ? 1 : 0;
+        } else {
+            pieces += counts[3 * p + 2];
+        }
     }
     // The host's entry stage first (with raster entries the peeling draws' own device passes are among
     // the device's; this is the whole entry stage, draws, read-backs and the host's compaction included).
@@ -234,6 +279,7 @@ Image4f HarcRenderer::render(FrameStats& stats)
     case HarcOptions::Integration::Partial: stats.extra["integration"] = "partial"; break;
     case HarcOptions::Integration::Average: stats.extra["integration"] = "average"; break;
     case HarcOptions::Integration::Slices: stats.extra["integration"] = "slices"; break;
+    case HarcOptions::Integration::Iso: stats.extra["integration"] = "iso"; break;
     case HarcOptions::Integration::Full:
         stats.extra["integration"] = "full";
         stats.extra["full_table"] = std::to_string(ns) + "x" + std::to_string(ns) + "x" + std::to_string(nl);
@@ -257,7 +303,31 @@ Image4f HarcRenderer::render(FrameStats& stats)
     return image;
 }
 
+std::vector<double> HarcRenderer::isoHitDepth() const
+{
+    // λ is the distance along the unit ray from its origin (kernels/ray.h's clvr_ray_unit, as Camera::ray).
+    std::vector<double> z(isoHitLambda_.size(), std::numeric_limits<double>::infinity());
+    const glm::dvec3 forward = camera_.forward();
+    for (int y = 0; y < image_.height; ++y)
+        for (int x = 0; x < image_.width; ++x) {
+            const std::size_t p = static_cast<std::size_t>(y) * image_.width + x;
+            if (p >= isoHitLambda_.size() || !std::isfinite(isoHitLambda_[p]))
+                continue;
+            const Ray ray = camera_.ray(x, y, image_.width, image_.height);
+            z[p] = glm::dot(ray.origin + static_cast<double>(isoHitLambda_[p]) * ray.direction - camera_.position, forward);
+        }
+    return z;
+}
+
 }  // namespace
+
+std::vector<double> harcIsoHitDepth(const Renderer& renderer)
+{
+    const auto* harc = dynamic_cast<const HarcRenderer*>(&renderer);
+    if (!harc)
+        throw InternalError("harcIsoHitDepth: not a harc renderer");
+    return harc->isoHitDepth();
+}
 
 TechniqueInfo harcTechnique()
 {

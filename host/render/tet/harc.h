@@ -24,10 +24,21 @@ namespace clvr {
 struct HarcOptions {
     // Slices: not a harc option but tetslice's fused path (host/render/tet/tetslice.h): the walk samples the
     // cells' linear field at slices of constant eye depth sliceDepth0 + k sliceSpacing, k < sliceCount.
-    enum class Integration { Partial, Average, Full, Slices };
+    // Iso: tetiso's fused path (host/render/tet/tetiso.h): the walk stops at the ray's first crossing of
+    // iso.value and shades it (HarcIso).
+    enum class Integration { Partial, Average, Full, Slices, Iso };
     Integration integration = Integration::Partial;
     double sliceDepth0 = 0.0, sliceSpacing = 0.0;
     int sliceCount = 0;
+    struct HarcIso {
+        double value = 0.0;                  // data units
+        std::vector<glm::dvec3> normals;     // per mesh point, unit (or 0): interpolated barycentrically in each cell
+        glm::dvec3 light{0.0, 0.0, 1.0};     // towards the light, unit; the color is the transfer function's
+                                             // at the value (white without one)
+        double ambient = 0.1, diffuse = 0.9;
+        bool shaded = true;                  // false: the color unshaded
+        bool equalWeights = false;           // the entry and exit points' shades averaged instead of weighted by q
+    } iso;
     int fullScalarSamples = 64;     // "full_table": [NS, NL], the (s_f, s_b, l) table is NS x NS x NL
     int fullLengthSamples = 64;
     std::uint64_t maxSteps = 0;     // per ray; 0 = the default, 4 * cbrt(tets) + 10000
@@ -97,8 +108,12 @@ void prependEyeEntry(HarcEntryLists& lists, std::uint32_t tet);
 // for bad options or an empty mesh, DeviceError when the mesh does not fit on the device.
 std::unique_ptr<Renderer> makeHarcRenderer(Device& device, const Scene& scene, const TetMesh& mesh,
                                            const TetTopology& topology);
-// The same with the options given instead of read from scene.options (tetslice's fused path).
+// The same with the options given instead of read from scene.options (tetslice's and tetiso's fused paths).
 std::unique_ptr<Renderer> makeHarcRenderer(Device& device, const Scene& scene, const TetMesh& mesh,
                                            const TetTopology& topology, const HarcOptions& options);
+
+// For a harc renderer made with Integration::Iso, after a frame: the eye depth of each pixel's iso-surface
+// hit (row 0 at the top), +infinity where its ray found none. InternalError for any other renderer.
+std::vector<double> harcIsoHitDepth(const Renderer& renderer);
 
 }  // namespace clvr

@@ -8,6 +8,7 @@
 #include "host/render/options_util.h"
 #include "host/render/scaffold.h"
 #include "host/render/tet/cell_faces.h"
+#include "host/render/tet/harc.h"
 #include "host/runtime/embedded_kernels.h"
 #include "host/runtime/errors.h"
 #include "kernels/tetiso_params.h"
@@ -137,6 +138,27 @@ std::vector<glm::dvec3> averagedVertexGradients(const TetMesh& mesh)
 namespace {
 
 
+// The scene's iso-surface, checked for tetiso: present, shaded with gradients or not at all.
+IsoSpec checkedIso(const Scene& scene)
+{
+    if (!scene.iso)
+        throw InputError("iso: technique tetiso needs \"iso\": {\"value\": ...}, and the scene has none");
+    if (scene.iso->shading == IsoSpec::Shading::Gradientless)
+        throw InputError("iso.shading: tetiso shades with vertex gradients: \"gradient\" or \"none\", got \"gradientless\"");
+    return *scene.iso;
+}
+
+// Per point the shading normal -gradient / |gradient| of the averaged cell gradients (0 where it is 0).
+std::vector<glm::dvec3> vertexNormals(const TetMesh& mesh)
+{
+    std::vector<glm::dvec3> normals = averagedVertexGradients(mesh);
+    for (glm::dvec3& n : normals) {
+        const double length = glm::length(n);
+        n = length > 0.0 ? -n / length : glm::dvec3(0.0);
+    }
+    return normals;
+}
+
 std::string tetisoFragmentSource()
 {
     return "#define CLVR_TETISO_FRAGMENT 1\n" + std::string(embeddedKernelSource("tetiso.cl"));
@@ -189,11 +211,7 @@ Tetiso::Tetiso(Device& device, const Scene& scene, const TetMesh& mesh)
       shift_(0.5 * (mesh.boundsMin() + mesh.boundsMax())), cells_(mesh, shift_, "tetiso"), rasterizer_(device),
       fb_(device, scene.image.width, scene.image.height, true)
 {
-    if (!scene.iso)
-        throw InputError("iso: technique tetiso needs \"iso\": {\"value\": ...}, and the scene has none");
-    iso_ = *scene.iso;
-    if (iso_.shading == IsoSpec::Shading::Gradientless)
-        throw InputError("iso.shading: tetiso shades with vertex gradients: \"gradient\" or \"none\", got \"gradientless\"");
+    iso_ = checkedIso(scene);
     color_ = surfaceColor(scene.transferFunction);
     const glm::dvec3 lo = mesh.boundsMin(), hi = mesh.boundsMax();
     camera_ = frameCamera(scene, lo, hi);
@@ -210,12 +228,7 @@ Tetiso::Tetiso(Device& device, const Scene& scene, const TetMesh& mesh)
         scalars_[p] = static_cast<float>((mesh.scalars[p] - sLo_) * sScale_);
     isoNormalized_ = static_cast<float>(std::clamp((iso_.value - sLo_) * sScale_, 0.0, 1.0));
 
-    const std::vector<glm::dvec3> gradients = averagedVertexGradients(mesh);
-    normals_.resize(gradients.size());
-    for (std::size_t p = 0; p < gradients.size(); ++p) {
-        const double length = glm::length(gradients[p]);
-        normals_[p] = length > 0.0 ? -gradients[p] / length : glm::dvec3(0.0);
-    }
+    normals_ = vertexNormals(mesh);
 
     // The iso-value's interval, then the exact range test of each of its cells.
     std::vector<double> cellMin(mesh.tets.size()), cellMax(mesh.tets.size());
@@ -378,6 +391,7 @@ Image4f Tetiso::render(FrameStats& stats)
     finishFrame(device_, clock, stats, std::move(hostPasses));
     stats.extra["launches"] = mergePassesByName(stats.passes) - hostCount;  // per pass name: its launches summed
     counts_.report(stats);
+    stats.extra["path"] = "raster";
     stats.extra["iso_value"] = iso_.value;
     stats.extra["weights"] = options_.weights == TetisoOptions::Weights::Equal ? "equal" : "interpolated";
     stats.extra["intervals"] = options_.intervals;
@@ -405,6 +419,47 @@ std::vector<double> Tetiso::hitDepth()
     return z;
 }
 
+// The fused path: harc's renderer walking the cells with Integration::Iso — the first crossing of each ray,
+// shaded from the same vertex normals, light and weights as the face draws —, its stats named as tetiso's.
+class TetisoFused final : public TetisoRenderer {
+public:
+    TetisoFused(Device& device, const Scene& scene, const TetMesh& mesh)
+    {
+        const TetisoOptions options = parseTetisoOptions(scene.options);
+        const IsoSpec iso = checkedIso(scene);
+        HarcOptions harc;
+        harc.integration = HarcOptions::Integration::Iso;
+        harc.iso.value = iso.value;
+        harc.iso.normals = vertexNormals(mesh);
+        harc.iso.light = iso.lightFor(frameCamera(scene, mesh.boundsMin(), mesh.boundsMax()));
+        harc.iso.ambient = iso.ambient;
+        harc.iso.diffuse = iso.diffuse;
+        harc.iso.shaded = iso.shading != IsoSpec::Shading::None;
+        harc.iso.equalWeights = options.weights == TetisoOptions::Weights::Equal;
+        weights_ = options.weights == TetisoOptions::Weights::Equal ? "equal" : "interpolated";
+        isoValue_ = iso.value;
+        walk_ = makeHarcRenderer(device, scene, mesh, buildTopology(mesh), harc);
+    }
+    Image4f render(FrameStats& stats) override
+    {
+        Image4f image = walk_->render(stats);
+        stats.samples = 0;
+        stats.extra["path"] = "fused";
+        stats.extra["pixels_hit"] = stats.extra["pieces"];  // the walk's count of rays that found a crossing
+        stats.extra["iso_value"] = isoValue_;
+        stats.extra["weights"] = weights_;
+        return image;
+    }
+    std::uint64_t residentBytes() const override { return walk_->residentBytes(); }
+    void setTransferFunction(const TransferFunction& tf) override { walk_->setTransferFunction(tf); }
+    std::vector<double> hitDepth() override { return harcIsoHitDepth(*walk_); }
+
+private:
+    std::unique_ptr<Renderer> walk_;
+    double isoValue_ = 0.0;
+    std::string weights_;
+};
+
 }  // namespace
 
 TechniqueInfo tetisoTechnique()
@@ -415,7 +470,9 @@ TechniqueInfo tetisoTechnique()
     t.description = "shaded iso-surfaces of tetrahedral grids from cell faces with interpolation weights, seeds/000 §4.1 (docs/tetiso.md)";
     t.options = {
         {"weights", "interpolated", "", "\"interpolated\" (Figure 8's weights) or \"equal\" (front and back faces blended equally, Figure 9 left)"},
-        {"intervals", 64, "", "interval bit-streams over the value range, 1..4096 (which cells an iso-value draws)"},
+        {"intervals", 64, "", "interval bit-streams over the value range, 1..4096 (which cells an iso-value draws; raster path)"},
+        {"path", "fused", "", "\"fused\" (harc's cell walk stops at each ray's first crossing) or \"raster\" (the face "
+                              "draws and per-pixel passes of seeds/000 §4.1)"},
     };
     t.makeForMesh = [](Device& device, const Scene& scene, const TetMesh& mesh) -> std::unique_ptr<Renderer> {
         return makeTetisoRenderer(device, scene, mesh);
@@ -438,6 +495,9 @@ TetisoOptions parseTetisoOptions(const nlohmann::json& options)
                 badOption(key, "must be \"interpolated\" or \"equal\", got " + value.dump());
         } else if (key == "intervals") {
             o.intervals = integerOption(key, value, 1, 4096);
+        } else if (key == "path") {
+            o.path = choiceOption(key, value, {"fused", "raster"}) == 0 ? TetisoOptions::Path::Fused
+                                                                       : TetisoOptions::Path::Raster;
         } else {
             unparsedOption(info, key);
         }
@@ -447,6 +507,8 @@ TetisoOptions parseTetisoOptions(const nlohmann::json& options)
 
 std::unique_ptr<TetisoRenderer> makeTetisoRenderer(Device& device, const Scene& scene, const TetMesh& mesh)
 {
+    if (parseTetisoOptions(scene.options).path == TetisoOptions::Path::Fused)
+        return std::make_unique<TetisoFused>(device, scene, mesh);
     return std::make_unique<Tetiso>(device, scene, mesh);
 }
 

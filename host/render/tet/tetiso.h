@@ -28,7 +28,12 @@ namespace clvr {
 struct TetisoOptions {
     enum class Weights { Interpolated, Equal };
     Weights weights = Weights::Interpolated;  // "weights": "interpolated" (Figure 8) or "equal" (Figure 9, left)
-    int intervals = 64;                       // "intervals": bit-streams over the normalized value range
+    int intervals = 64;                       // "intervals": bit-streams over the normalized value range (raster path)
+    // "path": "fused" (default): harc's cell walk stops each ray at its first crossing of the iso-value and
+    // shades it as the face draws would (host/render/tet/harc.h, Integration::Iso); "raster": the paper's
+    // face draws and per-pixel passes through the raster stage.
+    enum class Path { Fused, Raster };
+    Path path = Path::Fused;
 };
 
 // Its registry entry (host/render/renderer.h).
