@@ -36,6 +36,8 @@ CLVR_LAYOUT_FIELD(ClSlice3dParams, own_lo)
 CLVR_LAYOUT_FIELD(ClSlice3dParams, own_hi)
 CLVR_LAYOUT_FIELD(ClSlice3dParams, grid_hi)
 CLVR_LAYOUT_FIELD(ClSlice3dParams, clip_mesh)
+CLVR_LAYOUT_FIELD(ClSlice3dParams, tight_lo)
+CLVR_LAYOUT_FIELD(ClSlice3dParams, tight_hi)
 
 CLVR_LAYOUT_SIZE(ClSlice3dOverBackgroundParams)
 CLVR_LAYOUT_FIELD(ClSlice3dOverBackgroundParams, background)

@@ -142,11 +142,32 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
      * sample is still checked, so this only limits the loop. */
     const float3 own_lo = p.own_lo.xyz, own_hi = p.own_hi.xyz;
     const int4 offset = p.part_offset;
-    const ClvrOwnedGrid owned = {dims, offset, own_lo, own_hi};  /* for empty-space runs */
     float zin, zout;
     clvr_box_chord(go, gd, own_lo, own_hi, &zin, &zout);
     int k_lo, k_hi;
     clvr_slice_range(zin, zout, depth0, delta_s, p.slice_count, &k_lo, &k_hi);
+#ifndef SLICE3D_PREINTEGRATED
+    /* With empty-space skipping the sample loop runs over the box of the bricks that are not empty
+     * (p.tight_lo, p.tight_hi): every sample outside it lies in an empty brick, which the loop would step
+     * over (tau 0: the same bits), and the runs through the margins between the data and the grid's faces
+     * cost per ray whatever the slice count. The samples counted stay the owned box's, as without it: its
+     * owned samples form one run of k (each coordinate is monotonic in k), from k_first to k_last. */
+    int k_first = k_lo, k_last = k_hi;
+    const float3 loop_lo = skip ? p.tight_lo.xyz : own_lo, loop_hi = skip ? p.tight_hi.xyz : own_hi;
+    if (skip) {
+        while (k_first <= k_last && !clvr_grid_owned(clvr_slice_point(go, gd, depth0, delta_s, k_first), own_lo, own_hi))
+            ++k_first;
+        while (k_last >= k_first && !clvr_grid_owned(clvr_slice_point(go, gd, depth0, delta_s, k_last), own_lo, own_hi))
+            --k_last;
+        float tin, tout;
+        clvr_box_chord(go, gd, loop_lo, loop_hi, &tin, &tout);
+        clvr_slice_range(tin, tout, depth0, delta_s, p.slice_count, &k_lo, &k_hi);
+    }
+    const ClvrOwnedGrid owned = {dims, offset, loop_lo, loop_hi};  /* for empty-space runs */
+    int k_stop = k_last;  /* where early termination stopped the ray */
+#else
+    const ClvrOwnedGrid owned = {dims, offset, own_lo, own_hi};  /* for empty-space runs */
+#endif
 
     float3 c = (float3)(0.0f);
     float alpha_acc = 0.0f;
@@ -210,7 +231,7 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
         float transmittance = 1.0f;
         for (int k = k_lo; k <= k_hi; ++k) {
             const float3 g = clvr_slice_point(go, gd, depth0, delta_s, k);
-            if (!clvr_grid_owned(g, own_lo, own_hi))
+            if (!clvr_grid_owned(g, loop_lo, loop_hi))
                 continue;
             const float3 gl = clvr_grid_local(g, offset);
             if (skip) {
@@ -239,14 +260,16 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
             const float alpha = 1.0f - clvr_exp2(ct.w * slab);
             c += (transmittance * alpha) * ct.xyz;
             transmittance *= 1.0f - alpha;
-            if (1.0f - transmittance >= ert_alpha)
+            if (1.0f - transmittance >= ert_alpha) {
+                k_stop = k;
                 break;
+            }
         }
         alpha_acc = 1.0f - transmittance;
     } else {
         for (int k = k_hi; k >= k_lo; --k) {
             const float3 g = clvr_slice_point(go, gd, depth0, delta_s, k);
-            if (!clvr_grid_owned(g, own_lo, own_hi))
+            if (!clvr_grid_owned(g, loop_lo, loop_hi))
                 continue;
             const float3 gl = clvr_grid_local(g, offset);
             if (skip) {
@@ -276,6 +299,12 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
             c = ct.xyz * alpha + (1.0f - alpha) * c;
             alpha_acc = alpha + (1.0f - alpha) * alpha_acc;
         }
+    }
+#endif
+#ifndef SLICE3D_PREINTEGRATED
+    if (skip) {  /* the owned box's samples up to where the ray stopped; all but those taken stepped over */
+        const uint inside = k_stop >= k_first ? (uint)(k_stop - k_first + 1) : 0u;
+        stepped_over = inside - taken;
     }
 #endif
     const int i = y * p.width + x;

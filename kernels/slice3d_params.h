@@ -43,7 +43,11 @@ typedef struct {
                               * coordinates: the box whose chord the slabs at its faces are clipped to
                               * (kernels/slice3d.cl), w = 0 */
     cl_int4 clip_mesh;       /* SLICE3D_CLIP_MESH builds: (layers, 1 if inverse, 1 if naive, 0) */
-} ClSlice3dParams;           /* 384 bytes */
+    cl_float4 tight_lo;      /* with skip: the box of the bricks that are not empty, in full-grid coordinates,
+                              * inside [own_lo, own_hi) (tight_lo >= tight_hi on an axis: none); samples the
+                              * sample loop visits (kernels/slice3d.cl), w = 0 */
+    cl_float4 tight_hi;
+} ClSlice3dParams;           /* 416 bytes */
 
 typedef struct {
     cl_float4 background;    /* image background, w = 0 */

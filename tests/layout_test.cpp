@@ -137,7 +137,7 @@ TEST(Layout, EveryParamsStructFitsTheKernelArgumentSpace)
     }
     // The sizes the headers document (a field added without its padding shows here first).
     EXPECT_EQ(sizeof(ClCamera), 80u);
-    EXPECT_EQ(sizeof(ClSlice3dParams), 384u);
+    EXPECT_EQ(sizeof(ClSlice3dParams), 416u);
     EXPECT_EQ(sizeof(ClPlanesParams), 288u);
     EXPECT_EQ(sizeof(ClBlendParams), 256u);
     EXPECT_EQ(sizeof(ClHarcParams), 256u);

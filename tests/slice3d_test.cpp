@@ -258,6 +258,24 @@ TEST(Slice3dEmptySpace, BrickGridHoldsEachBricksMinMaxWithOnePointOverlap)
             }
 }
 
+// The box the fused kernel's sample loop runs in: the bricks that are not empty, per axis their lowest and
+// highest index; none at all: lo = the brick counts, hi = -1 (an empty box).
+TEST(Slice3dEmptySpace, FilledBricksSpanTheNonEmptyOnes)
+{
+    const glm::ivec3 dims(5, 4, 3);
+    std::vector<cl_uchar> empty(60, 1);
+    glm::ivec3 lo, hi;
+    filledBricks(dims, empty, lo, hi);
+    EXPECT_EQ(lo, dims);
+    EXPECT_EQ(hi, glm::ivec3(-1));
+    auto at = [&](int x, int y, int z) -> cl_uchar& { return empty[(static_cast<std::size_t>(z) * 4 + y) * 5 + x]; };
+    at(3, 1, 2) = 0;
+    at(1, 2, 0) = 0;
+    filledBricks(dims, empty, lo, hi);
+    EXPECT_EQ(lo, glm::ivec3(1, 1, 0));
+    EXPECT_EQ(hi, glm::ivec3(3, 2, 2));
+}
+
 TEST(Slice3dEmptySpace, RadiiAreChebyshevDistancesToTheNearestNonEmptyBrick)
 {
     const glm::ivec3 n(7, 5, 3);
@@ -329,9 +347,21 @@ TEST(Slice3dEmptySpace, SkippingIsBitIdenticalToTheFullLoop)
         TransferFunction tf;
         bool expectSkips;
     };
+    // Data only in one corner block: the sample loop runs inside the box of the bricks that are not empty
+    // (kernels/slice3d.cl), much smaller than the grid; the samples counted stay the grid's.
+    static const Volume corner = [] {
+        Volume v = generateVolume("marschner-lobb", {40, 36, 44});
+        for (int z = 0; z < v.dims.z; ++z)
+            for (int y = 0; y < v.dims.y; ++y)
+                for (int x = 0; x < v.dims.x; ++x)
+                    if (x < 21 || y < 17 || z > 26)
+                        v.values[(static_cast<std::size_t>(z) * v.dims.y + y) * v.dims.x + x] = 0.0f;
+        return v;
+    }();
     const Case cases[] = {{"sphere", &sphere, sphereTf, true},
                           {"ml threshold", &marschnerLobb41(), mlThreshold, true},
-                          {"ml usual", &marschnerLobb41(), test::designTransferFunction(), false}};
+                          {"ml usual", &marschnerLobb41(), test::designTransferFunction(), false},
+                          {"corner block", &corner, mlThreshold, true}};
     const json orders[] = {{{"slices", 96}},
                            {{"slices", 96}, {"order", "front-to-back"}},
                            {{"slices", 128}, {"order", "front-to-back"}, {"early_termination", 0.9}}};

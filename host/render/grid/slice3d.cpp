@@ -75,6 +75,7 @@ private:
     cl::Buffer emptyBricks_;
     cl::Buffer psi_;  // integration "preintegrated": the ψ table of host/optics/psi_table.h
     std::uint64_t emptyBrickCount_ = 0;
+    glm::ivec3 filledLo_{0}, filledHi_{-1};  // the bricks that are not empty span [filledLo_, filledHi_]
     double brickSetupMs_ = 0.0;
     std::string voxelType_ = "float32";  // on the device
     // Fused path.
@@ -189,6 +190,7 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
         brickSetupMs_ = msSince(t0);
         brickDims_ = grid.dims;
         emptyBrickCount_ = static_cast<std::uint64_t>(std::count(flags.begin(), flags.end(), cl_uchar(1)));
+        filledBricks(grid.dims, flags, filledLo_, filledHi_);
         emptyBricks_ = device_.upload("slice3d empty-space radii", emptySpaceRadii(grid.dims, flags));
         residentBytes_ += flags.size();
         if (clipMesh_)  // the peeling draws
@@ -262,6 +264,7 @@ void Slice3dRenderer::setTransferFunction(const TransferFunction& tf)
         const std::vector<cl_uchar> radii = emptySpaceRadii(brickGrid_.dims, flags);
         brickSetupMs_ = msSince(t0);
         emptyBrickCount_ = static_cast<std::uint64_t>(std::count(flags.begin(), flags.end(), cl_uchar(1)));
+        filledBricks(brickGrid_.dims, flags, filledLo_, filledHi_);
         device_.queue().enqueueWriteBuffer(emptyBricks_, CL_TRUE, 0, radii.size(), radii.data());
     } else {
         fragmentProgram_.buffers[1] = tf_.buffer();
@@ -295,6 +298,13 @@ Image4f Slice3dRenderer::renderFused(FrameStats& stats)
     params.front_to_back = frontToBack ? 1 : 0;
     params.ert_alpha = ert;
     setGridPartParams(params, part_, dims_);
+    // The box of the bricks that are not empty (brick b covers the points [4b, 4b + 4] of this volume, at
+    // part_offset in the full grid), inside the owned box: the samples the loop visits (kernels/slice3d.cl).
+    const glm::vec3 partOffset(part_.offset);
+    for (int a = 0; a < 3; ++a) {
+        params.tight_lo.s[a] = std::max(params.own_lo.s[a], partOffset[a] + static_cast<float>(filledLo_[a] * kBrickCells));
+        params.tight_hi.s[a] = std::min(params.own_hi.s[a], partOffset[a] + static_cast<float>((filledHi_[a] + 1) * kBrickCells));
+    }
     // The whole grid's box, [0, n - 1] per axis, half open above as own_hi is (the next float above n - 1), so
     // that a ray lying in the last grid plane counts as inside, as its samples do.
     const glm::vec3 last = glm::vec3(part_.fullDims - 1);
@@ -723,6 +733,21 @@ std::vector<cl_uchar> emptyBricks(const BrickGrid& grid, const TransferFunction&
         flags[b] = tauZeroOn(tf, m.x - pad, m.y + pad) ? 1 : 0;
     }
     return flags;
+}
+
+void filledBricks(const glm::ivec3& brickDims, const std::vector<cl_uchar>& empty, glm::ivec3& lo, glm::ivec3& hi)
+{
+    lo = brickDims;
+    hi = glm::ivec3(-1);
+    glm::ivec3 b;
+    std::size_t i = 0;
+    for (b.z = 0; b.z < brickDims.z; ++b.z)
+        for (b.y = 0; b.y < brickDims.y; ++b.y)
+            for (b.x = 0; b.x < brickDims.x; ++b.x, ++i)
+                if (!empty[i]) {
+                    lo = glm::min(lo, b);
+                    hi = glm::max(hi, b);
+                }
 }
 
 std::vector<cl_uchar> emptySpaceRadii(const glm::ivec3& brickDims, const std::vector<cl_uchar>& empty)

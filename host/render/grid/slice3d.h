@@ -73,6 +73,10 @@ BrickGrid buildBrickGrid(const Volume& volume);
 // float rounding in the trilinear interpolation cannot leave the interval.
 std::vector<cl_uchar> emptyBricks(const BrickGrid& grid, const TransferFunction& tf);
 
+// The bricks that are not empty (`empty`: emptyBricks' flags) span [lo, hi] per axis; none: lo = brickDims,
+// hi = -1. The fused kernel's sample loop runs inside their box.
+void filledBricks(const glm::ivec3& brickDims, const std::vector<cl_uchar>& empty, glm::ivec3& lo, glm::ivec3& hi);
+
 // What the fused kernel reads per brick (kernels/slice3d.cl): 0 for a brick that is not empty, else
 // r + 1 where every brick within Chebyshev distance r is empty (bricks outside the grid count as
 // empty), capped at 255; the kernel steps over that cube in one run.
