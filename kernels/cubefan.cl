@@ -71,8 +71,9 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
  * level[v], value[v] (CubeOctree::selectGrid, laid out by cubefan_at): per voxel v the level L of the selected cube
  * that holds it, bit 7 set where that cube is transparent, and the cube's value. In the coordinates
  * q = (p - field_lo) inv_spacing, voxel v's cube is [v, v + 1) and the selected cube holding it
- * [(v >> L) << L, min(((v >> L) + 1) << L, dims)). From the voxel where the ray enters the field (t >= 0:
- * in front of the eye, or of the image plane), each step reads the cube holding the current voxel, adds
+ * [(v >> L) << L, min(((v >> L) + 1) << L, dims)). From the voxel where the ray enters the box of the bricks
+ * that add color (p.filled_lo, p.filled_hi: outside it every cube is transparent) (t >= 0: in front of the
+ * eye, or of the image plane) to where it leaves it, each step reads the cube holding the current voxel, adds
  * its chord of length l (world units: the ray's direction is a unit vector) as (C alpha, alpha) with
  * alpha = 1 - exp(-tau l), exactly as the reference integral and the raster path's exact thickness, and
  * moves to the voxel across the face the ray leaves by. The voxel index moves monotonically along the
@@ -115,7 +116,9 @@ kernel void cubefan_fused(global float4* out, global uint* steps, global uint* s
     /* A ray parallel to an axis gets a direction of 1e-30 along it: its exits there lie beyond any other. */
     qd3 = select(qd3, copysign((float3)(1e-30f), qd3), isless(fabs(qd3), (float3)(1e-30f)));
     const float3 inv3 = 1.0f / qd3;
-    const float3 t0 = -qe3 * inv3, t1 = (convert_float3(p.dims.xyz) - qe3) * inv3;
+    /* The ray's part inside the box of the bricks that add color: outside it every cube is transparent. */
+    const int3 box_lo = p.filled_lo.xyz, box_hi = p.filled_hi.xyz;
+    const float3 t0 = (convert_float3(box_lo) - qe3) * inv3, t1 = (convert_float3(box_hi) - qe3) * inv3;
     const float3 tn = fmin(t0, t1), tx = fmax(t0, t1);
     float t = fmax(fmax(fmax(tn.x, tn.y), tn.z), 0.0f);
     const float t_out = fmin(fmin(tx.x, tx.y), tx.z);
@@ -130,9 +133,9 @@ kernel void cubefan_fused(global float4* out, global uint* steps, global uint* s
     float transmittance = 1.0f;
     uint crossed = 0, stepped_over = 0;
     if (t_out > t) {
-        int vx = clamp((int)floor(qex + qdx * t), 0, nx - 1);
-        int vy = clamp((int)floor(qey + qdy * t), 0, ny - 1);
-        int vz = clamp((int)floor(qez + qdz * t), 0, nz - 1);
+        int vx = clamp((int)floor(qex + qdx * t), box_lo.x, box_hi.x - 1);
+        int vy = clamp((int)floor(qey + qdy * t), box_lo.y, box_hi.y - 1);
+        int vz = clamp((int)floor(qez + qdz * t), box_lo.z, box_hi.z - 1);
         for (;;) {
             const size_t at = cubefan_at(vx, vy, vz, bricks);
             const int code = level[at];
@@ -171,8 +174,8 @@ kernel void cubefan_fused(global float4* out, global uint* steps, global uint* s
             vx = cubefan_next(axis == 0, vx, lox, hix, px, qex, qdx, t);
             vy = cubefan_next(axis == 1, vy, loy, hiy, py, qey, qdy, t);
             vz = cubefan_next(axis == 2, vz, loz, hiz, pz, qez, qdz, t);
-            if ((uint)vx >= (uint)nx || (uint)vy >= (uint)ny || (uint)vz >= (uint)nz)
-                break;
+            if (vx < box_lo.x || vy < box_lo.y || vz < box_lo.z || vx >= box_hi.x || vy >= box_hi.y || vz >= box_hi.z)
+                break; /* out of the box (a line leaves a box once) */
         }
     }
     out[pixel] = (float4)(c + transmittance * p.background.xyz, 1.0f - transmittance);

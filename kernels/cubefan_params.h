@@ -27,6 +27,8 @@ typedef struct {
     cl_int4 dims;           /* xyz: voxels per axis (the selection grid's) */
     cl_int width, height, tf_count;
     cl_float ert_alpha;     /* stop once the opacity reaches this; > 1: never */
-} ClCubefanFusedParams;     /* 160 bytes */
+    cl_int4 filled_lo;      /* xyz: the box of the bricks with a voxel that adds color, in voxels [lo, hi): */
+    cl_int4 filled_hi;      /* the rays walk only inside it (none: lo >= hi) */
+} ClCubefanFusedParams;     /* 192 bytes */
 
 #endif

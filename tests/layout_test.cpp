@@ -130,6 +130,7 @@ TEST(Layout, EveryParamsStructFitsTheKernelArgumentSpace)
         {"accum", sizeof(ClAccumParams) + 2 * sizeof(void*)},
         {"tetslice_composite", sizeof(ClTetsliceCompositeParams) + 4 * sizeof(void*)},
         {"tetiso_weights", sizeof(ClTetisoParams) + 3 * sizeof(void*)},
+        {"cubefan_fused", sizeof(ClCubefanFusedParams) + 7 * sizeof(void*)},
     };
     for (const auto& [kernel, bytes] : argumentBytes) {
         EXPECT_LE(bytes, limit) << kernel;
@@ -148,6 +149,7 @@ TEST(Layout, EveryParamsStructFitsTheKernelArgumentSpace)
     EXPECT_EQ(sizeof(ClTetisoParams), 32u);
     EXPECT_EQ(sizeof(ClIso3dFinishParams), 48u);
     EXPECT_EQ(sizeof(ClIso3dFusedParams), 240u);
+    EXPECT_EQ(sizeof(ClCubefanFusedParams), 192u);
     EXPECT_EQ(sizeof(ClStack2dIsoFinishParams), 32u);
     EXPECT_EQ(sizeof(ClStack2dFusedParams), 384u);
     EXPECT_EQ(sizeof(ClPixelTransfer), 128u);

@@ -29,6 +29,7 @@
 namespace clvr {
 
 static_assert(sizeof(ClCubefanUniforms) == 112, "float4s only: the fragment program reads it from its uniforms");
+static_assert(sizeof(ClCubefanFusedParams) == 192, "also probed on the device by tests/layout_test.cpp");
 
 const char* opacityName(CubefanOptions::Opacity opacity)
 {
@@ -252,6 +253,7 @@ private:
     cubefan::SelectionStats gridStats_;
     std::uint64_t gridEmptyBricks_ = 0;  // bricks of 4^3 voxels with nothing to add
     double gridMs_ = 0.0;                // the last build of the grid (selection, empty space, upload)
+    glm::ivec3 filledLo_{0}, filledHi_{0};  // voxels [lo, hi) hold every cube that adds color
     std::uint64_t residentBytes_ = 0;
 };
 
@@ -331,6 +333,10 @@ double CubefanRenderer::updateSelectionGrid()
     }
     const std::vector<cl_uchar> space = emptySpaceRadii(bricks, empty);
     gridEmptyBricks_ = static_cast<std::uint64_t>(std::count(empty.begin(), empty.end(), cl_uchar(1)));
+    glm::ivec3 lo, hi;  // the bricks with a voxel that adds color: the rays walk only in their box
+    filledBricks(bricks, empty, lo, hi);
+    filledLo_ = glm::min(lo * 4, dims_);
+    filledHi_ = glm::min((hi + 1) * 4, dims_);
     device_.queue().enqueueWriteBuffer(gridLevel_, CL_FALSE, 0, grid.level.size(), grid.level.data());
     device_.queue().enqueueWriteBuffer(gridSpace_, CL_FALSE, 0, space.size(), space.data());
     device_.queue().enqueueWriteBuffer(gridValue_, CL_TRUE, 0, grid.value.size() * sizeof(float), grid.value.data());
@@ -354,6 +360,8 @@ Image4f CubefanRenderer::renderFused(FrameStats& stats)
     p.height = image_.height;
     p.tf_count = static_cast<cl_int>(tf_.count());
     p.ert_alpha = options_.earlyTermination < 1.0 ? static_cast<float>(options_.earlyTermination) : 2.0f;
+    p.filled_lo = cl_int4{{filledLo_.x, filledLo_.y, filledLo_.z, 0}};
+    p.filled_hi = cl_int4{{filledHi_.x, filledHi_.y, filledHi_.z, 0}};
     int a = 0;
     fused_.setArg(a++, fb_.color());
     fused_.setArg(a++, fusedSteps_);
