@@ -110,9 +110,7 @@ TEST(SphericalCeiling, DoesTheFusedKernelsWork)
         const clvr::tools::SphericalCeiling ceiling(volume, scene.transferFunction, *scene.camera, scene.image,
                                                     clvr::parseSphericalOptions(scene.options));
         const clvr::tools::CeilingResult result = ceiling.render(2);
-        clvr::Image4d want(kernel.width(), kernel.height());
-        for (std::size_t i = 0; i < kernel.pixelCount(); ++i)
-            want.pixels()[i] = glm::dvec4(kernel.pixels()[i]);
+        const clvr::Image4d want = clvr::raster::reference::toDouble(kernel);
         const clvr::test::ImageError e = clvr::test::imageError(result.image, want);
         std::printf("[ measured ] spherical ceiling vs kernel (%s): max %.3g, mean %.3g; samples %llu vs %llu\n",
                     c.options.dump().c_str(), std::max({e.maxAbs.r, e.maxAbs.g, e.maxAbs.b, e.maxAbs.a}),
@@ -155,9 +153,7 @@ TEST(Stack2dCeiling, DoesTheFusedKernelsWork)
         ASSERT_TRUE(clvr::tools::stack2dCeilingFits(scene, options));
         const clvr::tools::Stack2dCeiling ceiling(volume, scene.transferFunction, *scene.camera, scene.image, options);
         const clvr::tools::CeilingResult result = ceiling.render(2);
-        clvr::Image4d want(kernel.width(), kernel.height());
-        for (std::size_t i = 0; i < kernel.pixelCount(); ++i)
-            want.pixels()[i] = glm::dvec4(kernel.pixels()[i]);
+        const clvr::Image4d want = clvr::raster::reference::toDouble(kernel);
         const clvr::test::ImageError e = clvr::test::imageError(result.image, want);
         std::printf("[ measured ] stack2d ceiling vs kernel (%s): max %.3g, mean %.3g; samples %llu vs %llu\n",
                     c.options.dump().c_str(), std::max({e.maxAbs.r, e.maxAbs.g, e.maxAbs.b, e.maxAbs.a}),

@@ -8,6 +8,7 @@
 #include "host/io/volume_io.h"
 #include "host/reference/cube_reference.h"
 #include "host/runtime/errors.h"
+#include "raster/reference/pixel_transfer.h"
 #include "tests/support/test_util.h"
 
 #include <gtest/gtest.h>
@@ -134,13 +135,9 @@ TEST(CubefanRenderer, ErrorZeroMatchesTheExactCubeFieldIntegral)
         EXPECT_GT(errorOf[2], 5.0 * errorOf[0]) << view;
         // The texture is what the fragments read: at 512^2 (k = l_max tau_max = 1.5 here) it is the
         // exponential to 1e-5; at 4^2 its bilinear error shows.
-        const Image4f exp = render(makeScene(camera, tf, 64, {{"opacity", "exp"}}), volume);
-        Image4d expD(64, 64);
+        const Image4d expD = clvr::raster::reference::toDouble(render(makeScene(camera, tf, 64, {{"opacity", "exp"}}), volume));
         const Image4f texture = render(makeScene(camera, tf, 64, {{"path", "raster"}}), volume);
         const Image4f coarse = render(makeScene(camera, tf, 64, {{"texture_size", 4}}), volume);
-        for (int y = 0; y < 64; ++y)
-            for (int x = 0; x < 64; ++x)
-                expD.at(x, y) = glm::dvec4(exp.at(x, y));
         const double tableError = worst(test::imageError(texture, expD).maxAbs);
         const double coarseError = worst(test::imageError(coarse, expD).maxAbs);
         std::printf("%s: texture 512^2 vs exp %.2e, 4^2 vs exp %.2e\n", view.c_str(), tableError, coarseError);
@@ -309,10 +306,7 @@ TEST(CubefanFused, IsTheExactThicknessImageOfTheRasterPath)
             EXPECT_EQ(rasterStats.extra["path"], "raster");
             EXPECT_EQ(count(fusedStats, "cubes"), count(rasterStats, "cubes")) << what;
             EXPECT_GT(count(fusedStats, "cubes_crossed"), 0u) << what;
-            Image4d rasterD(64, 64);
-            for (int y = 0; y < 64; ++y)
-                for (int x = 0; x < 64; ++x)
-                    rasterD.at(x, y) = glm::dvec4(raster.at(x, y));
+            const Image4d rasterD = clvr::raster::reference::toDouble(raster);
             const test::ImageError e = printError("fused vs raster (exact thickness), " + what, fused, rasterD);
             EXPECT_EQ(e.nanCount, 0u);
             // The raster path's exact thickness is itself within 5e-4 of the integral (ErrorZero... above).
