@@ -23,6 +23,7 @@
 #include <array>
 #include <chrono>
 #include <future>
+#include <optional>
 #include <cmath>
 #include <string>
 
@@ -241,7 +242,7 @@ private:
     raster::Rasterizer rasterizer_;
     raster::Framebuffer fb_;
     raster::FragmentProgram fan_, box_;
-    OverBackground overBackground_;
+    std::optional<OverBackground> overBackground_;  // the raster path's last pass (the fused kernel adds the background)
     std::array<ProjectedChunk, 2> chunks_;  // the chunk being drawn and the next; kept: pages touched once
     // The fused path: the selection as a grid over the voxels (level and value per voxel, on the device),
     // current for options_.error and tfHost_ when gridCurrent_, and the kernel's per-pixel counts.
@@ -259,8 +260,7 @@ private:
 
 CubefanRenderer::CubefanRenderer(Device& device, const Scene& scene, const Volume& volume)
     : device_(device), options_(parseCubefanOptions(scene.options)), image_(scene.image),
-      tfHost_(scene.transferFunction), rasterizer_(device), fb_(device, scene.image.width, scene.image.height),
-      overBackground_(device)
+      tfHost_(scene.transferFunction), rasterizer_(device), fb_(device, scene.image.width, scene.image.height)
 {
     checkGridVolume(volume, "cubefan");
     if (volume.part)
@@ -295,6 +295,7 @@ CubefanRenderer::CubefanRenderer(Device& device, const Scene& scene, const Volum
         fused_ = device_.kernel("cubefan.cl", "cubefan_fused");
         return;
     }
+    overBackground_.emplace(device_);
     fan_.source = programSource("CLVR_CUBEFAN_FAN");
     fan_.attributes = 1;  // (l / l_max or alpha, value)
     box_.source = programSource("CLVR_CUBEFAN_BOX");
@@ -482,7 +483,7 @@ Image4f CubefanRenderer::renderRaster(FrameStats& stats)
     const double loopMs = msSince(t0);
 
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
-    overBackground_.run(fb_.color(), pixels, image_.background, "cubefan: over background");
+    overBackground_->run(fb_.color(), pixels, image_.background, "cubefan: over background");
     Image4f image = readImage(device_, fb_.color(), image_.width, image_.height);
     const raster::DrawStats drawn = rasterizer_.takeStats();
 
