@@ -313,6 +313,295 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
     skipped[i] = stepped_over;
 }
 
+#if !defined(SLICE3D_CLIP_TEXTURE) && !defined(SLICE3D_CLIP_MESH) && !defined(SLICE3D_PREINTEGRATED)
+/* ---- The packet kernel: slice3d_fused for 8 neighbouring pixels of a row at once, one per lane of float8
+ * vectors (docs/slice3d.md, "Ray packets"). The slices are the same planes for every pixel, so the 8 rays
+ * step through k together: positions, the transfer function, the exponential and the blending run as
+ * vector instructions (PoCL does not vectorize slice3d_fused's divergent per-pixel loop); only the voxel
+ * loads and the empty-space lookups are per lane. Every lane computes exactly slice3d_fused's expressions,
+ * so its pixel is the same bits: a lane whose sample is not owned, or whose ray has stopped, is masked; a
+ * lane in an empty brick while another lane samples takes its sample, whose tau is 0 (empty bricks are
+ * decided with a margin for float rounding), which changes nothing; the packet steps over slices only
+ * when every active lane is in an empty brick, as far as the nearest of their runs' ends. */
+#define SLICE3D_LANES 8
+#define SLICE3D_EACH_LANE(M) M(0) M(1) M(2) M(3) M(4) M(5) M(6) M(7)
+
+/* clvr_exp2 (kernels/clvr_common.h) lane by lane, the same operations. */
+float8 slice3d_exp2_8(const float8 x)
+{
+    const float8 n = rint(x);
+    const float8 f = x - n;
+    const float8 p = 1.0f + f * (6.931472028550421e-1f +
+                                 f * (2.402264791363012e-1f +
+                                      f * (5.550332471162809e-2f +
+                                           f * (9.618437357674640e-3f +
+                                                f * (1.339887440266574e-3f + f * 1.535336188319500e-4f)))));
+    const float8 r = p * as_float8((convert_int8(n) + 127) << 23);
+    return select((float8)(0.0f), r, isgreaterequal(x, -126.0f));
+}
+
+/* clvr_tf_eval (kernels/transfer_function.h) lane by lane: the same segment and expression per lane, found
+ * by selects over the segments instead of a search. */
+void slice3d_tf_eval8(global const float* tf, const int n, const float8 x, float8* r, float8* g, float8* b,
+                      float8* tau)
+{
+    global const float* value = tf + ((n + 3) & ~3);
+    global const float* slope = value + 4 * n;
+    float8 vr = value[0], vg = value[1], vb = value[2], vt = value[3];
+    for (int j = 0; j + 1 < n; ++j) {
+        const float s = tf[j];
+        const int8 in = j == 0 ? isgreater(x, s) : isgreaterequal(x, s);
+        const float8 dx = x - s;
+        global const float* v = value + 4 * j;
+        global const float* m = slope + 4 * j;
+        vr = select(vr, v[0] + dx * m[0], in);
+        vg = select(vg, v[1] + dx * m[1], in);
+        vb = select(vb, v[2] + dx * m[2], in);
+        vt = select(vt, v[3] + dx * m[3], in);
+    }
+    const int8 top = isgreaterequal(x, tf[n - 1]);
+    global const float* v = value + 4 * (n - 1);
+    *r = select(vr, (float8)(v[0]), top);
+    *g = select(vg, (float8)(v[1]), top);
+    *b = select(vb, (float8)(v[2]), top);
+    *tau = select(vt, (float8)(v[3]), top);
+}
+
+/* clvr_empty_run (kernels/empty_space.h) lane by lane, the same arithmetic: lane l's sample k lies in brick
+ * (bx, by, bz) and every brick within Chebyshev distance r of it is empty; the last slice towards k_end still
+ * in that cube of bricks (k where no candidate checks out; only the lanes that sample are meaningful). */
+int8 slice3d_in_cube8(const float8 go_x, const float8 go_y, const float8 go_z, const float8 gd_x, const float8 gd_y,
+                      const float8 gd_z, const float depth0, const float delta_s, const int8 k, const ClvrOwnedGrid* grid,
+                      const int8 bx, const int8 by, const int8 bz, const int8 r)
+{
+    const float8 z = depth0 + convert_float8(k) * delta_s;
+    const float8 gx = go_x + z * gd_x, gy = go_y + z * gd_y, gz = go_z + z * gd_z;
+    const int8 in = isgreaterequal(gx, grid->own_lo.x) & isgreaterequal(gy, grid->own_lo.y) &
+                    isgreaterequal(gz, grid->own_lo.z) & isless(gx, grid->own_hi.x) & isless(gy, grid->own_hi.y) &
+                    isless(gz, grid->own_hi.z);
+    const float3 off = convert_float3(grid->offset.xyz);
+    /* outside lanes read as 0: their answer is 0 anyway */
+    const int8 cx = min(convert_int8(select((float8)(0.0f), gx - off.x, in)), grid->dims.x - 2) >> CLVR_BRICK_SHIFT;
+    const int8 cy = min(convert_int8(select((float8)(0.0f), gy - off.y, in)), grid->dims.y - 2) >> CLVR_BRICK_SHIFT;
+    const int8 cz = min(convert_int8(select((float8)(0.0f), gz - off.z, in)), grid->dims.z - 2) >> CLVR_BRICK_SHIFT;
+    const uint8 c = max(abs_diff(cx, bx), max(abs_diff(cy, by), abs_diff(cz, bz)));
+    return in & (c <= convert_uint8(r));
+}
+
+int8 slice3d_empty_run8(const float8 go_x, const float8 go_y, const float8 go_z, const float8 gd_x, const float8 gd_y,
+                        const float8 gd_z, const float depth0, const float delta_s, const int k, const int step,
+                        const int8 k_end, const ClvrOwnedGrid* grid, const int8 bx, const int8 by, const int8 bz,
+                        const int8 r)
+{
+    const float3 off = convert_float3(grid->offset.xyz);
+    const int4 dims = grid->dims;
+    /* the face each lane walks towards, per axis: the cube's high side where step * gd > 0, else its low one */
+    const float8 lo_x = off.x + convert_float8(max(bx - r, 0) << CLVR_BRICK_SHIFT);
+    const float8 lo_y = off.y + convert_float8(max(by - r, 0) << CLVR_BRICK_SHIFT);
+    const float8 lo_z = off.z + convert_float8(max(bz - r, 0) << CLVR_BRICK_SHIFT);
+    const float8 hi_x = off.x + fmin(convert_float8((bx + r + 1) << CLVR_BRICK_SHIFT), (float)(dims.x - 1));
+    const float8 hi_y = off.y + fmin(convert_float8((by + r + 1) << CLVR_BRICK_SHIFT), (float)(dims.y - 1));
+    const float8 hi_z = off.z + fmin(convert_float8((bz + r + 1) << CLVR_BRICK_SHIFT), (float)(dims.z - 1));
+    const float fs = (float)step;
+    const float8 tx = (select(lo_x, hi_x, isgreater(fs * gd_x, 0.0f)) - go_x) * (1.0f / gd_x);
+    const float8 ty = (select(lo_y, hi_y, isgreater(fs * gd_y, 0.0f)) - go_y) * (1.0f / gd_y);
+    const float8 tz = (select(lo_z, hi_z, isgreater(fs * gd_z, 0.0f)) - go_z) * (1.0f / gd_z);
+    const float none = step > 0 ? INFINITY : -INFINITY;
+    const float8 ex = select(tx, (float8)(none), gd_x == 0.0f), ey = select(ty, (float8)(none), gd_y == 0.0f);
+    const float8 ez = select(tz, (float8)(none), gd_z == 0.0f);
+    const float8 zexit = step > 0 ? fmin(ex, fmin(ey, ez)) : fmax(ex, fmax(ey, ez));
+    const float8 kf = (zexit - depth0) / delta_s;
+    const float8 fk = (float8)((float)k), fe = convert_float8(k_end);
+    const int8 c1 = step > 0 ? convert_int8(clamp(floor(kf), fk, fe)) : convert_int8(clamp(ceil(kf), fe, fk));
+    const int8 c2 = c1 - step;
+    const int8 ok1 = (c1 != k) & slice3d_in_cube8(go_x, go_y, go_z, gd_x, gd_y, gd_z, depth0, delta_s, c1, grid, bx, by, bz, r);
+    const int8 ok2 = (c1 != k) & (c2 != k) &
+                     slice3d_in_cube8(go_x, go_y, go_z, gd_x, gd_y, gd_z, depth0, delta_s, c2, grid, bx, by, bz, r);
+    return select(select((int8)(k), c2, ok2), c1, ok1);
+}
+
+kernel void slice3d_fused_packet(global float4* out, global uint* samples, global uint* skipped,
+                                 global const SLICE3D_VOXEL* volume, global const float* tf,
+                                 global const uchar* space, const ClSlice3dParams p)
+{
+    const int x0 = (int)get_global_id(0) * SLICE3D_LANES, y = (int)get_global_id(1);
+    if (x0 >= p.width || y >= p.height)
+        return;
+    const int4 dims = p.dims, bdims = p.brick_dims, offset = p.part_offset;
+    const float depth0 = p.depth0, delta_s = p.delta_s, ert_alpha = p.ert_alpha;
+    const int tf_count = p.tf_count, skip = p.skip;
+    const float3 own_lo = p.own_lo.xyz, own_hi = p.own_hi.xyz;
+    const float3 loop_lo = skip ? p.tight_lo.xyz : own_lo, loop_hi = skip ? p.tight_hi.xyz : own_hi;
+    const ClvrOwnedGrid owned = {dims, offset, loop_lo, loop_hi};  /* for empty-space runs */
+
+    /* Each lane's ray, as slice3d_fused sets it up (scalar), kept in arrays for the per-lane steps. */
+    float gox[8], goy[8], goz[8], gdx[8], gdy[8], gdz[8], cin[8], cout[8], ndl[8], nsl[8];
+    int klo[8], khi[8], kfirst[8], klast[8];
+    int k_begin = p.slice_count, k_end = -1;
+    for (int l = 0; l < SLICE3D_LANES; ++l) {
+        gox[l] = goy[l] = goz[l] = gdx[l] = gdy[l] = gdz[l] = cin[l] = cout[l] = ndl[l] = nsl[l] = 0.0f;
+        klo[l] = kfirst[l] = 0;
+        khi[l] = klast[l] = -1;
+        if (x0 + l >= p.width)
+            continue;
+        const float2 size = (float2)((float)p.width, (float)p.height);
+        const float2 s = clvr_ray_window_offset(clvr_ray_pixel_centre(x0 + l, y), size, p.camera);
+        float3 o, d;
+        clvr_ray_depth(s, p.camera, &o, &d);
+        const float delta = delta_s * clvr_ray_stretch(s, p.camera);
+        ndl[l] = -delta * M_LOG2E_F;
+        const float3 go = (o - p.grid_origin.xyz) * p.inv_spacing.xyz;
+        const float3 gd = d * p.inv_spacing.xyz;
+        gox[l] = go.x, goy[l] = go.y, goz[l] = go.z, gdx[l] = gd.x, gdy[l] = gd.y, gdz[l] = gd.z;
+        float zin, zout;
+        clvr_box_chord(go, gd, own_lo, own_hi, &zin, &zout);
+        int k_lo, k_hi;
+        clvr_slice_range(zin, zout, depth0, delta_s, p.slice_count, &k_lo, &k_hi);
+        int k_first = k_lo, k_last = k_hi;
+        if (skip) {
+            while (k_first <= k_last && !clvr_grid_owned(clvr_slice_point(go, gd, depth0, delta_s, k_first), own_lo, own_hi))
+                ++k_first;
+            while (k_last >= k_first && !clvr_grid_owned(clvr_slice_point(go, gd, depth0, delta_s, k_last), own_lo, own_hi))
+                --k_last;
+            float tin, tout;
+            clvr_box_chord(go, gd, loop_lo, loop_hi, &tin, &tout);
+            clvr_slice_range(tin, tout, depth0, delta_s, p.slice_count, &k_lo, &k_hi);
+        }
+        klo[l] = k_lo, khi[l] = k_hi, kfirst[l] = k_first, klast[l] = k_last;
+        if (k_lo <= k_hi) {
+            k_begin = min(k_begin, k_lo);
+            k_end = max(k_end, k_hi);
+        }
+        float chord_in, chord_out;
+        clvr_box_chord(go, gd, (float3)(0.0f), p.grid_hi.xyz, &chord_in, &chord_out);
+        cin[l] = fmax(chord_in, 0.0f);
+        cout[l] = chord_out;
+        nsl[l] = -clvr_ray_stretch(s, p.camera) * M_LOG2E_F;
+    }
+    const float8 go_x = vload8(0, gox), go_y = vload8(0, goy), go_z = vload8(0, goz);
+    const float8 gd_x = vload8(0, gdx), gd_y = vload8(0, gdy), gd_z = vload8(0, gdz);
+    const float8 chord_in = vload8(0, cin), chord_out = vload8(0, cout);
+    const float8 neg_delta_log2e = vload8(0, ndl), neg_stretch_log2e = vload8(0, nsl);
+    const int8 lo8 = vload8(0, klo), hi8 = vload8(0, khi);
+    const float3 off = convert_float3(offset.xyz);
+    const uint nx = (uint)dims.x, nxy = nx * (uint)dims.y;
+
+    float8 cr = 0.0f, cg = 0.0f, cb = 0.0f;
+    float8 transmittance = 1.0f, alpha_acc = 0.0f;
+    int8 live = lo8 <= hi8;           /* lanes with slices to sample and not stopped */
+    int8 k_stop = vload8(0, klast);   /* where early termination stopped each ray */
+    int8 taken = 0;
+    const int ftb = p.front_to_back, step = ftb ? 1 : -1;
+    for (int k = ftb ? k_begin : k_end; ftb ? k <= k_end : k >= k_begin; k += step) {
+        const float z = depth0 + (float)k * delta_s;
+        const float8 gx = go_x + z * gd_x, gy = go_y + z * gd_y, gz = go_z + z * gd_z;
+        const int8 act = live & (k >= lo8) & (k <= hi8) & isgreaterequal(gx, loop_lo.x) &
+                         isgreaterequal(gy, loop_lo.y) & isgreaterequal(gz, loop_lo.z) & isless(gx, loop_hi.x) &
+                         isless(gy, loop_hi.y) & isless(gz, loop_hi.z);
+        if (!any(act))
+            continue;
+        /* the volume's own coordinates, 0 in the lanes that do not sample (their loads stay in the grid) */
+        const float8 lx = select((float8)(0.0f), gx - off.x, act);
+        const float8 ly = select((float8)(0.0f), gy - off.y, act);
+        const float8 lz = select((float8)(0.0f), gz - off.z, act);
+        const int8 ix = min(convert_int8(lx), dims.x - 2);
+        const int8 iy = min(convert_int8(ly), dims.y - 2);
+        const int8 iz = min(convert_int8(lz), dims.z - 2);
+        if (skip) {
+            const uint8 bi = (convert_uint8(iz >> CLVR_BRICK_SHIFT) * (uint)bdims.y + convert_uint8(iy >> CLVR_BRICK_SHIFT)) *
+                                 (uint)bdims.x + convert_uint8(ix >> CLVR_BRICK_SHIFT);
+            int8 sp;
+#define SLICE3D_SPACE(L) sp.s##L = space[bi.s##L];
+            SLICE3D_EACH_LANE(SLICE3D_SPACE)
+#undef SLICE3D_SPACE
+            if (!any(act & (sp == 0))) {
+                /* every sampling lane is in an empty brick: step to the nearest end of their runs, but no
+                 * further than any other live lane's next sample */
+                const int8 run_end = slice3d_empty_run8(go_x, go_y, go_z, gd_x, gd_y, gd_z, depth0, delta_s, k, step,
+                                                        ftb ? hi8 : lo8, &owned, ix >> CLVR_BRICK_SHIFT,
+                                                        iy >> CLVR_BRICK_SHIFT, iz >> CLVR_BRICK_SHIFT, sp - 1);
+                int8 bound;
+                if (ftb)
+                    bound = select(select(select((int8)(k_end), (int8)(k), k <= hi8), lo8 - 1, k < lo8), run_end, act);
+                else
+                    bound = select(select(select((int8)(k_begin), (int8)(k), k >= lo8), hi8 + 1, k > hi8), run_end, act);
+                bound = select((int8)(ftb ? k_end : k_begin), bound, live);
+                const int4 b4 = ftb ? min(bound.lo, bound.hi) : max(bound.lo, bound.hi);
+                const int2 b2 = ftb ? min(b4.lo, b4.hi) : max(b4.lo, b4.hi);
+                k = ftb ? min(b2.x, b2.y) : max(b2.x, b2.y);
+                continue;
+            }
+        }
+        taken -= act;
+        const float8 fx = lx - convert_float8(ix), fy = ly - convert_float8(iy), fz = lz - convert_float8(iz);
+        const uint8 idx = convert_uint8(iz) * nxy + convert_uint8(iy) * nx + convert_uint8(ix);
+        float8 a00x, a00y, a10x, a10y, a01x, a01y, a11x, a11y;
+#define SLICE3D_GATHER(L)                                                                                 \
+        {                                                                                                 \
+            global const SLICE3D_VOXEL* q = volume + idx.s##L;                                            \
+            const float2 v00 = convert_float2(vload2(0, q)), v10 = convert_float2(vload2(0, q + nx));     \
+            const float2 v01 = convert_float2(vload2(0, q + nxy));                                        \
+            const float2 v11 = convert_float2(vload2(0, q + nxy + nx));                                   \
+            a00x.s##L = v00.x, a00y.s##L = v00.y, a10x.s##L = v10.x, a10y.s##L = v10.y;                   \
+            a01x.s##L = v01.x, a01y.s##L = v01.y, a11x.s##L = v11.x, a11y.s##L = v11.y;                   \
+        }
+        SLICE3D_EACH_LANE(SLICE3D_GATHER)
+#undef SLICE3D_GATHER
+        const float8 c00 = a00x + fx * (a00y - a00x);
+        const float8 c10 = a10x + fx * (a10y - a10x);
+        const float8 c01 = a01x + fx * (a01y - a01x);
+        const float8 c11 = a11x + fx * (a11y - a11x);
+        const float8 c0 = c00 + fy * (c10 - c00);
+        const float8 c1 = c01 + fy * (c11 - c01);
+        const float8 value = c0 + fz * (c1 - c0);
+        float8 r, g, b, tau;
+        slice3d_tf_eval8(tf, tf_count, value, &r, &g, &b, &tau);
+        /* slice3d_slab_log2e lane by lane */
+        const int8 first = isless(z - delta_s, chord_in), last = isgreater(z + delta_s, chord_out);
+        const float8 slo = select((float8)(z - 0.5f * delta_s), chord_in, first);
+        const float8 shi = select((float8)(z + 0.5f * delta_s), chord_out, last);
+        const float8 slab = select(neg_delta_log2e, fmax(shi - slo, 0.0f) * neg_stretch_log2e, first | last);
+        const float8 alpha = 1.0f - slice3d_exp2_8(tau * slab);
+        if (ftb) {
+            cr = select(cr, cr + (transmittance * alpha) * r, act);
+            cg = select(cg, cg + (transmittance * alpha) * g, act);
+            cb = select(cb, cb + (transmittance * alpha) * b, act);
+            transmittance = select(transmittance, transmittance * (1.0f - alpha), act);
+            const int8 done = act & isgreaterequal(1.0f - transmittance, ert_alpha);
+            k_stop = select(k_stop, (int8)(k), done);
+            live &= ~done;
+            if (!any(live))
+                break;
+        } else {
+            cr = select(cr, r * alpha + (1.0f - alpha) * cr, act);
+            cg = select(cg, g * alpha + (1.0f - alpha) * cg, act);
+            cb = select(cb, b * alpha + (1.0f - alpha) * cb, act);
+            alpha_acc = select(alpha_acc, alpha + (1.0f - alpha) * alpha_acc, act);
+        }
+    }
+    if (ftb)
+        alpha_acc = 1.0f - transmittance;
+    const float8 orr = cr + (1.0f - alpha_acc) * p.background.x;
+    const float8 org = cg + (1.0f - alpha_acc) * p.background.y;
+    const float8 orb = cb + (1.0f - alpha_acc) * p.background.z;
+    float ro[8], go8[8], bo[8], ao[8];
+    int ks[8], tk[8];
+    vstore8(orr, 0, ro), vstore8(org, 0, go8), vstore8(orb, 0, bo), vstore8(alpha_acc, 0, ao);
+    vstore8(k_stop, 0, ks), vstore8(taken, 0, tk);
+    for (int l = 0; l < SLICE3D_LANES && x0 + l < p.width; ++l) {
+        uint stepped_over = 0;
+        if (skip) {  /* as slice3d_fused: the owned box's samples up to where the ray stopped */
+            const uint inside = ks[l] >= kfirst[l] ? (uint)(ks[l] - kfirst[l] + 1) : 0u;
+            stepped_over = inside - (uint)tk[l];
+        }
+        const int i = y * p.width + x0 + l;
+        out[i] = (float4)(ro[l], go8[l], bo[l], ao[l]);
+        samples[i] = (uint)tk[l] + stepped_over;
+        skipped[i] = stepped_over;
+    }
+}
+#endif
+
 /* The pass-by-pass path's last pass: premultiplied (I, A) in place -> I + (1 - A) background, A. */
 kernel void slice3d_over_background(global float4* color, const ClSlice3dOverBackgroundParams p)
 {

@@ -2,6 +2,7 @@
 // CPU reference integral (error falling with the slice count), back-to-front == front-to-back,
 // early ray termination bound, fused == pass-by-pass raster path, identical bits, orientation.
 #include "host/render/grid/slice3d.h"
+#include "host/cluster/partition.h"  // cutGridPart
 #include "host/render/transfer_function_upload.h"  // tauZeroOn
 
 #include "host/runtime/errors.h"
@@ -159,7 +160,7 @@ void expectInputError(const json& options, const std::string& fragment)
 TEST(Slice3dOptions, BadOptionsThrowInputErrorNamingTheKey)
 {
     expectInputError({{"foo", 1}},
-                     "options.foo: unknown option for slice3d (known: slices, slice_spacing, order, early_termination, path, empty_space_skipping, voxel_type, integration, clip, clip_texture)");
+                     "options.foo: unknown option for slice3d (known: slices, slice_spacing, order, early_termination, path, empty_space_skipping, voxel_type, packets, integration, clip, clip_texture)");
     expectInputError({{"slices", 0}}, "options.slices");
     expectInputError({{"slices", 65537}}, "options.slices");
     expectInputError({{"slices", 2.5}}, "options.slices");
@@ -170,6 +171,7 @@ TEST(Slice3dOptions, BadOptionsThrowInputErrorNamingTheKey)
     expectInputError({{"path", "gpu"}}, "options.path");
     expectInputError({{"voxel_type", "int8"}}, "options.voxel_type");
     expectInputError({{"empty_space_skipping", 1}}, "options.empty_space_skipping");
+    expectInputError({{"packets", "yes"}}, "options.packets");
     expectInputError({{"early_termination", 1.5}}, "options.early_termination");
     expectInputError({{"early_termination", 0.9}}, "options.early_termination");  // needs front-to-back
     expectInputError({{"early_termination", 0.9}, {"order", "front-to-back"}, {"path", "raster"}},
@@ -392,6 +394,116 @@ TEST(Slice3dEmptySpace, SkippingIsBitIdenticalToTheFullLoop)
                                 static_cast<unsigned long long>(skipped),
                                 static_cast<unsigned long long>(withStats.samples));
             }
+}
+
+
+// The packet kernel (slice3d_fused_packet: 8 pixels of a row per work-item, one per float8 lane) computes
+// each lane with the one-pixel kernel's expressions, so the images must be the same bits (memcmp), and the
+// samples inside the box the same count; it takes at least the samples the one-pixel kernel takes (a lane in
+// an empty brick samples while its neighbours do: tau 0 there, nothing changes). Float, uint8 and uint16
+// volumes, empty-space skipping on and off, both orders and early termination, three cameras (one with its
+// center ray along grid lines), images 61 and 5 pixels wide (the last packet of a row part empty, and a row
+// narrower than one packet), and a sort-last part (its owned box and offset).
+TEST(Slice3dPackets, BitIdenticalToOnePixelPerWorkItem)
+{
+    static const Volume sphere = generateVolume("sphere", {48, 40, 56});
+    const TransferFunction sphereTf({{0.0, {0, 0, 0}, 0.0}, {0.3, {0.2, 0.4, 1}, 0.0}, {0.6, {1, 0.5, 0}, 6.0},
+                                     {1.0, {1, 1, 1}, 12.0}});
+    const TransferFunction mlThreshold({{0.0, {0, 0, 0}, 0.0}, {0.45, {0.3, 0.3, 1}, 0.0}, {1.0, {1, 1, 0.5}, 9.0}});
+    // Integer volumes (uint8 and uint16 on the device): Marschner-Lobb scaled to 0..255 and 0..4095 and rounded.
+    const auto scaled = [](double top) {
+        Volume v = marschnerLobb41();
+        for (float& x : v.values)
+            x = std::round(x * static_cast<float>(top));
+        return v;
+    };
+    static const Volume ml8 = scaled(255.0), ml16 = scaled(4095.0);
+    const TransferFunction tf8({{0.0, {0, 0, 0}, 0.0}, {115.0, {0.3, 0.3, 1}, 0.0}, {255.0, {1, 1, 0.5}, 0.035}});
+    const TransferFunction tf16({{0.0, {0, 0, 0}, 0.0}, {1800.0, {0.3, 0.3, 1}, 0.0}, {4095.0, {1, 1, 0.5}, 0.002}});
+    // A hollow box (the grid's faces 3 points thick, empty inside): where one lane's ray is in an empty run
+    // through the inside, its neighbour may just be entering through a side face into the shell; the packet
+    // must not step past that neighbour's first samples.
+    static const Volume hollow = [] {
+        Volume v = generateVolume("sphere", {45, 38, 41});
+        for (int z = 0; z < v.dims.z; ++z)
+            for (int y = 0; y < v.dims.y; ++y)
+                for (int x = 0; x < v.dims.x; ++x) {
+                    const int d = std::min({x, y, z, v.dims.x - 1 - x, v.dims.y - 1 - y, v.dims.z - 1 - z});
+                    v.values[(static_cast<std::size_t>(z) * v.dims.y + y) * v.dims.x + x] = d < 3 ? 1.0f : 0.0f;
+                }
+        return v;
+    }();
+    const TransferFunction hollowTf({{0.0, {0, 0, 0}, 0.0}, {0.5, {0.2, 0.4, 1}, 0.0}, {1.0, {1, 0.6, 0.2}, 3.0}});
+    static const Volume part = [] {
+        const Volume& v = marschnerLobb41();
+        return cutGridPart(v, partitionGrid(v.dims, v.origin, v.spacing, 3), 1);
+    }();
+    Camera onAxis;
+    onAxis.position = {0.0, 0.0, 3.0};
+    onAxis.focalPoint = {0.0, 0.0, 0.0};
+    onAxis.viewUp = {0.0, 1.0, 0.0};
+    onAxis.viewAngle = 30.0;
+    struct Case {
+        const char* name;
+        const Volume* volume;
+        TransferFunction tf;
+        const char* voxelType;
+    };
+    const Case cases[] = {{"sphere", &sphere, sphereTf, "float32"},
+                          {"hollow box", &hollow, hollowTf, "uint8"},
+                          {"ml threshold", &marschnerLobb41(), mlThreshold, "float32"},
+                          {"ml usual", &marschnerLobb41(), test::designTransferFunction(), "float32"},
+                          {"ml uint8", &ml8, tf8, "uint8"},
+                          {"ml uint16", &ml16, tf16, "uint16"},
+                          {"ml part 1 of 3", &part, mlThreshold, "float32"}};
+    const json orders[] = {{{"slices", 96}},
+                           {{"slices", 96}, {"empty_space_skipping", false}},
+                           {{"slices", 96}, {"order", "front-to-back"}},
+                           {{"slices", 128}, {"order", "front-to-back"}, {"early_termination", 0.9}}};
+    int compared = 0;
+    for (const Case& c : cases)
+        for (const Camera& camera : {perspectiveCamera(), parallelCamera(), onAxis})
+            for (const json& base : orders)
+                for (int width : {61, 5}) {
+                    if (width == 5 && camera.position != onAxis.position && base.size() > 1)
+                        continue;  // the narrow image: every camera once, the option sets on one
+                    json packets = base, pixels = base;
+                    pixels["packets"] = false;
+                    Scene one = makeScene(camera, c.tf, width, packets), other = makeScene(camera, c.tf, width, pixels);
+                    one.image.height = other.image.height = 47;
+                    FrameStats ps, qs;
+                    const Image4f p = test::renderScene(one, *c.volume, &ps);
+                    const Image4f q = test::renderScene(other, *c.volume, &qs);
+                    const std::string label = std::string(c.name) + (camera.parallel ? " parallel " : " perspective ") +
+                                              base.dump() + " width " + std::to_string(width);
+                    ASSERT_EQ(p.pixelCount(), q.pixelCount());
+                    EXPECT_EQ(std::memcmp(p.pixels().data(), q.pixels().data(), p.pixelCount() * sizeof(glm::vec4)), 0)
+                        << label;
+                    EXPECT_TRUE(ps.extra["packets"].get<bool>()) << label;
+                    EXPECT_FALSE(qs.extra["packets"].get<bool>()) << label;
+                    EXPECT_EQ(ps.extra["voxel_type"], c.voxelType) << label;
+                    EXPECT_EQ(ps.samples, qs.samples) << label;
+                    const auto taken = [](const FrameStats& s) { return s.extra["samples_taken"].get<std::uint64_t>(); };
+                    EXPECT_GE(taken(ps), taken(qs)) << label;
+                    EXPECT_LE(taken(ps), ps.samples) << label;
+                    EXPECT_GT(taken(qs), 0u) << label;
+                    ++compared;
+                }
+    EXPECT_EQ(compared, 7 * (3 * 4 + 3 + 3));
+}
+
+// The packet kernel is the one-pixel kernel's stand-in only where it is built: with a clip texture or
+// pre-integrated slabs the fused path keeps one pixel per work-item (stats say which ran).
+TEST(Slice3dPackets, ClipAndPreintegratedKeepOnePixelPerWorkItem)
+{
+    FrameStats plain, pre;
+    test::renderScene(makeScene(perspectiveCamera(), test::designTransferFunction(), 24, {{"slices", 32}}),
+                      marschnerLobb41(), &plain);
+    test::renderScene(makeScene(perspectiveCamera(), test::designTransferFunction(), 24,
+                                {{"slices", 32}, {"integration", "preintegrated"}}),
+                      marschnerLobb41(), &pre);
+    EXPECT_TRUE(plain.extra["packets"].get<bool>());
+    EXPECT_FALSE(pre.extra["packets"].get<bool>());
 }
 
 

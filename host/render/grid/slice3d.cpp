@@ -80,6 +80,7 @@ private:
     std::string voxelType_ = "float32";  // on the device
     // Fused path.
     cl::Kernel fused_;
+    bool packet_ = false;
     cl::Buffer out_, samples_, skipped_;
     // Pass-by-pass path.
     std::unique_ptr<raster::Framebuffer> framebuffer_;
@@ -179,6 +180,11 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
     if (options_.path == Slice3dOptions::Path::Fused) {
         fused_ = device_.kernel("slice3d.cl", "slice3d_fused", {}, trilinearOptions);
+        // Ray packets (docs/slice3d.md): the same kernel's arithmetic on 8 pixels at once; the clip and
+        // pre-integrated variants keep one pixel per work-item.
+        packet_ = options_.packets && !clipTexture_ && !clipMesh_ && !options_.preintegrated;
+        if (packet_)
+            fused_ = device_.kernel("slice3d.cl", "slice3d_fused_packet", {}, trilinearOptions);
         out_ = device_.buffer("slice3d image", pixels * sizeof(cl_float4), CL_MEM_WRITE_ONLY);
         samples_ = device_.buffer("slice3d sample counts", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
         skipped_ = device_.buffer("slice3d skipped sample counts", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
@@ -337,7 +343,8 @@ Image4f Slice3dRenderer::renderFused(FrameStats& stats)
         params.psi_n = static_cast<cl_int>(psiTable().size);
     }
     fused_.setArg(a++, params);
-    device_.launch("slice3d: fused", fused_, image_.width, image_.height);
+    // A packet work-item renders pixels 8x .. 8x + 7 of its row.
+    device_.launch("slice3d: fused", fused_, packet_ ? (image_.width + 7) / 8 : image_.width, image_.height);
 
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
     Image4f image = readImage(device_, out_, image_.width, image_.height);
@@ -347,6 +354,7 @@ Image4f Slice3dRenderer::renderFused(FrameStats& stats)
     stats.extra["samples_skipped"] = skipped;
     stats.extra["samples_taken"] = stats.samples - skipped;
     stats.extra["empty_space_skipping"] = skip;
+    stats.extra["packets"] = packet_;
     stats.extra["bricks"] = {brickDims_.x, brickDims_.y, brickDims_.z};
     stats.extra["empty_bricks"] = emptyBrickCount_;
     stats.extra["brick_setup_ms"] = brickSetupMs_;
@@ -604,6 +612,9 @@ TechniqueInfo slice3dTechnique()
         {"path", "fused", "", "\"fused\" (all slices of a pixel in one kernel) or \"raster\" (pass by pass)"},
         {"empty_space_skipping", true, "", "fused path: step over bricks where tau is 0 (same image)"},
         {"voxel_type", "auto", "", "\"auto\" (uint8/uint16 on the device when the values fit) or \"float32\""},
+        {"packets", true, "",
+         "fused path: 8 neighbouring pixels per work-item as vector lanes (same image; not with preintegrated or "
+         "clipping) or false: one pixel per work-item"},
         {"integration", "sample", "",
          "\"sample\" (alpha = 1 - exp(-tau delta) per slice sample) or \"preintegrated\" (fused path: each slab "
          "between samples integrated exactly for a linear scalar)"},
@@ -654,6 +665,8 @@ Slice3dOptions parseSlice3dOptions(const nlohmann::json& options)
                 badOption(key, "must be \"sample\" or \"preintegrated\", got " + value.dump());
         } else if (key == "empty_space_skipping") {
             o.emptySpaceSkipping = booleanOption(key, value);
+        } else if (key == "packets") {
+            o.packets = booleanOption(key, value);
         } else if (key == "clip") {
             o.clip = parseClip(value);
         } else if (key == "clip_texture") {
