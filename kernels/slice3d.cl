@@ -536,6 +536,35 @@ kernel void slice3d_fused_packet(global float4* out, global uint* samples, globa
         const float8 fx = lx - convert_float8(ix), fy = ly - convert_float8(iy), fz = lz - convert_float8(iz);
         const uint8 idx = convert_uint8(iz) * nxy + convert_uint8(iy) * nx + convert_uint8(ix);
         float8 a00x, a00y, a10x, a10y, a01x, a01y, a11x, a11y;
+#if defined(SLICE3D_VOXEL_BITS) && (SLICE3D_VOXEL_BITS == 8 || SLICE3D_VOXEL_BITS == 16)
+        /* Integer voxels: each (i, i + 1) pair is one 16- or 32-bit load, put into a lane of one vector and
+         * split into its two values there (little-endian: value i in the low half), half the lane inserts. */
+#if SLICE3D_VOXEL_BITS == 8
+        typedef ushort PairT;
+        typedef ushort8 Pair8;
+#define SLICE3D_PAIR(q) as_ushort(vload2(0, q))
+#define SLICE3D_SPLIT(v, lo, hi) lo = convert_float8(v & (ushort)0xff), hi = convert_float8(v >> (ushort)8)
+#else
+        typedef uint PairT;
+        typedef uint8 Pair8;
+#define SLICE3D_PAIR(q) as_uint(vload2(0, q))
+#define SLICE3D_SPLIT(v, lo, hi) lo = convert_float8(v & 0xffffu), hi = convert_float8(v >> 16u)
+#endif
+        Pair8 p00, p10, p01, p11;
+#define SLICE3D_GATHER(L)                                                                                 \
+        {                                                                                                 \
+            global const SLICE3D_VOXEL* q = volume + idx.s##L;                                            \
+            p00.s##L = SLICE3D_PAIR(q), p10.s##L = SLICE3D_PAIR(q + nx);                                  \
+            p01.s##L = SLICE3D_PAIR(q + nxy), p11.s##L = SLICE3D_PAIR(q + nxy + nx);                      \
+        }
+        SLICE3D_EACH_LANE(SLICE3D_GATHER)
+        SLICE3D_SPLIT(p00, a00x, a00y);
+        SLICE3D_SPLIT(p10, a10x, a10y);
+        SLICE3D_SPLIT(p01, a01x, a01y);
+        SLICE3D_SPLIT(p11, a11x, a11y);
+#undef SLICE3D_PAIR
+#undef SLICE3D_SPLIT
+#else
 #define SLICE3D_GATHER(L)                                                                                 \
         {                                                                                                 \
             global const SLICE3D_VOXEL* q = volume + idx.s##L;                                            \
@@ -546,6 +575,7 @@ kernel void slice3d_fused_packet(global float4* out, global uint* samples, globa
             a01x.s##L = v01.x, a01y.s##L = v01.y, a11x.s##L = v11.x, a11y.s##L = v11.y;                   \
         }
         SLICE3D_EACH_LANE(SLICE3D_GATHER)
+#endif
 #undef SLICE3D_GATHER
         const float8 c00 = a00x + fx * (a00y - a00x);
         const float8 c10 = a10x + fx * (a10y - a10x);

@@ -615,7 +615,7 @@ TEST(BenchAccuracy, ScenesAreTheBenchViewsWithOnlySlicesAndIntegrationChanged)
         present.push_back(file.filename().string());
     std::sort(sorted.begin(), sorted.end());
     EXPECT_EQ(sorted, present);
-    ASSERT_EQ(listed.size(), 18u);
+    ASSERT_EQ(listed.size(), 24u);
     const std::filesystem::path dir = files.front().parent_path();
     for (const std::string& name : listed) {
         const clvr::Scene scene = clvr::loadScene(dir / name);

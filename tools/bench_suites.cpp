@@ -69,7 +69,7 @@ std::vector<std::string> benchSuiteScenes(const std::string& suite)
     // pre-integrated over slice counts, for --reference (and --peer: VTK at each scene's spacing).
     std::vector<std::string> accuracy;
     for (const char* volume : {"ml256", "engine"}) {
-        for (const char* slices : {"64", "128", "256", "512", "1024"})
+        for (const char* slices : {"64", "96", "128", "144", "192", "256", "512", "1024"})
             accuracy.push_back(std::string("acc-") + volume + "-sample-" + slices + ".json");
         for (const char* slices : {"64", "128", "256", "512"})
             accuracy.push_back(std::string("acc-") + volume + "-pre-" + slices + ".json");

@@ -146,13 +146,13 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
         volume_ = device_.upload("slice3d volume (uint8)", v);
         voxelType_ = "uint8";
         residentBytes_ = v.size();
-        trilinearOptions = "-DSLICE3D_VOXEL=uchar -DSLICE3D_TRILINEAR=clvr_trilinear_uchar";
+        trilinearOptions = "-DSLICE3D_VOXEL=uchar -DSLICE3D_VOXEL_BITS=8 -DSLICE3D_TRILINEAR=clvr_trilinear_uchar";
     } else if (fused && options_.nativeVoxels && integralUpTo(65535.0f)) {
         std::vector<cl_ushort> v(volume.values.begin(), volume.values.end());
         volume_ = device_.upload("slice3d volume (uint16)", v);
         voxelType_ = "uint16";
         residentBytes_ = v.size() * sizeof(cl_ushort);
-        trilinearOptions = "-DSLICE3D_VOXEL=ushort -DSLICE3D_TRILINEAR=clvr_trilinear_ushort";
+        trilinearOptions = "-DSLICE3D_VOXEL=ushort -DSLICE3D_VOXEL_BITS=16 -DSLICE3D_TRILINEAR=clvr_trilinear_ushort";
     } else {
         volume_ = device_.upload("slice3d volume (float32)", volume.values);
         residentBytes_ = volume.values.size() * sizeof(float);
