@@ -420,6 +420,48 @@ int8 slice3d_empty_run8(const float8 go_x, const float8 go_y, const float8 go_z,
     return select(select((int8)(k), c2, ok2), c1, ok1);
 }
 
+/* clvr_box_chord lane by lane (the same divisions and min/max per axis; an axis the ray runs parallel to
+ * empties the chord where the ray lies outside [lo, hi) on it). */
+void slice3d_chord_axis8(const float8 g0, const float8 gs, const float l, const float h, float8* z0, float8* z1)
+{
+    const float8 t0 = (l - g0) / gs, t1 = (h - g0) / gs;
+    const int8 flat = gs == 0.0f;
+    *z0 = select(fmax(*z0, fmin(t0, t1)), *z0, flat);
+    *z1 = select(fmin(*z1, fmax(t0, t1)), select(*z1, (float8)(-INFINITY), isless(g0, l) | isgreaterequal(g0, h)), flat);
+}
+
+void slice3d_box_chord8(const float8 go_x, const float8 go_y, const float8 go_z, const float8 gd_x, const float8 gd_y,
+                        const float8 gd_z, const float3 lo, const float3 hi, float8* zin, float8* zout)
+{
+    float8 z0 = -INFINITY, z1 = INFINITY;
+    slice3d_chord_axis8(go_x, gd_x, lo.x, hi.x, &z0, &z1);
+    slice3d_chord_axis8(go_y, gd_y, lo.y, hi.y, &z0, &z1);
+    slice3d_chord_axis8(go_z, gd_z, lo.z, hi.z, &z0, &z1);
+    *zin = z0;
+    *zout = z1;
+}
+
+/* clvr_slice_range lane by lane. */
+void slice3d_slice_range8(const float8 zin, const float8 zout, const float depth0, const float delta_s, const int count,
+                          int8* k_lo, int8* k_hi)
+{
+    const float n = (float)count;
+    const int8 chord = islessequal(zin, zout);
+    *k_lo = select((int8)(0), convert_int8(clamp(ceil((zin - depth0) / delta_s) - 1.0f, 0.0f, n)), chord);
+    *k_hi = select((int8)(-1), convert_int8(clamp(floor((zout - depth0) / delta_s) + 1.0f, -1.0f, n - 1.0f)), chord);
+}
+
+/* clvr_grid_owned of each lane's slice-k point (clvr_slice_point's expression). */
+int8 slice3d_owned8(const float8 go_x, const float8 go_y, const float8 go_z, const float8 gd_x, const float8 gd_y,
+                    const float8 gd_z, const float depth0, const float delta_s, const int8 k, const float3 lo,
+                    const float3 hi)
+{
+    const float8 z = depth0 + convert_float8(k) * delta_s;
+    const float8 gx = go_x + z * gd_x, gy = go_y + z * gd_y, gz = go_z + z * gd_z;
+    return isgreaterequal(gx, lo.x) & isgreaterequal(gy, lo.y) & isgreaterequal(gz, lo.z) & isless(gx, hi.x) &
+           isless(gy, hi.y) & isless(gz, hi.z);
+}
+
 kernel void slice3d_fused_packet(global float4* out, global uint* samples, global uint* skipped,
                                  global const SLICE3D_VOXEL* volume, global const float* tf,
                                  global const uchar* space, const ClSlice3dParams p)
@@ -434,62 +476,75 @@ kernel void slice3d_fused_packet(global float4* out, global uint* samples, globa
     const float3 loop_lo = skip ? p.tight_lo.xyz : own_lo, loop_hi = skip ? p.tight_hi.xyz : own_hi;
     const ClvrOwnedGrid owned = {dims, offset, loop_lo, loop_hi};  /* for empty-space runs */
 
-    /* Each lane's ray, as slice3d_fused sets it up (scalar), kept in arrays for the per-lane steps. */
-    float gox[8], goy[8], goz[8], gdx[8], gdy[8], gdz[8], cin[8], cout[8], ndl[8], nsl[8];
-    int klo[8], khi[8], kfirst[8], klast[8];
-    int k_begin = p.slice_count, k_end = -1;
-    for (int l = 0; l < SLICE3D_LANES; ++l) {
-        gox[l] = goy[l] = goz[l] = gdx[l] = gdy[l] = gdz[l] = cin[l] = cout[l] = ndl[l] = nsl[l] = 0.0f;
-        klo[l] = kfirst[l] = 0;
-        khi[l] = klast[l] = -1;
-        if (x0 + l >= p.width)
-            continue;
-        const float2 size = (float2)((float)p.width, (float)p.height);
-        const float2 s = clvr_ray_window_offset(clvr_ray_pixel_centre(x0 + l, y), size, p.camera);
-        float3 o, d;
-        clvr_ray_depth(s, p.camera, &o, &d);
-        const float delta = delta_s * clvr_ray_stretch(s, p.camera);
-        ndl[l] = -delta * M_LOG2E_F;
-        const float3 go = (o - p.grid_origin.xyz) * p.inv_spacing.xyz;
-        const float3 gd = d * p.inv_spacing.xyz;
-        gox[l] = go.x, goy[l] = go.y, goz[l] = go.z, gdx[l] = gd.x, gdy[l] = gd.y, gdz[l] = gd.z;
-        float zin, zout;
-        clvr_box_chord(go, gd, own_lo, own_hi, &zin, &zout);
-        int k_lo, k_hi;
-        clvr_slice_range(zin, zout, depth0, delta_s, p.slice_count, &k_lo, &k_hi);
-        int k_first = k_lo, k_last = k_hi;
-        if (skip) {
-            while (k_first <= k_last && !clvr_grid_owned(clvr_slice_point(go, gd, depth0, delta_s, k_first), own_lo, own_hi))
-                ++k_first;
-            while (k_last >= k_first && !clvr_grid_owned(clvr_slice_point(go, gd, depth0, delta_s, k_last), own_lo, own_hi))
-                --k_last;
-            float tin, tout;
-            clvr_box_chord(go, gd, loop_lo, loop_hi, &tin, &tout);
-            clvr_slice_range(tin, tout, depth0, delta_s, p.slice_count, &k_lo, &k_hi);
-        }
-        klo[l] = k_lo, khi[l] = k_hi, kfirst[l] = k_first, klast[l] = k_last;
-        if (k_lo <= k_hi) {
-            k_begin = min(k_begin, k_lo);
-            k_end = max(k_end, k_hi);
-        }
-        float chord_in, chord_out;
-        clvr_box_chord(go, gd, (float3)(0.0f), p.grid_hi.xyz, &chord_in, &chord_out);
-        cin[l] = fmax(chord_in, 0.0f);
-        cout[l] = chord_out;
-        nsl[l] = -clvr_ray_stretch(s, p.camera) * M_LOG2E_F;
+    /* Each lane's ray, as slice3d_fused sets it up (clvr_ray_window_offset, clvr_ray_depth, clvr_ray_stretch:
+     * the same expressions lane by lane; the row's offset s.y is one scalar). */
+    const float2 size = (float2)((float)p.width, (float)p.height);
+    const ClCamera cam = p.camera;
+    const float sy = clvr_ray_window_offset(clvr_ray_pixel_centre(x0, y), size, cam).y;
+    const float8 wx = convert_float8(x0 + (int8)(0, 1, 2, 3, 4, 5, 6, 7)) + 0.5f;
+    const float8 sx = (wx / size.x * 2.0f - 1.0f) * cam.params.x * cam.params.y;
+    /* s.y as a vector too: a product of two scalars would be rounded before the sum it is added to, where the
+     * one-pixel kernel's float3 expressions fuse it (a * b + c as one rounding) */
+    const float8 sy8 = sy;
+    float8 o_x, o_y, o_z, d_x, d_y, d_z, stretch;
+    if (clvr_ray_parallel(cam)) {
+        o_x = cam.position.x + sx * cam.right.x + sy8 * cam.up.x;
+        o_y = cam.position.y + sx * cam.right.y + sy8 * cam.up.y;
+        o_z = cam.position.z + sx * cam.right.z + sy8 * cam.up.z;
+        d_x = cam.forward.x, d_y = cam.forward.y, d_z = cam.forward.z;
+        stretch = 1.0f;
+    } else {
+        o_x = cam.position.x, o_y = cam.position.y, o_z = cam.position.z;
+        d_x = cam.forward.x + sx * cam.right.x + sy8 * cam.up.x;
+        d_y = cam.forward.y + sx * cam.right.y + sy8 * cam.up.y;
+        d_z = cam.forward.z + sx * cam.right.z + sy8 * cam.up.z;
+        stretch = sqrt(1.0f + sx * sx + sy8 * sy8);
     }
-    const float8 go_x = vload8(0, gox), go_y = vload8(0, goy), go_z = vload8(0, goz);
-    const float8 gd_x = vload8(0, gdx), gd_y = vload8(0, gdy), gd_z = vload8(0, gdz);
-    const float8 chord_in = vload8(0, cin), chord_out = vload8(0, cout);
-    const float8 neg_delta_log2e = vload8(0, ndl), neg_stretch_log2e = vload8(0, nsl);
-    const int8 lo8 = vload8(0, klo), hi8 = vload8(0, khi);
+    const float8 delta = delta_s * stretch;
+    const float8 neg_delta_log2e = -delta * M_LOG2E_F;
+    const float8 neg_stretch_log2e = -stretch * M_LOG2E_F;
+    const float8 go_x = (o_x - p.grid_origin.x) * p.inv_spacing.x, go_y = (o_y - p.grid_origin.y) * p.inv_spacing.y;
+    const float8 go_z = (o_z - p.grid_origin.z) * p.inv_spacing.z;
+    const float8 gd_x = d_x * p.inv_spacing.x, gd_y = d_y * p.inv_spacing.y, gd_z = d_z * p.inv_spacing.z;
+    /* the slices near the chord through the owned box; with skipping, the first and last owned ones (for the
+     * samples counted) and the slices near the chord through the box of the bricks that are not empty */
+    float8 zin, zout;
+    slice3d_box_chord8(go_x, go_y, go_z, gd_x, gd_y, gd_z, own_lo, own_hi, &zin, &zout);
+    int8 lo8, hi8;
+    slice3d_slice_range8(zin, zout, depth0, delta_s, p.slice_count, &lo8, &hi8);
+    int8 k_first = lo8, k_last = hi8;
+    if (skip) {
+        for (int8 move = (int8)(-1); any(move);) {
+            move = (k_first <= k_last) & ~slice3d_owned8(go_x, go_y, go_z, gd_x, gd_y, gd_z, depth0, delta_s, k_first,
+                                                         own_lo, own_hi);
+            k_first -= move;
+        }
+        for (int8 move = (int8)(-1); any(move);) {
+            move = (k_last >= k_first) & ~slice3d_owned8(go_x, go_y, go_z, gd_x, gd_y, gd_z, depth0, delta_s, k_last,
+                                                        own_lo, own_hi);
+            k_last += move;
+        }
+        slice3d_box_chord8(go_x, go_y, go_z, gd_x, gd_y, gd_z, loop_lo, loop_hi, &zin, &zout);
+        slice3d_slice_range8(zin, zout, depth0, delta_s, p.slice_count, &lo8, &hi8);
+    }
+    /* lanes past the row's end: nothing to sample, nothing written */
+    const int8 in_row = x0 + (int8)(0, 1, 2, 3, 4, 5, 6, 7) < p.width;
+    lo8 = select((int8)(0), lo8, in_row), hi8 = select((int8)(-1), hi8, in_row);
+    k_first = select((int8)(0), k_first, in_row), k_last = select((int8)(-1), k_last, in_row);
+    const int8 ranged = lo8 <= hi8;
+    const int4 b4 = min(select((int8)(p.slice_count), lo8, ranged).lo, select((int8)(p.slice_count), lo8, ranged).hi);
+    const int4 e4 = max(select((int8)(-1), hi8, ranged).lo, select((int8)(-1), hi8, ranged).hi);
+    const int k_begin = min(min(b4.x, b4.y), min(b4.z, b4.w)), k_end = max(max(e4.x, e4.y), max(e4.z, e4.w));
+    float8 chord_in, chord_out;
+    slice3d_box_chord8(go_x, go_y, go_z, gd_x, gd_y, gd_z, (float3)(0.0f), p.grid_hi.xyz, &chord_in, &chord_out);
+    chord_in = fmax(chord_in, 0.0f);
     const float3 off = convert_float3(offset.xyz);
     const uint nx = (uint)dims.x, nxy = nx * (uint)dims.y;
 
     float8 cr = 0.0f, cg = 0.0f, cb = 0.0f;
     float8 transmittance = 1.0f, alpha_acc = 0.0f;
     int8 live = lo8 <= hi8;           /* lanes with slices to sample and not stopped */
-    int8 k_stop = vload8(0, klast);   /* where early termination stopped each ray */
+    int8 k_stop = k_last;             /* where early termination stopped each ray */
     int8 taken = 0;
     const int ftb = p.front_to_back, step = ftb ? 1 : -1;
     for (int k = ftb ? k_begin : k_end; ftb ? k <= k_end : k >= k_begin; k += step) {
@@ -615,9 +670,9 @@ kernel void slice3d_fused_packet(global float4* out, global uint* samples, globa
     const float8 org = cg + (1.0f - alpha_acc) * p.background.y;
     const float8 orb = cb + (1.0f - alpha_acc) * p.background.z;
     float ro[8], go8[8], bo[8], ao[8];
-    int ks[8], tk[8];
+    int ks[8], tk[8], kfirst[8];
     vstore8(orr, 0, ro), vstore8(org, 0, go8), vstore8(orb, 0, bo), vstore8(alpha_acc, 0, ao);
-    vstore8(k_stop, 0, ks), vstore8(taken, 0, tk);
+    vstore8(k_stop, 0, ks), vstore8(taken, 0, tk), vstore8(k_first, 0, kfirst);
     for (int l = 0; l < SLICE3D_LANES && x0 + l < p.width; ++l) {
         uint stepped_over = 0;
         if (skip) {  /* as slice3d_fused: the owned box's samples up to where the ray stopped */

@@ -492,6 +492,24 @@ TEST(Slice3dPackets, BitIdenticalToOnePixelPerWorkItem)
     EXPECT_EQ(compared, 7 * (3 * 4 + 3 + 3));
 }
 
+// A transfer function with tau 0 everywhere empties every brick (the box of the bricks that are not empty is
+// then one point, host/render/grid/slice3d.cpp): neither kernel takes a sample, the image is the background,
+// and the samples inside the box are still counted, all stepped over.
+TEST(Slice3dPackets, TransparentTransferFunctionTakesNoSample)
+{
+    const TransferFunction clear({{0.0, {1, 0, 0}, 0.0}, {1.0, {0, 1, 0}, 0.0}});
+    for (bool packets : {true, false}) {
+        FrameStats stats;
+        const Image4f image = test::renderScene(
+            makeScene(perspectiveCamera(), clear, 29, {{"slices", 64}, {"packets", packets}}), marschnerLobb41(), &stats);
+        EXPECT_EQ(stats.extra["samples_taken"].get<std::uint64_t>(), 0u) << packets;
+        EXPECT_EQ(stats.extra["samples_skipped"].get<std::uint64_t>(), stats.samples) << packets;
+        EXPECT_GT(stats.samples, 10000u) << packets;
+        for (const glm::vec4& p : image.pixels())
+            ASSERT_EQ(p, glm::vec4(0.1f, 0.2f, 0.3f, 0.0f)) << packets;
+    }
+}
+
 // The packet kernel is the one-pixel kernel's stand-in only where it is built: with a clip texture or
 // pre-integrated slabs the fused path keeps one pixel per work-item (stats say which ran).
 TEST(Slice3dPackets, ClipAndPreintegratedKeepOnePixelPerWorkItem)

@@ -311,6 +311,12 @@ Image4f Slice3dRenderer::renderFused(FrameStats& stats)
         params.tight_lo.s[a] = std::max(params.own_lo.s[a], partOffset[a] + static_cast<float>(filledLo_[a] * kBrickCells));
         params.tight_hi.s[a] = std::min(params.own_hi.s[a], partOffset[a] + static_cast<float>((filledHi_[a] + 1) * kBrickCells));
     }
+    // No brick holds anything (or the box misses the owned one): a box of one point, whose chord is at most
+    // that point's and whose half-open test no sample passes. An inverted box would not do: the slab test
+    // gives the chord between its faces' planes, and the loop would visit every slice there for nothing.
+    if (params.tight_lo.s[0] >= params.tight_hi.s[0] || params.tight_lo.s[1] >= params.tight_hi.s[1] ||
+        params.tight_lo.s[2] >= params.tight_hi.s[2])
+        params.tight_hi = params.tight_lo;
     // The whole grid's box, [0, n - 1] per axis, half open above as own_hi is (the next float above n - 1), so
     // that a ray lying in the last grid plane counts as inside, as its samples do.
     const glm::vec3 last = glm::vec3(part_.fullDims - 1);
