@@ -313,7 +313,7 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
     skipped[i] = stepped_over;
 }
 
-#if !defined(SLICE3D_CLIP_TEXTURE) && !defined(SLICE3D_CLIP_MESH) && !defined(SLICE3D_PREINTEGRATED)
+#ifndef SLICE3D_PREINTEGRATED
 /* ---- The packet kernel: slice3d_fused for 8 neighbouring pixels of a row at once, one per lane of float8
  * vectors (docs/slice3d.md, "Ray packets"). The slices are the same planes for every pixel, so the 8 rays
  * step through k together: positions, the transfer function, the exponential and the blending run as
@@ -464,7 +464,14 @@ int8 slice3d_owned8(const float8 go_x, const float8 go_y, const float8 go_z, con
 
 kernel void slice3d_fused_packet(global float4* out, global uint* samples, global uint* skipped,
                                  global const SLICE3D_VOXEL* volume, global const float* tf,
-                                 global const uchar* space, const ClSlice3dParams p)
+                                 global const uchar* space,
+#ifdef SLICE3D_CLIP_TEXTURE
+                                 global const float* clip_texels,
+#endif
+#ifdef SLICE3D_CLIP_MESH
+                                 global const float4* clip_layers,
+#endif
+                                 const ClSlice3dParams p)
 {
     const int x0 = (int)get_global_id(0) * SLICE3D_LANES, y = (int)get_global_id(1);
     if (x0 >= p.width || y >= p.height)
@@ -503,6 +510,38 @@ kernel void slice3d_fused_packet(global float4* out, global uint* samples, globa
     const float8 delta = delta_s * stretch;
     const float8 neg_delta_log2e = -delta * M_LOG2E_F;
     const float8 neg_stretch_log2e = -stretch * M_LOG2E_F;
+#if defined(SLICE3D_CLIP_TEXTURE) || defined(SLICE3D_CLIP_MESH)
+    /* the clip tests run lane by lane, with slice3d_fused's own code: each lane's ray in arrays */
+    float ox[8], oy[8], oz[8], dx[8], dy[8], dz[8];
+    vstore8(o_x, 0, ox), vstore8(o_y, 0, oy), vstore8(o_z, 0, oz), vstore8(d_x, 0, dx), vstore8(d_y, 0, dy), vstore8(d_z, 0, dz);
+#endif
+#ifdef SLICE3D_CLIP_TEXTURE
+    /* clip-texture coordinates along each lane's ray, u = uo + z ud (slice3d_fused's expressions per lane) */
+    float uox[8], uoy[8], uoz[8], udx[8], udy[8], udz[8];
+    for (int l = 0; l < SLICE3D_LANES; ++l) {
+        const float3 o = (float3)(ox[l], oy[l], oz[l]), d = (float3)(dx[l], dy[l], dz[l]);
+        const float4 clip_row0 = p.clip_row[0], clip_row1 = p.clip_row[1], clip_row2 = p.clip_row[2];
+        const float3 uo = (float3)(dot(clip_row0.xyz, o) + clip_row0.w, dot(clip_row1.xyz, o) + clip_row1.w,
+                                   dot(clip_row2.xyz, o) + clip_row2.w);
+        const float3 ud = (float3)(dot(clip_row0.xyz, d), dot(clip_row1.xyz, d), dot(clip_row2.xyz, d));
+        uox[l] = uo.x, uoy[l] = uo.y, uoz[l] = uo.z, udx[l] = ud.x, udy[l] = ud.y, udz[l] = ud.z;
+    }
+    const float8 uo_x = vload8(0, uox), uo_y = vload8(0, uoy), uo_z = vload8(0, uoz);
+    const float8 ud_x = vload8(0, udx), ud_y = vload8(0, udy), ud_z = vload8(0, udz);
+#endif
+#ifdef SLICE3D_CLIP_MESH
+    /* each lane's mesh layers, its deepest back face (naive) and its next layer, as slice3d_fused keeps them */
+    const int4 mesh = p.clip_mesh;
+    const size_t mesh_stride = (size_t)p.width * (size_t)p.height;
+    int last_back[8], mesh_next[8];
+    for (int l = 0; l < SLICE3D_LANES; ++l) {
+        last_back[l] = -1, mesh_next[l] = 0;
+        global const float4* layers = clip_layers + ((size_t)y * p.width + min(x0 + l, p.width - 1));
+        for (int m = 0; m < mesh.x; ++m)
+            if (layers[(size_t)m * mesh_stride].y == 0.0f)
+                last_back[l] = m;
+    }
+#endif
     const float8 go_x = (o_x - p.grid_origin.x) * p.inv_spacing.x, go_y = (o_y - p.grid_origin.y) * p.inv_spacing.y;
     const float8 go_z = (o_z - p.grid_origin.z) * p.inv_spacing.z;
     const float8 gd_x = d_x * p.inv_spacing.x, gd_y = d_y * p.inv_spacing.y, gd_z = d_z * p.inv_spacing.z;
@@ -550,7 +589,7 @@ kernel void slice3d_fused_packet(global float4* out, global uint* samples, globa
     for (int k = ftb ? k_begin : k_end; ftb ? k <= k_end : k >= k_begin; k += step) {
         const float z = depth0 + (float)k * delta_s;
         const float8 gx = go_x + z * gd_x, gy = go_y + z * gd_y, gz = go_z + z * gd_z;
-        const int8 act = live & (k >= lo8) & (k <= hi8) & isgreaterequal(gx, loop_lo.x) &
+        int8 act = live & (k >= lo8) & (k <= hi8) & isgreaterequal(gx, loop_lo.x) &
                          isgreaterequal(gy, loop_lo.y) & isgreaterequal(gz, loop_lo.z) & isless(gx, loop_hi.x) &
                          isless(gy, loop_hi.y) & isless(gz, loop_hi.z);
         if (!any(act))
@@ -588,6 +627,30 @@ kernel void slice3d_fused_packet(global float4* out, global uint* samples, globa
             }
         }
         taken -= act;
+#if defined(SLICE3D_CLIP_TEXTURE) || defined(SLICE3D_CLIP_MESH)
+        /* the clip tests lane by lane: a sample they remove counts as taken and adds nothing */
+        int acts[8];
+        vstore8(act, 0, acts);
+#ifdef SLICE3D_CLIP_TEXTURE
+        {
+            const float8 u_x = uo_x + z * ud_x, u_y = uo_y + z * ud_y, u_z = uo_z + z * ud_z;
+            float ux[8], uy[8], uz[8];
+            vstore8(u_x, 0, ux), vstore8(u_y, 0, uy), vstore8(u_z, 0, uz);
+            for (int l = 0; l < SLICE3D_LANES; ++l)
+                if (acts[l] && !clvr_clip_keep(clip_texels, p.clip_tex, (float3)(ux[l], uy[l], uz[l]), p.clip_inverse))
+                    acts[l] = 0;
+        }
+#endif
+#ifdef SLICE3D_CLIP_MESH
+        for (int l = 0; l < SLICE3D_LANES; ++l)
+            if (acts[l] && !slice3d_mesh_keep(clip_layers + ((size_t)y * p.width + x0 + l), mesh_stride, mesh, last_back[l],
+                                              &mesh_next[l], z))
+                acts[l] = 0;
+#endif
+        act = vload8(0, acts);
+        if (!any(act))
+            continue;
+#endif
         const float8 fx = lx - convert_float8(ix), fy = ly - convert_float8(iy), fz = lz - convert_float8(iz);
         const uint8 idx = convert_uint8(iz) * nxy + convert_uint8(iy) * nx + convert_uint8(ix);
         float8 a00x, a00y, a10x, a10y, a01x, a01y, a11x, a11y;

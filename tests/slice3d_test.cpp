@@ -510,20 +510,50 @@ TEST(Slice3dPackets, TransparentTransferFunctionTakesNoSample)
     }
 }
 
-// The packet kernel is the one-pixel kernel's stand-in only where it is built: with a clip texture or
-// pre-integrated slabs the fused path keeps one pixel per work-item (stats say which ran).
-TEST(Slice3dPackets, ClipAndPreintegratedKeepOnePixelPerWorkItem)
+// With a clip texture and with a clip mesh (peeled layers) the packet kernel runs each lane's clip test with the
+// one-pixel kernel's code: the same bits, both orders and both clip methods, skipping on (a sample a clip test
+// removes counts as taken); with pre-integrated slabs the fused path keeps one pixel per work-item (stats say
+// which ran).
+TEST(Slice3dPackets, ClippedImagesAreBitIdenticalPreintegratedKeepsOnePixel)
 {
-    FrameStats plain, pre;
-    test::renderScene(makeScene(perspectiveCamera(), test::designTransferFunction(), 24, {{"slices", 32}}),
-                      marschnerLobb41(), &plain);
+    const json sphereTexture = {{"shape", "sphere"}, {"center", {0.1, -0.05, 0.0}}, {"radius", 0.7}};
+    const json sphereMesh = {{"generator", "sphere"}, {"center", {0.1, 0.0, 0.2}}, {"radius", 0.6}, {"segments", 32}};
+    const TransferFunction mlThreshold({{0.0, {0, 0, 0}, 0.0}, {0.45, {0.3, 0.3, 1}, 0.0}, {1.0, {1, 1, 0.5}, 9.0}});
+    const json clips[] = {{{"clip_texture", sphereTexture}},
+                          {{"clip_texture", {{"shape", "sphere"}, {"radius", 0.6}, {"inverse", true}}}},
+                          {{"clip", {{"mesh", sphereMesh}}}},
+                          {{"clip", {{"mesh", sphereMesh}, {"inverse", true}, {"method", "naive"}}}}};
+    int compared = 0;
+    for (const json& clip : clips)
+        for (const json& order : {json{{"order", "back-to-front"}}, json{{"order", "front-to-back"}, {"early_termination", 0.95}}})
+            for (const Camera& camera : {perspectiveCamera(), parallelCamera()}) {
+                json options = {{"slices", 80}};
+                options.update(clip);
+                options.update(order);
+                json pixels = options;
+                pixels["packets"] = false;
+                FrameStats ps, qs;
+                const Image4f p = test::renderScene(makeScene(camera, mlThreshold, 43, options), marschnerLobb41(), &ps);
+                const Image4f q = test::renderScene(makeScene(camera, mlThreshold, 43, pixels), marschnerLobb41(), &qs);
+                const std::string label = options.dump() + (camera.parallel ? " parallel" : " perspective");
+                ASSERT_EQ(p.pixelCount(), q.pixelCount());
+                EXPECT_EQ(std::memcmp(p.pixels().data(), q.pixels().data(), p.pixelCount() * sizeof(glm::vec4)), 0)
+                    << label;
+                EXPECT_TRUE(ps.extra["packets"].get<bool>()) << label;
+                EXPECT_EQ(ps.samples, qs.samples) << label;
+                // the clip removes part of the image: some pixel is the background, some is not
+                const auto background = [](const glm::vec4& v) { return v.a == 0.0f; };
+                EXPECT_TRUE(std::any_of(p.pixels().begin(), p.pixels().end(), background)) << label;
+                EXPECT_FALSE(std::all_of(p.pixels().begin(), p.pixels().end(), background)) << label;
+                ++compared;
+            }
+    EXPECT_EQ(compared, 16);
+    FrameStats pre;
     test::renderScene(makeScene(perspectiveCamera(), test::designTransferFunction(), 24,
                                 {{"slices", 32}, {"integration", "preintegrated"}}),
                       marschnerLobb41(), &pre);
-    EXPECT_TRUE(plain.extra["packets"].get<bool>());
     EXPECT_FALSE(pre.extra["packets"].get<bool>());
 }
-
 
 // ---- images ----------------------------------------------------------------------------------
 

@@ -180,9 +180,9 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
     if (options_.path == Slice3dOptions::Path::Fused) {
         fused_ = device_.kernel("slice3d.cl", "slice3d_fused", {}, trilinearOptions);
-        // Ray packets (docs/slice3d.md): the same kernel's arithmetic on 8 pixels at once; the clip and
-        // pre-integrated variants keep one pixel per work-item.
-        packet_ = options_.packets && !clipTexture_ && !clipMesh_ && !options_.preintegrated;
+        // Ray packets (docs/slice3d.md): the same kernel's arithmetic on 8 pixels at once; the pre-integrated
+        // slabs keep one pixel per work-item.
+        packet_ = options_.packets && !options_.preintegrated;
         if (packet_)
             fused_ = device_.kernel("slice3d.cl", "slice3d_fused_packet", {}, trilinearOptions);
         out_ = device_.buffer("slice3d image", pixels * sizeof(cl_float4), CL_MEM_WRITE_ONLY);
@@ -619,8 +619,8 @@ TechniqueInfo slice3dTechnique()
         {"empty_space_skipping", true, "", "fused path: step over bricks where tau is 0 (same image)"},
         {"voxel_type", "auto", "", "\"auto\" (uint8/uint16 on the device when the values fit) or \"float32\""},
         {"packets", true, "",
-         "fused path: 8 neighbouring pixels per work-item as vector lanes (same image; not with preintegrated or "
-         "clipping) or false: one pixel per work-item"},
+         "fused path: 8 neighbouring pixels per work-item as vector lanes (same image; not with preintegrated) or "
+         "false: one pixel per work-item"},
         {"integration", "sample", "",
          "\"sample\" (alpha = 1 - exp(-tau delta) per slice sample) or \"preintegrated\" (fused path: each slab "
          "between samples integrated exactly for a linear scalar)"},
