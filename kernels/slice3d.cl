@@ -13,6 +13,7 @@
 #include "transfer_function.h"
 #include "volume_sampling.h"
 #include "empty_space.h"
+#include "packet.h"
 #ifdef SLICE3D_PREINTEGRATED
 #include "segment_integral.h"
 #endif
@@ -323,145 +324,6 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
  * lane in an empty brick while another lane samples takes its sample, whose tau is 0 (empty bricks are
  * decided with a margin for float rounding), which changes nothing; the packet steps over slices only
  * when every active lane is in an empty brick, as far as the nearest of their runs' ends. */
-#define SLICE3D_LANES 8
-#define SLICE3D_EACH_LANE(M) M(0) M(1) M(2) M(3) M(4) M(5) M(6) M(7)
-
-/* clvr_exp2 (kernels/clvr_common.h) lane by lane, the same operations. */
-float8 slice3d_exp2_8(const float8 x)
-{
-    const float8 n = rint(x);
-    const float8 f = x - n;
-    const float8 p = 1.0f + f * (6.931472028550421e-1f +
-                                 f * (2.402264791363012e-1f +
-                                      f * (5.550332471162809e-2f +
-                                           f * (9.618437357674640e-3f +
-                                                f * (1.339887440266574e-3f + f * 1.535336188319500e-4f)))));
-    const float8 r = p * as_float8((convert_int8(n) + 127) << 23);
-    return select((float8)(0.0f), r, isgreaterequal(x, -126.0f));
-}
-
-/* clvr_tf_eval (kernels/transfer_function.h) lane by lane: the same segment and expression per lane, found
- * by selects over the segments instead of a search. */
-void slice3d_tf_eval8(global const float* tf, const int n, const float8 x, float8* r, float8* g, float8* b,
-                      float8* tau)
-{
-    global const float* value = tf + ((n + 3) & ~3);
-    global const float* slope = value + 4 * n;
-    float8 vr = value[0], vg = value[1], vb = value[2], vt = value[3];
-    for (int j = 0; j + 1 < n; ++j) {
-        const float s = tf[j];
-        const int8 in = j == 0 ? isgreater(x, s) : isgreaterequal(x, s);
-        const float8 dx = x - s;
-        global const float* v = value + 4 * j;
-        global const float* m = slope + 4 * j;
-        vr = select(vr, v[0] + dx * m[0], in);
-        vg = select(vg, v[1] + dx * m[1], in);
-        vb = select(vb, v[2] + dx * m[2], in);
-        vt = select(vt, v[3] + dx * m[3], in);
-    }
-    const int8 top = isgreaterequal(x, tf[n - 1]);
-    global const float* v = value + 4 * (n - 1);
-    *r = select(vr, (float8)(v[0]), top);
-    *g = select(vg, (float8)(v[1]), top);
-    *b = select(vb, (float8)(v[2]), top);
-    *tau = select(vt, (float8)(v[3]), top);
-}
-
-/* clvr_empty_run (kernels/empty_space.h) lane by lane, the same arithmetic: lane l's sample k lies in brick
- * (bx, by, bz) and every brick within Chebyshev distance r of it is empty; the last slice towards k_end still
- * in that cube of bricks (k where no candidate checks out; only the lanes that sample are meaningful). */
-int8 slice3d_in_cube8(const float8 go_x, const float8 go_y, const float8 go_z, const float8 gd_x, const float8 gd_y,
-                      const float8 gd_z, const float depth0, const float delta_s, const int8 k, const ClvrOwnedGrid* grid,
-                      const int8 bx, const int8 by, const int8 bz, const int8 r)
-{
-    const float8 z = depth0 + convert_float8(k) * delta_s;
-    const float8 gx = go_x + z * gd_x, gy = go_y + z * gd_y, gz = go_z + z * gd_z;
-    const int8 in = isgreaterequal(gx, grid->own_lo.x) & isgreaterequal(gy, grid->own_lo.y) &
-                    isgreaterequal(gz, grid->own_lo.z) & isless(gx, grid->own_hi.x) & isless(gy, grid->own_hi.y) &
-                    isless(gz, grid->own_hi.z);
-    const float3 off = convert_float3(grid->offset.xyz);
-    /* outside lanes read as 0: their answer is 0 anyway */
-    const int8 cx = min(convert_int8(select((float8)(0.0f), gx - off.x, in)), grid->dims.x - 2) >> CLVR_BRICK_SHIFT;
-    const int8 cy = min(convert_int8(select((float8)(0.0f), gy - off.y, in)), grid->dims.y - 2) >> CLVR_BRICK_SHIFT;
-    const int8 cz = min(convert_int8(select((float8)(0.0f), gz - off.z, in)), grid->dims.z - 2) >> CLVR_BRICK_SHIFT;
-    const uint8 c = max(abs_diff(cx, bx), max(abs_diff(cy, by), abs_diff(cz, bz)));
-    return in & (c <= convert_uint8(r));
-}
-
-int8 slice3d_empty_run8(const float8 go_x, const float8 go_y, const float8 go_z, const float8 gd_x, const float8 gd_y,
-                        const float8 gd_z, const float depth0, const float delta_s, const int k, const int step,
-                        const int8 k_end, const ClvrOwnedGrid* grid, const int8 bx, const int8 by, const int8 bz,
-                        const int8 r)
-{
-    const float3 off = convert_float3(grid->offset.xyz);
-    const int4 dims = grid->dims;
-    /* the face each lane walks towards, per axis: the cube's high side where step * gd > 0, else its low one */
-    const float8 lo_x = off.x + convert_float8(max(bx - r, 0) << CLVR_BRICK_SHIFT);
-    const float8 lo_y = off.y + convert_float8(max(by - r, 0) << CLVR_BRICK_SHIFT);
-    const float8 lo_z = off.z + convert_float8(max(bz - r, 0) << CLVR_BRICK_SHIFT);
-    const float8 hi_x = off.x + fmin(convert_float8((bx + r + 1) << CLVR_BRICK_SHIFT), (float)(dims.x - 1));
-    const float8 hi_y = off.y + fmin(convert_float8((by + r + 1) << CLVR_BRICK_SHIFT), (float)(dims.y - 1));
-    const float8 hi_z = off.z + fmin(convert_float8((bz + r + 1) << CLVR_BRICK_SHIFT), (float)(dims.z - 1));
-    const float fs = (float)step;
-    const float8 tx = (select(lo_x, hi_x, isgreater(fs * gd_x, 0.0f)) - go_x) * (1.0f / gd_x);
-    const float8 ty = (select(lo_y, hi_y, isgreater(fs * gd_y, 0.0f)) - go_y) * (1.0f / gd_y);
-    const float8 tz = (select(lo_z, hi_z, isgreater(fs * gd_z, 0.0f)) - go_z) * (1.0f / gd_z);
-    const float none = step > 0 ? INFINITY : -INFINITY;
-    const float8 ex = select(tx, (float8)(none), gd_x == 0.0f), ey = select(ty, (float8)(none), gd_y == 0.0f);
-    const float8 ez = select(tz, (float8)(none), gd_z == 0.0f);
-    const float8 zexit = step > 0 ? fmin(ex, fmin(ey, ez)) : fmax(ex, fmax(ey, ez));
-    const float8 kf = (zexit - depth0) / delta_s;
-    const float8 fk = (float8)((float)k), fe = convert_float8(k_end);
-    const int8 c1 = step > 0 ? convert_int8(clamp(floor(kf), fk, fe)) : convert_int8(clamp(ceil(kf), fe, fk));
-    const int8 c2 = c1 - step;
-    const int8 ok1 = (c1 != k) & slice3d_in_cube8(go_x, go_y, go_z, gd_x, gd_y, gd_z, depth0, delta_s, c1, grid, bx, by, bz, r);
-    const int8 ok2 = (c1 != k) & (c2 != k) &
-                     slice3d_in_cube8(go_x, go_y, go_z, gd_x, gd_y, gd_z, depth0, delta_s, c2, grid, bx, by, bz, r);
-    return select(select((int8)(k), c2, ok2), c1, ok1);
-}
-
-/* clvr_box_chord lane by lane (the same divisions and min/max per axis; an axis the ray runs parallel to
- * empties the chord where the ray lies outside [lo, hi) on it). */
-void slice3d_chord_axis8(const float8 g0, const float8 gs, const float l, const float h, float8* z0, float8* z1)
-{
-    const float8 t0 = (l - g0) / gs, t1 = (h - g0) / gs;
-    const int8 flat = gs == 0.0f;
-    *z0 = select(fmax(*z0, fmin(t0, t1)), *z0, flat);
-    *z1 = select(fmin(*z1, fmax(t0, t1)), select(*z1, (float8)(-INFINITY), isless(g0, l) | isgreaterequal(g0, h)), flat);
-}
-
-void slice3d_box_chord8(const float8 go_x, const float8 go_y, const float8 go_z, const float8 gd_x, const float8 gd_y,
-                        const float8 gd_z, const float3 lo, const float3 hi, float8* zin, float8* zout)
-{
-    float8 z0 = -INFINITY, z1 = INFINITY;
-    slice3d_chord_axis8(go_x, gd_x, lo.x, hi.x, &z0, &z1);
-    slice3d_chord_axis8(go_y, gd_y, lo.y, hi.y, &z0, &z1);
-    slice3d_chord_axis8(go_z, gd_z, lo.z, hi.z, &z0, &z1);
-    *zin = z0;
-    *zout = z1;
-}
-
-/* clvr_slice_range lane by lane. */
-void slice3d_slice_range8(const float8 zin, const float8 zout, const float depth0, const float delta_s, const int count,
-                          int8* k_lo, int8* k_hi)
-{
-    const float n = (float)count;
-    const int8 chord = islessequal(zin, zout);
-    *k_lo = select((int8)(0), convert_int8(clamp(ceil((zin - depth0) / delta_s) - 1.0f, 0.0f, n)), chord);
-    *k_hi = select((int8)(-1), convert_int8(clamp(floor((zout - depth0) / delta_s) + 1.0f, -1.0f, n - 1.0f)), chord);
-}
-
-/* clvr_grid_owned of each lane's slice-k point (clvr_slice_point's expression). */
-int8 slice3d_owned8(const float8 go_x, const float8 go_y, const float8 go_z, const float8 gd_x, const float8 gd_y,
-                    const float8 gd_z, const float depth0, const float delta_s, const int8 k, const float3 lo,
-                    const float3 hi)
-{
-    const float8 z = depth0 + convert_float8(k) * delta_s;
-    const float8 gx = go_x + z * gd_x, gy = go_y + z * gd_y, gz = go_z + z * gd_z;
-    return isgreaterequal(gx, lo.x) & isgreaterequal(gy, lo.y) & isgreaterequal(gz, lo.z) & isless(gx, hi.x) &
-           isless(gy, hi.y) & isless(gz, hi.z);
-}
-
 kernel void slice3d_fused_packet(global float4* out, global uint* samples, global uint* skipped,
                                  global const SLICE3D_VOXEL* volume, global const float* tf,
                                  global const uchar* space,
@@ -473,7 +335,7 @@ kernel void slice3d_fused_packet(global float4* out, global uint* samples, globa
 #endif
                                  const ClSlice3dParams p)
 {
-    const int x0 = (int)get_global_id(0) * SLICE3D_LANES, y = (int)get_global_id(1);
+    const int x0 = (int)get_global_id(0) * CLVR_LANES, y = (int)get_global_id(1);
     if (x0 >= p.width || y >= p.height)
         return;
     const int4 dims = p.dims, bdims = p.brick_dims, offset = p.part_offset;
@@ -518,7 +380,7 @@ kernel void slice3d_fused_packet(global float4* out, global uint* samples, globa
 #ifdef SLICE3D_CLIP_TEXTURE
     /* clip-texture coordinates along each lane's ray, u = uo + z ud (slice3d_fused's expressions per lane) */
     float uox[8], uoy[8], uoz[8], udx[8], udy[8], udz[8];
-    for (int l = 0; l < SLICE3D_LANES; ++l) {
+    for (int l = 0; l < CLVR_LANES; ++l) {
         const float3 o = (float3)(ox[l], oy[l], oz[l]), d = (float3)(dx[l], dy[l], dz[l]);
         const float4 clip_row0 = p.clip_row[0], clip_row1 = p.clip_row[1], clip_row2 = p.clip_row[2];
         const float3 uo = (float3)(dot(clip_row0.xyz, o) + clip_row0.w, dot(clip_row1.xyz, o) + clip_row1.w,
@@ -534,7 +396,7 @@ kernel void slice3d_fused_packet(global float4* out, global uint* samples, globa
     const int4 mesh = p.clip_mesh;
     const size_t mesh_stride = (size_t)p.width * (size_t)p.height;
     int last_back[8], mesh_next[8];
-    for (int l = 0; l < SLICE3D_LANES; ++l) {
+    for (int l = 0; l < CLVR_LANES; ++l) {
         last_back[l] = -1, mesh_next[l] = 0;
         global const float4* layers = clip_layers + ((size_t)y * p.width + min(x0 + l, p.width - 1));
         for (int m = 0; m < mesh.x; ++m)
@@ -548,37 +410,35 @@ kernel void slice3d_fused_packet(global float4* out, global uint* samples, globa
     /* the slices near the chord through the owned box; with skipping, the first and last owned ones (for the
      * samples counted) and the slices near the chord through the box of the bricks that are not empty */
     float8 zin, zout;
-    slice3d_box_chord8(go_x, go_y, go_z, gd_x, gd_y, gd_z, own_lo, own_hi, &zin, &zout);
+    clvr_box_chord8(go_x, go_y, go_z, gd_x, gd_y, gd_z, own_lo, own_hi, &zin, &zout);
     int8 lo8, hi8;
-    slice3d_slice_range8(zin, zout, depth0, delta_s, p.slice_count, &lo8, &hi8);
+    clvr_slice_range8(zin, zout, depth0, delta_s, p.slice_count, &lo8, &hi8);
     int8 k_first = lo8, k_last = hi8;
     if (skip) {
         for (int8 move = (int8)(-1); any(move);) {
-            move = (k_first <= k_last) & ~slice3d_owned8(go_x, go_y, go_z, gd_x, gd_y, gd_z, depth0, delta_s, k_first,
+            move = (k_first <= k_last) & ~clvr_grid_owned8(go_x, go_y, go_z, gd_x, gd_y, gd_z, depth0, delta_s, k_first,
                                                          own_lo, own_hi);
             k_first -= move;
         }
         for (int8 move = (int8)(-1); any(move);) {
-            move = (k_last >= k_first) & ~slice3d_owned8(go_x, go_y, go_z, gd_x, gd_y, gd_z, depth0, delta_s, k_last,
+            move = (k_last >= k_first) & ~clvr_grid_owned8(go_x, go_y, go_z, gd_x, gd_y, gd_z, depth0, delta_s, k_last,
                                                         own_lo, own_hi);
             k_last += move;
         }
-        slice3d_box_chord8(go_x, go_y, go_z, gd_x, gd_y, gd_z, loop_lo, loop_hi, &zin, &zout);
-        slice3d_slice_range8(zin, zout, depth0, delta_s, p.slice_count, &lo8, &hi8);
+        clvr_box_chord8(go_x, go_y, go_z, gd_x, gd_y, gd_z, loop_lo, loop_hi, &zin, &zout);
+        clvr_slice_range8(zin, zout, depth0, delta_s, p.slice_count, &lo8, &hi8);
     }
     /* lanes past the row's end: nothing to sample, nothing written */
     const int8 in_row = x0 + (int8)(0, 1, 2, 3, 4, 5, 6, 7) < p.width;
     lo8 = select((int8)(0), lo8, in_row), hi8 = select((int8)(-1), hi8, in_row);
     k_first = select((int8)(0), k_first, in_row), k_last = select((int8)(-1), k_last, in_row);
     const int8 ranged = lo8 <= hi8;
-    const int4 b4 = min(select((int8)(p.slice_count), lo8, ranged).lo, select((int8)(p.slice_count), lo8, ranged).hi);
-    const int4 e4 = max(select((int8)(-1), hi8, ranged).lo, select((int8)(-1), hi8, ranged).hi);
-    const int k_begin = min(min(b4.x, b4.y), min(b4.z, b4.w)), k_end = max(max(e4.x, e4.y), max(e4.z, e4.w));
+    const int k_begin = clvr_min8(select((int8)(p.slice_count), lo8, ranged));
+    const int k_end = clvr_max8(select((int8)(-1), hi8, ranged));
     float8 chord_in, chord_out;
-    slice3d_box_chord8(go_x, go_y, go_z, gd_x, gd_y, gd_z, (float3)(0.0f), p.grid_hi.xyz, &chord_in, &chord_out);
+    clvr_box_chord8(go_x, go_y, go_z, gd_x, gd_y, gd_z, (float3)(0.0f), p.grid_hi.xyz, &chord_in, &chord_out);
     chord_in = fmax(chord_in, 0.0f);
     const float3 off = convert_float3(offset.xyz);
-    const uint nx = (uint)dims.x, nxy = nx * (uint)dims.y;
 
     float8 cr = 0.0f, cg = 0.0f, cb = 0.0f;
     float8 transmittance = 1.0f, alpha_acc = 0.0f;
@@ -606,12 +466,12 @@ kernel void slice3d_fused_packet(global float4* out, global uint* samples, globa
                                  (uint)bdims.x + convert_uint8(ix >> CLVR_BRICK_SHIFT);
             int8 sp;
 #define SLICE3D_SPACE(L) sp.s##L = space[bi.s##L];
-            SLICE3D_EACH_LANE(SLICE3D_SPACE)
+            CLVR_EACH_LANE(SLICE3D_SPACE)
 #undef SLICE3D_SPACE
             if (!any(act & (sp == 0))) {
                 /* every sampling lane is in an empty brick: step to the nearest end of their runs, but no
                  * further than any other live lane's next sample */
-                const int8 run_end = slice3d_empty_run8(go_x, go_y, go_z, gd_x, gd_y, gd_z, depth0, delta_s, k, step,
+                const int8 run_end = clvr_empty_run8(go_x, go_y, go_z, gd_x, gd_y, gd_z, depth0, delta_s, k, step,
                                                         ftb ? hi8 : lo8, &owned, ix >> CLVR_BRICK_SHIFT,
                                                         iy >> CLVR_BRICK_SHIFT, iz >> CLVR_BRICK_SHIFT, sp - 1);
                 int8 bound;
@@ -620,9 +480,7 @@ kernel void slice3d_fused_packet(global float4* out, global uint* samples, globa
                 else
                     bound = select(select(select((int8)(k_begin), (int8)(k), k >= lo8), hi8 + 1, k > hi8), run_end, act);
                 bound = select((int8)(ftb ? k_end : k_begin), bound, live);
-                const int4 b4 = ftb ? min(bound.lo, bound.hi) : max(bound.lo, bound.hi);
-                const int2 b2 = ftb ? min(b4.lo, b4.hi) : max(b4.lo, b4.hi);
-                k = ftb ? min(b2.x, b2.y) : max(b2.x, b2.y);
+                k = ftb ? clvr_min8(bound) : clvr_max8(bound);
                 continue;
             }
         }
@@ -636,13 +494,13 @@ kernel void slice3d_fused_packet(global float4* out, global uint* samples, globa
             const float8 u_x = uo_x + z * ud_x, u_y = uo_y + z * ud_y, u_z = uo_z + z * ud_z;
             float ux[8], uy[8], uz[8];
             vstore8(u_x, 0, ux), vstore8(u_y, 0, uy), vstore8(u_z, 0, uz);
-            for (int l = 0; l < SLICE3D_LANES; ++l)
+            for (int l = 0; l < CLVR_LANES; ++l)
                 if (acts[l] && !clvr_clip_keep(clip_texels, p.clip_tex, (float3)(ux[l], uy[l], uz[l]), p.clip_inverse))
                     acts[l] = 0;
         }
 #endif
 #ifdef SLICE3D_CLIP_MESH
-        for (int l = 0; l < SLICE3D_LANES; ++l)
+        for (int l = 0; l < CLVR_LANES; ++l)
             if (acts[l] && !slice3d_mesh_keep(clip_layers + ((size_t)y * p.width + x0 + l), mesh_stride, mesh, last_back[l],
                                               &mesh_next[l], z))
                 acts[l] = 0;
@@ -651,19 +509,19 @@ kernel void slice3d_fused_packet(global float4* out, global uint* samples, globa
         if (!any(act))
             continue;
 #endif
-        const float8 fx = lx - convert_float8(ix), fy = ly - convert_float8(iy), fz = lz - convert_float8(iz);
-        const uint8 idx = convert_uint8(iz) * nxy + convert_uint8(iy) * nx + convert_uint8(ix);
-        float8 a00x, a00y, a10x, a10y, a01x, a01y, a11x, a11y;
 #if defined(SLICE3D_VOXEL_BITS) && (SLICE3D_VOXEL_BITS == 8 || SLICE3D_VOXEL_BITS == 16)
         /* Integer voxels: each (i, i + 1) pair is one 16- or 32-bit load, put into a lane of one vector and
-         * split into its two values there (little-endian: value i in the low half), half the lane inserts. */
+         * split into its two values there (little-endian: value i in the low half), half the lane inserts;
+         * then clvr_trilinear's interpolation as vectors. */
+        const float8 fx = lx - convert_float8(ix), fy = ly - convert_float8(iy), fz = lz - convert_float8(iz);
+        const uint nx = (uint)dims.x, nxy = nx * (uint)dims.y;
+        const uint8 idx = convert_uint8(iz) * nxy + convert_uint8(iy) * nx + convert_uint8(ix);
+        float8 a00x, a00y, a10x, a10y, a01x, a01y, a11x, a11y;
 #if SLICE3D_VOXEL_BITS == 8
-        typedef ushort PairT;
         typedef ushort8 Pair8;
 #define SLICE3D_PAIR(q) as_ushort(vload2(0, q))
 #define SLICE3D_SPLIT(v, lo, hi) lo = convert_float8(v & (ushort)0xff), hi = convert_float8(v >> (ushort)8)
 #else
-        typedef uint PairT;
         typedef uint8 Pair8;
 #define SLICE3D_PAIR(q) as_uint(vload2(0, q))
 #define SLICE3D_SPLIT(v, lo, hi) lo = convert_float8(v & 0xffffu), hi = convert_float8(v >> 16u)
@@ -675,26 +533,14 @@ kernel void slice3d_fused_packet(global float4* out, global uint* samples, globa
             p00.s##L = SLICE3D_PAIR(q), p10.s##L = SLICE3D_PAIR(q + nx);                                  \
             p01.s##L = SLICE3D_PAIR(q + nxy), p11.s##L = SLICE3D_PAIR(q + nxy + nx);                      \
         }
-        SLICE3D_EACH_LANE(SLICE3D_GATHER)
+        CLVR_EACH_LANE(SLICE3D_GATHER)
+#undef SLICE3D_GATHER
         SLICE3D_SPLIT(p00, a00x, a00y);
         SLICE3D_SPLIT(p10, a10x, a10y);
         SLICE3D_SPLIT(p01, a01x, a01y);
         SLICE3D_SPLIT(p11, a11x, a11y);
 #undef SLICE3D_PAIR
 #undef SLICE3D_SPLIT
-#else
-#define SLICE3D_GATHER(L)                                                                                 \
-        {                                                                                                 \
-            global const SLICE3D_VOXEL* q = volume + idx.s##L;                                            \
-            const float2 v00 = convert_float2(vload2(0, q)), v10 = convert_float2(vload2(0, q + nx));     \
-            const float2 v01 = convert_float2(vload2(0, q + nxy));                                        \
-            const float2 v11 = convert_float2(vload2(0, q + nxy + nx));                                   \
-            a00x.s##L = v00.x, a00y.s##L = v00.y, a10x.s##L = v10.x, a10y.s##L = v10.y;                   \
-            a01x.s##L = v01.x, a01y.s##L = v01.y, a11x.s##L = v11.x, a11y.s##L = v11.y;                   \
-        }
-        SLICE3D_EACH_LANE(SLICE3D_GATHER)
-#endif
-#undef SLICE3D_GATHER
         const float8 c00 = a00x + fx * (a00y - a00x);
         const float8 c10 = a10x + fx * (a10y - a10x);
         const float8 c01 = a01x + fx * (a01y - a01x);
@@ -702,14 +548,17 @@ kernel void slice3d_fused_packet(global float4* out, global uint* samples, globa
         const float8 c0 = c00 + fy * (c10 - c00);
         const float8 c1 = c01 + fy * (c11 - c01);
         const float8 value = c0 + fz * (c1 - c0);
+#else
+        const float8 value = clvr_trilinear8(volume, dims, lx, ly, lz);
+#endif
         float8 r, g, b, tau;
-        slice3d_tf_eval8(tf, tf_count, value, &r, &g, &b, &tau);
+        clvr_tf_eval8(tf, tf_count, value, &r, &g, &b, &tau);
         /* slice3d_slab_log2e lane by lane */
         const int8 first = isless(z - delta_s, chord_in), last = isgreater(z + delta_s, chord_out);
         const float8 slo = select((float8)(z - 0.5f * delta_s), chord_in, first);
         const float8 shi = select((float8)(z + 0.5f * delta_s), chord_out, last);
         const float8 slab = select(neg_delta_log2e, fmax(shi - slo, 0.0f) * neg_stretch_log2e, first | last);
-        const float8 alpha = 1.0f - slice3d_exp2_8(tau * slab);
+        const float8 alpha = 1.0f - clvr_exp2_8(tau * slab);
         if (ftb) {
             cr = select(cr, cr + (transmittance * alpha) * r, act);
             cg = select(cg, cg + (transmittance * alpha) * g, act);
@@ -736,7 +585,7 @@ kernel void slice3d_fused_packet(global float4* out, global uint* samples, globa
     int ks[8], tk[8], kfirst[8];
     vstore8(orr, 0, ro), vstore8(org, 0, go8), vstore8(orb, 0, bo), vstore8(alpha_acc, 0, ao);
     vstore8(k_stop, 0, ks), vstore8(taken, 0, tk), vstore8(k_first, 0, kfirst);
-    for (int l = 0; l < SLICE3D_LANES && x0 + l < p.width; ++l) {
+    for (int l = 0; l < CLVR_LANES && x0 + l < p.width; ++l) {
         uint stepped_over = 0;
         if (skip) {  /* as slice3d_fused: the owned box's samples up to where the ray stopped */
             const uint inside = ks[l] >= kfirst[l] ? (uint)(ks[l] - kfirst[l] + 1) : 0u;

@@ -11,6 +11,7 @@
 #include "raster.cl"
 #include "clvr_common.h"
 #include "empty_space.h"
+#include "packet.h"
 #endif
 
 /* One fragment of a stack quad (direct volume rendering; iso-surfaces below). attr[0] = (u, v, lower, weight): the 2D texture coordinates on the
@@ -238,15 +239,14 @@ kernel void stack2d_iso_finish(global float4* color, global const uchar* stencil
  * planes in bricks of the stack grid where nothing can show (kernels/empty_space.h; tau is 0, or all values
  * lie below the iso-value) are stepped over: the pixel is the same bit for bit. samples[pixel]: planes
  * met inside the box (taken or stepped over), skipped[pixel]: those stepped over. */
-kernel void stack2d_fused(global float4* out, global uint* samples, global uint* skipped, global const float* stack,
-                          global const float* tf, global const float4* map, global const uchar* space,
+void stack2d_fused_pixel(const int x, const int y, global float4* out, global uint* samples, global uint* skipped,
+                         global const float* stack, global const float* tf, global const float4* map,
+                         global const uchar* space,
 #ifdef CLVR_STACK2D_CLIP_TEXTURE
-                          global const float* clip_texels,
+                         global const float* clip_texels,
 #endif
-                          const ClStack2dFusedParams p)
+                         const ClStack2dFusedParams p)
 {
-    CLVR_GUARD_2D(p.width, p.height);
-    const int x = (int)get_global_id(0), y = (int)get_global_id(1);
     const size_t pixel = (size_t)y * (size_t)p.width + (size_t)x;
     const float2 s = clvr_ray_window_offset(clvr_ray_pixel_centre(x, y), (float2)((float)p.width, (float)p.height),
                                             p.camera);
@@ -336,5 +336,151 @@ kernel void stack2d_fused(global float4* out, global uint* samples, global uint*
     samples[pixel] = taken + stepped_over;
     skipped[pixel] = stepped_over;
 }
+
+kernel void stack2d_fused(global float4* out, global uint* samples, global uint* skipped, global const float* stack,
+                          global const float* tf, global const float4* map, global const uchar* space,
+#ifdef CLVR_STACK2D_CLIP_TEXTURE
+                          global const float* clip_texels,
+#endif
+                          const ClStack2dFusedParams p)
+{
+    CLVR_GUARD_2D(p.width, p.height);
+    stack2d_fused_pixel((int)get_global_id(0), (int)get_global_id(1), out, samples, skipped, stack, tf, map, space,
+#ifdef CLVR_STACK2D_CLIP_TEXTURE
+                        clip_texels,
+#endif
+                        p);
+}
+
+#ifndef CLVR_STACK2D_CLIP_TEXTURE
+/* The fused path's ray packets (host/render/grid/stack2d.cpp, plain mode 0 only; docs/stack2d.md): pixels
+ * 8x .. 8x + 7 of a row per work-item, one per lane of float8 vectors (kernels/packet.h), stepping through the
+ * same planes j together, each lane with stack2d_fused_pixel's expressions, so the image is its bits. Each
+ * lane's ray is set up as stack2d_fused_pixel sets it up; the lanes must walk the planes in one direction
+ * (the stack's axis seen from the same side): where they do not — a wide-angle camera whose rays straddle a
+ * plane through the eye parallel to the axis — the work-item renders its 8 pixels one by one instead. As
+ * slice3d's packets: a lane whose plane point is outside the box or behind the eye, or whose ray has stopped,
+ * is masked; planes are stepped over only when every sampling lane is in an empty brick, to the nearest end of
+ * their runs and never past another lane's next plane; a lane in an empty brick beside sampling ones takes its
+ * sample (tau 0: nothing changes). samples[] counts what stack2d_fused_pixel counts (the planes met in the box
+ * in front of the eye up to where the ray stopped), skipped[] those the lane did not sample. */
+kernel void stack2d_fused_packet(global float4* out, global uint* samples, global uint* skipped,
+                                 global const float* stack, global const float* tf, global const float4* map,
+                                 global const uchar* space, const ClStack2dFusedParams p)
+{
+    const int x0 = (int)get_global_id(0) * CLVR_LANES, y = (int)get_global_id(1);
+    if (x0 >= p.width || y >= p.height)
+        return;
+    const float step = p.plane_step;
+    const int4 dims = p.dims;
+    const float3 own_lo = (float3)(0.0f, 0.0f, -INFINITY);
+    const float3 own_hi = (float3)(nextafter((float)(dims.x - 1), INFINITY), nextafter((float)(dims.y - 1), INFINITY),
+                                   INFINITY);
+    const ClvrOwnedGrid grid = {dims, (int4)(0), own_lo, own_hi};
+    const float4 r0 = p.to_stack[0], r1 = p.to_stack[1], r2 = p.to_stack[2];
+    float q1ox[8], q1oy[8], q1dx[8], q1dy[8], qoz[8], nfl[8];
+    int jlo[8], jhi[8];
+    int dir = 0, one_way = 1;
+    for (int l = 0; l < CLVR_LANES; ++l) {
+        q1ox[l] = q1oy[l] = q1dx[l] = q1dy[l] = qoz[l] = nfl[l] = 0.0f;
+        jlo[l] = 0, jhi[l] = -1;
+        if (x0 + l >= p.width)
+            continue;
+        const float2 s = clvr_ray_window_offset(clvr_ray_pixel_centre(x0 + l, y), (float2)((float)p.width, (float)p.height),
+                                                p.camera);
+        float3 o, d;
+        clvr_ray_depth(s, p.camera, &o, &d);
+        const float3 qo = (float3)(dot(r0.xyz, o) + r0.w, dot(r1.xyz, o) + r1.w, dot(r2.xyz, o) + r2.w);
+        const float3 qd = (float3)(dot(r0.xyz, d), dot(r1.xyz, d), dot(r2.xyz, d));
+        if (qd.z == 0.0f)  /* parallel to the planes: none met */
+            continue;
+        const float3 q1d = (float3)(qd.x / qd.z, qd.y / qd.z, 1.0f);
+        const float3 q1o = (float3)(qo.x - qo.z * q1d.x, qo.y - qo.z * q1d.y, 0.0f);
+        float uin, uout;
+        clvr_box_chord(q1o, q1d, (float3)(0.0f), (float3)(own_hi.xy, (float)(dims.z - 1)), &uin, &uout);
+        clvr_slice_range(uin, uout, 0.0f, step, p.planes, &jlo[l], &jhi[l]);
+        const int lane_dir = qd.z > 0.0f ? 1 : -1;
+        if (dir != 0 && lane_dir != dir)
+            one_way = 0;
+        dir = lane_dir;
+        q1ox[l] = q1o.x, q1oy[l] = q1o.y, q1dx[l] = q1d.x, q1dy[l] = q1d.y, qoz[l] = qo.z;
+        nfl[l] = -step * length(d) / fabs(qd.z) * M_LOG2E_F;
+    }
+    if (!one_way) {
+        for (int l = 0; l < CLVR_LANES && x0 + l < p.width; ++l)
+            stack2d_fused_pixel(x0 + l, y, out, samples, skipped, stack, tf, map, space, p);
+        return;
+    }
+    dir = dir != 0 ? dir : 1;
+    const float8 q1o_x = vload8(0, q1ox), q1o_y = vload8(0, q1oy), q1d_x = vload8(0, q1dx), q1d_y = vload8(0, q1dy);
+    const float8 q1o_z = 0.0f, q1d_z = 1.0f, qo_z = vload8(0, qoz), neg_full_log2e = vload8(0, nfl);
+    const int8 lo8 = vload8(0, jlo), hi8 = vload8(0, jhi);
+    const int8 ranged = lo8 <= hi8;
+    const int j_begin = clvr_min8(select((int8)(p.planes), lo8, ranged)), j_end = clvr_max8(select((int8)(-1), hi8, ranged));
+    const int skip = p.bricks.w;
+    float8 cr = 0.0f, cg = 0.0f, cb = 0.0f, transmittance = 1.0f;
+    int8 live = ranged, taken = 0, stepped = 0;
+    for (int j = dir > 0 ? j_begin : j_end; dir > 0 ? j <= j_end : j >= j_begin; j += dir) {
+        const float z = 0.0f + (float)j * step;  /* clvr_slice_point's depth of plane j */
+        const float8 qx = q1o_x + z * q1d_x, qy = q1o_y + z * q1d_y, qz = q1o_z + z * q1d_z;
+        int8 act = live & (j >= lo8) & (j <= hi8) & isgreaterequal(qx, own_lo.x) & isgreaterequal(qy, own_lo.y) &
+                   isless(qx, own_hi.x) & isless(qy, own_hi.y) & isgreater((qz - qo_z) * (float)dir, 0.0f);
+        if (!any(act))
+            continue;
+        /* the stack's own coordinates, 0 in the lanes that do not sample */
+        const float8 gx = select((float8)(0.0f), qx, act), gy = select((float8)(0.0f), qy, act);
+        const float8 gz = select((float8)(0.0f), qz, act);
+        if (skip) {
+            const int8 bx = min(convert_int8(gx), dims.x - 2) >> CLVR_BRICK_SHIFT;
+            const int8 by = min(convert_int8(gy), dims.y - 2) >> CLVR_BRICK_SHIFT;
+            const int8 bz = min(convert_int8(gz), dims.z - 2) >> CLVR_BRICK_SHIFT;
+            const uint8 bi = (convert_uint8(bz) * (uint)p.bricks.y + convert_uint8(by)) * (uint)p.bricks.x + convert_uint8(bx);
+            int8 sp;
+#define STACK2D_SPACE(L) sp.s##L = space[bi.s##L];
+            CLVR_EACH_LANE(STACK2D_SPACE)
+#undef STACK2D_SPACE
+            if (!any(act & (sp == 0))) {
+                const int8 run_end = clvr_empty_run8(q1o_x, q1o_y, q1o_z, q1d_x, q1d_y, q1d_z, 0.0f, step, j, dir,
+                                                     dir > 0 ? hi8 : lo8, &grid, bx, by, bz, sp - 1);
+                int8 bound;
+                if (dir > 0)
+                    bound = select(select(select((int8)(j_end), (int8)(j), j <= hi8), lo8 - 1, j < lo8), run_end, act);
+                else
+                    bound = select(select(select((int8)(j_begin), (int8)(j), j >= lo8), hi8 + 1, j > hi8), run_end, act);
+                bound = select((int8)(dir > 0 ? j_end : j_begin), bound, live);
+                const int jump = dir > 0 ? clvr_min8(bound) : clvr_max8(bound);
+                stepped += select((int8)(0), (int8)(dir * (jump - j) + 1), act);
+                j = jump;
+                continue;
+            }
+        }
+        taken -= act;
+        const float8 value = clvr_trilinear8(stack, dims, gx, gy, gz);
+        float8 r, g, b, tau;
+        clvr_tf_eval8(tf, p.tf_count, value, &r, &g, &b, &tau);
+        const float slab = j == 0 || j == p.planes - 1 ? 0.5f : 1.0f; /* the end planes' slabs are half */
+        const float8 alpha = 1.0f - clvr_exp2_8(tau * (slab * neg_full_log2e));
+        cr = select(cr, cr + (transmittance * alpha) * r, act);
+        cg = select(cg, cg + (transmittance * alpha) * g, act);
+        cb = select(cb, cb + (transmittance * alpha) * b, act);
+        transmittance = select(transmittance, transmittance * (1.0f - alpha), act);
+        live &= ~(act & isgreaterequal(1.0f - transmittance, p.ert_alpha));
+        if (!any(live))
+            break;
+    }
+    const float8 orr = cr + transmittance * p.background.x, org = cg + transmittance * p.background.y;
+    const float8 orb = cb + transmittance * p.background.z, oa = 1.0f - transmittance;
+    float ro[8], go[8], bo[8], ao[8];
+    int tk[8], st[8];
+    vstore8(orr, 0, ro), vstore8(org, 0, go), vstore8(orb, 0, bo), vstore8(oa, 0, ao);
+    vstore8(taken, 0, tk), vstore8(stepped, 0, st);
+    for (int l = 0; l < CLVR_LANES && x0 + l < p.width; ++l) {
+        const size_t i = (size_t)y * (size_t)p.width + (size_t)(x0 + l);
+        out[i] = (float4)(ro[l], go[l], bo[l], ao[l]);
+        samples[i] = (uint)(tk[l] + st[l]);
+        skipped[i] = (uint)st[l];
+    }
+}
+#endif
 
 #endif

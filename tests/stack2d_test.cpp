@@ -97,7 +97,7 @@ void expectInputError(const json& options, const std::string& fragment)
 
 TEST(Stack2dOptions, BadOptionsThrowInputErrorNamingTheKey)
 {
-    expectInputError({{"foo", 1}}, "options.foo: unknown option for stack2d (known: intermediate, reflectance_map_size, slices_per_polygon, clip_texture, path, empty_space_skipping, early_termination)");
+    expectInputError({{"foo", 1}}, "options.foo: unknown option for stack2d (known: intermediate, reflectance_map_size, slices_per_polygon, clip_texture, path, empty_space_skipping, early_termination, packets)");
     expectInputError({{"slices_per_polygon", 0}}, "options.slices_per_polygon: must be an integer in [1, 64], got 0");
     expectInputError({{"slices_per_polygon", 65}}, "options.slices_per_polygon");
     EXPECT_EQ(parseStack2dOptions({{"slices_per_polygon", 4}}).slicesPerPolygon, 4);
@@ -711,6 +711,59 @@ TEST(Stack2dFused, EarlyTerminationLeavesOutAtMostTheRemainingTransmittance)
     EXPECT_LE(maxDiff, 0.05 + 1e-6);
     EXPECT_GT(maxDiff, 0.0);
     EXPECT_LT(early.samples, full.samples * 9 / 10);
+}
+
+// The packet kernel (stack2d_fused_packet: 8 pixels of a row per work-item, one per float8 lane) computes each
+// lane with the one-pixel kernel's expressions: the images must be the same bits (memcmp) and the planes met the
+// same count. Plain rendering with and without intermediate slices, empty-space skipping on and off, early
+// termination, rows of 61 and 5 pixels, the oblique, parallel and inside cameras, and a 150-degree camera whose
+// rays see the stack's planes from both sides (those packets render their pixels one by one). Shaded stacks,
+// iso-surfaces and clip textures keep one pixel per work-item (stats "packets").
+TEST(Stack2dFused, PacketsAreBitIdenticalToOnePixelPerWorkItem)
+{
+    Camera wide;  // inside the box, so that its rays along the planes still meet the data
+    wide.position = {0.1, -0.05, 0.3};
+    wide.focalPoint = {0.6, 0.3, -1.0};  // 25 degrees off -z: the z stack; the image's far corners look past 90
+    wide.viewAngle = 150.0;
+    const TransferFunction threshold({{0.0, {0, 0, 0}, 0.0}, {0.55, {0.2, 0.5, 0.9}, 0.0}, {0.7, {1.0, 0.8, 0.3}, 6.0},
+                                      {1.0, {1, 1, 1}, 2.0}});
+    const json sets[] = {{{"intermediate", 1}},
+                         {{"intermediate", 0}},
+                         {{"intermediate", 1}, {"empty_space_skipping", false}},
+                         {{"intermediate", 2}, {"early_termination", 0.9}}};
+    int compared = 0;
+    for (const Camera& camera : {perspectiveCamera(), parallelCamera(), insideCamera(), wide})
+        for (const TransferFunction& tf : {threshold, test::designTransferFunction()})
+            for (const json& options : sets)
+                for (int width : {61, 5}) {
+                    Scene packets = makeScene(camera, width, options);
+                    packets.image.height = 47;
+                    packets.transferFunction = tf;
+                    Scene pixels = packets;
+                    pixels.options["packets"] = false;
+                    FrameStats ps, qs;
+                    const Image4f p = test::renderScene(packets, marschnerLobb41(), &ps);
+                    const Image4f q = test::renderScene(pixels, marschnerLobb41(), &qs);
+                    const std::string label = std::string(camera.viewAngle > 100.0 ? "wide" : cameraName(camera)) + " " +
+                                              options.dump() + " width " + std::to_string(width);
+                    ASSERT_EQ(p.pixelCount(), q.pixelCount());
+                    EXPECT_EQ(std::memcmp(p.pixels().data(), q.pixels().data(), p.pixelCount() * sizeof(glm::vec4)), 0)
+                        << label;
+                    EXPECT_TRUE(ps.extra["packets"].get<bool>()) << label;
+                    EXPECT_FALSE(qs.extra["packets"].get<bool>()) << label;
+                    EXPECT_EQ(ps.samples, qs.samples) << label;
+                    EXPECT_GT(qs.samples, 0u) << label;
+                    ++compared;
+                }
+    EXPECT_EQ(compared, 4 * 2 * 4 * 2);
+    FrameStats shaded, iso;
+    test::renderScene(shadedScene(perspectiveCamera(), {{"intermediate", 1}}), sphere33(), &shaded);
+    Scene isoScene = makeScene(perspectiveCamera(), 24, {{"intermediate", 1}});
+    isoScene.transferFunction = TransferFunction();
+    isoScene.iso = test::isoSpec(0.75, {0.4, 0.6, 1.0}, 0.15, 0.8);
+    test::renderScene(isoScene, marschnerLobb41(), &iso);
+    EXPECT_FALSE(shaded.extra["packets"].get<bool>());
+    EXPECT_FALSE(iso.extra["packets"].get<bool>());
 }
 
 // "path" and the options that only one path has.

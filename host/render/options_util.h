@@ -147,6 +147,12 @@ inline OptionInfo reflectanceMapSizeInfo()
 {
     return {"reflectance_map_size", 128, "", "n of the reflectance map of shaded rendering (\"lights\"): 6 n^2 shades"};
 }
+inline OptionInfo packetsInfo()
+{
+    return {"packets", true, "",
+            "fused path: 8 neighbouring pixels per work-item as vector lanes (the same image) where the technique's "
+            "mode has them (docs/scene-format.md), or false: one pixel per work-item"};
+}
 inline OptionInfo clipTextureInfo()
 {
     return {"clip_texture", nullptr, "none", "clip by a second texture (file or generator; docs/slice3d.md, Clip textures)"};

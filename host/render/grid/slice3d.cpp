@@ -618,9 +618,7 @@ TechniqueInfo slice3dTechnique()
         {"path", "fused", "", "\"fused\" (all slices of a pixel in one kernel) or \"raster\" (pass by pass)"},
         {"empty_space_skipping", true, "", "fused path: step over bricks where tau is 0 (same image)"},
         {"voxel_type", "auto", "", "\"auto\" (uint8/uint16 on the device when the values fit) or \"float32\""},
-        {"packets", true, "",
-         "fused path: 8 neighbouring pixels per work-item as vector lanes (same image; not with preintegrated) or "
-         "false: one pixel per work-item"},
+        packetsInfo(),
         {"integration", "sample", "",
          "\"sample\" (alpha = 1 - exp(-tau delta) per slice sample) or \"preintegrated\" (fused path: each slab "
          "between samples integrated exactly for a linear scalar)"},

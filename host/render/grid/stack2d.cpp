@@ -123,6 +123,7 @@ private:
     // the empty-space radii of the bricks of the drawn stack's grid (kernels/empty_space.h), kept with the
     // bricks' min-max for a new transfer function.
     cl::Kernel fused_;
+    bool packet_ = false;  // fused_ is stack2d_fused_packet
     cl::Buffer fusedSamples_, fusedSkipped_, space_, noMap_;
     BrickGrid brickGrid_;
     std::uint64_t emptyBrickCount_ = 0;
@@ -285,7 +286,11 @@ void Stack2dRenderer::setUpFused(const Volume& volume, const TransferFunction& t
     residentBytes_ += empty.size();
     if (!map_())  // the kernel takes a reflectance map argument in every mode
         noMap_ = device_.upload("stack2d no reflectance map", std::vector<glm::vec4>(1));
-    fused_ = device_.kernel("stack2d.cl", "stack2d_fused", {}, clipTexture_ ? "-DCLVR_STACK2D_CLIP_TEXTURE=1" : "");
+    // Ray packets (kernels/stack2d.cl stack2d_fused_packet, the same bits): plain direct volume rendering
+    // without a clip texture; shading, iso-surfaces and clip textures keep one pixel per work-item.
+    packet_ = options_.packets && !clipTexture_ && !iso_ && !lighting_.shaded();
+    fused_ = device_.kernel("stack2d.cl", packet_ ? "stack2d_fused_packet" : "stack2d_fused", {},
+                            clipTexture_ ? "-DCLVR_STACK2D_CLIP_TEXTURE=1" : "");
     const std::size_t pixels = framebuffer_->pixelCount();
     fusedSamples_ = device_.buffer("stack2d fused samples per pixel", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
     fusedSkipped_ = device_.buffer("stack2d fused skipped samples per pixel", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
@@ -367,6 +372,7 @@ Image4f Stack2dRenderer::render(FrameStats& stats)
     stats.extra["resident_bytes"] = residentBytes_;
     if (fused) {
         stats.extra["empty_space_skipping"] = options_.emptySpaceSkipping && emptyBrickCount_ > 0;
+        stats.extra["packets"] = packet_;
         stats.extra["empty_bricks"] = emptyBrickCount_;
         stats.extra["skipped"] = steppedOver;
         stats.extra["early_termination"] = options_.earlyTermination;
@@ -439,7 +445,8 @@ std::uint64_t Stack2dRenderer::renderFused(std::uint64_t& steppedOver)
     if (clipTexture_)
         fused_.setArg(a++, sliceTable_);  // one slice per quad: the table is empty, the texels start at 0
     fused_.setArg(a++, p);
-    device_.launch("stack2d: fused planes", fused_, image_.width, image_.height);
+    // A packet work-item renders pixels 8x .. 8x + 7 of its row.
+    device_.launch("stack2d: fused planes", fused_, packet_ ? (image_.width + 7) / 8 : image_.width, image_.height);
     const std::size_t pixels = framebuffer_->pixelCount();
     std::uint64_t samples = 0;
     steppedOver = 0;
@@ -588,6 +595,7 @@ TechniqueInfo stack2dTechnique()
                               "through the raster stage); slices_per_polygon > 1 takes \"raster\""},
         {"empty_space_skipping", true, "", "fused path: step over bricks where nothing can show (same image)"},
         earlyTerminationInfo(1.0),
+        packetsInfo(),
     };
     t.makeForVolume = makeStack2dRenderer;
     return t;
@@ -611,6 +619,8 @@ Stack2dOptions parseStack2dOptions(const nlohmann::json& options)
                                                                        : Stack2dOptions::Path::Raster;
         else if (key == "empty_space_skipping")
             o.emptySpaceSkipping = booleanOption(key, value);
+        else if (key == "packets")
+            o.packets = booleanOption(key, value);
         else if (key == "early_termination")
             o.earlyTermination = earlyTerminationOption(value);
         else

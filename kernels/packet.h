@@ -1,0 +1,196 @@
+/* kernels/packet.h — ray packets: 8 pixels' rays stepping through the same planes together, one per lane of
+ * float8 vectors (kernels/slice3d.cl's slice3d_fused_packet, kernels/stack2d.cl's stack2d_fused_packet;
+ * docs/slice3d.md, "Ray packets"). Each function here is a scalar function of kernels/ lane by lane, with
+ * the same operations in the same order, so that a packet's pixels are the scalar kernel's bits (OpenCL
+ * contracts a * b + c within one expression, for vectors as for scalars; a product of two scalars broadcast
+ * into a vector sum is rounded on its own, so such operands are made vectors first). OpenCL C 1.2. */
+#ifndef CLVR_PACKET_H
+#define CLVR_PACKET_H
+
+#include "empty_space.h"
+
+#define CLVR_LANES 8
+#define CLVR_EACH_LANE(M) M(0) M(1) M(2) M(3) M(4) M(5) M(6) M(7)
+
+/* clvr_exp2 (kernels/clvr_common.h) lane by lane, the same operations. */
+float8 clvr_exp2_8(const float8 x)
+{
+    const float8 n = rint(x);
+    const float8 f = x - n;
+    const float8 p = 1.0f + f * (6.931472028550421e-1f +
+                                 f * (2.402264791363012e-1f +
+                                      f * (5.550332471162809e-2f +
+                                           f * (9.618437357674640e-3f +
+                                                f * (1.339887440266574e-3f + f * 1.535336188319500e-4f)))));
+    const float8 r = p * as_float8((convert_int8(n) + 127) << 23);
+    return select((float8)(0.0f), r, isgreaterequal(x, -126.0f));
+}
+
+/* clvr_tf_eval (kernels/transfer_function.h) lane by lane: the same segment and expression per lane, found
+ * by selects over the segments instead of a search. */
+void clvr_tf_eval8(global const float* tf, const int n, const float8 x, float8* r, float8* g, float8* b,
+                      float8* tau)
+{
+    global const float* value = tf + ((n + 3) & ~3);
+    global const float* slope = value + 4 * n;
+    float8 vr = value[0], vg = value[1], vb = value[2], vt = value[3];
+    for (int j = 0; j + 1 < n; ++j) {
+        const float s = tf[j];
+        const int8 in = j == 0 ? isgreater(x, s) : isgreaterequal(x, s);
+        const float8 dx = x - s;
+        global const float* v = value + 4 * j;
+        global const float* m = slope + 4 * j;
+        vr = select(vr, v[0] + dx * m[0], in);
+        vg = select(vg, v[1] + dx * m[1], in);
+        vb = select(vb, v[2] + dx * m[2], in);
+        vt = select(vt, v[3] + dx * m[3], in);
+    }
+    const int8 top = isgreaterequal(x, tf[n - 1]);
+    global const float* v = value + 4 * (n - 1);
+    *r = select(vr, (float8)(v[0]), top);
+    *g = select(vg, (float8)(v[1]), top);
+    *b = select(vb, (float8)(v[2]), top);
+    *tau = select(vt, (float8)(v[3]), top);
+}
+
+/* clvr_empty_run (kernels/empty_space.h) lane by lane, the same arithmetic: lane l's sample k lies in brick
+ * (bx, by, bz) and every brick within Chebyshev distance r of it is empty; the last slice towards k_end still
+ * in that cube of bricks (k where no candidate checks out; only the lanes that sample are meaningful). */
+int8 clvr_in_cube8(const float8 go_x, const float8 go_y, const float8 go_z, const float8 gd_x, const float8 gd_y,
+                      const float8 gd_z, const float depth0, const float delta_s, const int8 k, const ClvrOwnedGrid* grid,
+                      const int8 bx, const int8 by, const int8 bz, const int8 r)
+{
+    const float8 z = depth0 + convert_float8(k) * delta_s;
+    const float8 gx = go_x + z * gd_x, gy = go_y + z * gd_y, gz = go_z + z * gd_z;
+    const int8 in = isgreaterequal(gx, grid->own_lo.x) & isgreaterequal(gy, grid->own_lo.y) &
+                    isgreaterequal(gz, grid->own_lo.z) & isless(gx, grid->own_hi.x) & isless(gy, grid->own_hi.y) &
+                    isless(gz, grid->own_hi.z);
+    const float3 off = convert_float3(grid->offset.xyz);
+    /* outside lanes read as 0: their answer is 0 anyway */
+    const int8 cx = min(convert_int8(select((float8)(0.0f), gx - off.x, in)), grid->dims.x - 2) >> CLVR_BRICK_SHIFT;
+    const int8 cy = min(convert_int8(select((float8)(0.0f), gy - off.y, in)), grid->dims.y - 2) >> CLVR_BRICK_SHIFT;
+    const int8 cz = min(convert_int8(select((float8)(0.0f), gz - off.z, in)), grid->dims.z - 2) >> CLVR_BRICK_SHIFT;
+    const uint8 c = max(abs_diff(cx, bx), max(abs_diff(cy, by), abs_diff(cz, bz)));
+    return in & (c <= convert_uint8(r));
+}
+
+int8 clvr_empty_run8(const float8 go_x, const float8 go_y, const float8 go_z, const float8 gd_x, const float8 gd_y,
+                        const float8 gd_z, const float depth0, const float delta_s, const int k, const int step,
+                        const int8 k_end, const ClvrOwnedGrid* grid, const int8 bx, const int8 by, const int8 bz,
+                        const int8 r)
+{
+    const float3 off = convert_float3(grid->offset.xyz);
+    const int4 dims = grid->dims;
+    /* the face each lane walks towards, per axis: the cube's high side where step * gd > 0, else its low one */
+    const float8 lo_x = off.x + convert_float8(max(bx - r, 0) << CLVR_BRICK_SHIFT);
+    const float8 lo_y = off.y + convert_float8(max(by - r, 0) << CLVR_BRICK_SHIFT);
+    const float8 lo_z = off.z + convert_float8(max(bz - r, 0) << CLVR_BRICK_SHIFT);
+    const float8 hi_x = off.x + fmin(convert_float8((bx + r + 1) << CLVR_BRICK_SHIFT), (float)(dims.x - 1));
+    const float8 hi_y = off.y + fmin(convert_float8((by + r + 1) << CLVR_BRICK_SHIFT), (float)(dims.y - 1));
+    const float8 hi_z = off.z + fmin(convert_float8((bz + r + 1) << CLVR_BRICK_SHIFT), (float)(dims.z - 1));
+    const float fs = (float)step;
+    const float8 tx = (select(lo_x, hi_x, isgreater(fs * gd_x, 0.0f)) - go_x) * (1.0f / gd_x);
+    const float8 ty = (select(lo_y, hi_y, isgreater(fs * gd_y, 0.0f)) - go_y) * (1.0f / gd_y);
+    const float8 tz = (select(lo_z, hi_z, isgreater(fs * gd_z, 0.0f)) - go_z) * (1.0f / gd_z);
+    const float none = step > 0 ? INFINITY : -INFINITY;
+    const float8 ex = select(tx, (float8)(none), gd_x == 0.0f), ey = select(ty, (float8)(none), gd_y == 0.0f);
+    const float8 ez = select(tz, (float8)(none), gd_z == 0.0f);
+    const float8 zexit = step > 0 ? fmin(ex, fmin(ey, ez)) : fmax(ex, fmax(ey, ez));
+    const float8 kf = (zexit - depth0) / delta_s;
+    const float8 fk = (float8)((float)k), fe = convert_float8(k_end);
+    const int8 c1 = step > 0 ? convert_int8(clamp(floor(kf), fk, fe)) : convert_int8(clamp(ceil(kf), fe, fk));
+    const int8 c2 = c1 - step;
+    const int8 ok1 = (c1 != k) & clvr_in_cube8(go_x, go_y, go_z, gd_x, gd_y, gd_z, depth0, delta_s, c1, grid, bx, by, bz, r);
+    const int8 ok2 = (c1 != k) & (c2 != k) &
+                     clvr_in_cube8(go_x, go_y, go_z, gd_x, gd_y, gd_z, depth0, delta_s, c2, grid, bx, by, bz, r);
+    return select(select((int8)(k), c2, ok2), c1, ok1);
+}
+
+/* clvr_box_chord lane by lane (the same divisions and min/max per axis; an axis the ray runs parallel to
+ * empties the chord where the ray lies outside [lo, hi) on it). */
+void clvr_chord_axis8(const float8 g0, const float8 gs, const float l, const float h, float8* z0, float8* z1)
+{
+    const float8 t0 = (l - g0) / gs, t1 = (h - g0) / gs;
+    const int8 flat = gs == 0.0f;
+    *z0 = select(fmax(*z0, fmin(t0, t1)), *z0, flat);
+    *z1 = select(fmin(*z1, fmax(t0, t1)), select(*z1, (float8)(-INFINITY), isless(g0, l) | isgreaterequal(g0, h)), flat);
+}
+
+void clvr_box_chord8(const float8 go_x, const float8 go_y, const float8 go_z, const float8 gd_x, const float8 gd_y,
+                        const float8 gd_z, const float3 lo, const float3 hi, float8* zin, float8* zout)
+{
+    float8 z0 = -INFINITY, z1 = INFINITY;
+    clvr_chord_axis8(go_x, gd_x, lo.x, hi.x, &z0, &z1);
+    clvr_chord_axis8(go_y, gd_y, lo.y, hi.y, &z0, &z1);
+    clvr_chord_axis8(go_z, gd_z, lo.z, hi.z, &z0, &z1);
+    *zin = z0;
+    *zout = z1;
+}
+
+/* clvr_slice_range lane by lane. */
+void clvr_slice_range8(const float8 zin, const float8 zout, const float depth0, const float delta_s, const int count,
+                          int8* k_lo, int8* k_hi)
+{
+    const float n = (float)count;
+    const int8 chord = islessequal(zin, zout);
+    *k_lo = select((int8)(0), convert_int8(clamp(ceil((zin - depth0) / delta_s) - 1.0f, 0.0f, n)), chord);
+    *k_hi = select((int8)(-1), convert_int8(clamp(floor((zout - depth0) / delta_s) + 1.0f, -1.0f, n - 1.0f)), chord);
+}
+
+/* clvr_grid_owned of each lane's slice-k point (clvr_slice_point's expression). */
+int8 clvr_grid_owned8(const float8 go_x, const float8 go_y, const float8 go_z, const float8 gd_x, const float8 gd_y,
+                    const float8 gd_z, const float depth0, const float delta_s, const int8 k, const float3 lo,
+                    const float3 hi)
+{
+    const float8 z = depth0 + convert_float8(k) * delta_s;
+    const float8 gx = go_x + z * gd_x, gy = go_y + z * gd_y, gz = go_z + z * gd_z;
+    return isgreaterequal(gx, lo.x) & isgreaterequal(gy, lo.y) & isgreaterequal(gz, lo.z) & isless(gx, hi.x) &
+           isless(gy, hi.y) & isless(gz, hi.z);
+}
+
+/* clvr_trilinear (kernels/volume_sampling.h) lane by lane at grid coordinates (gx, gy, gz), which the caller
+ * has checked in every lane (or set to 0 where the lane does not sample): the 4 pairs of loads per lane, the
+ * interpolation as vectors. */
+float8 clvr_trilinear8(global const float* v, const int4 dims, const float8 gx, const float8 gy, const float8 gz)
+{
+    const int8 i = min(convert_int8(gx), dims.x - 2), j = min(convert_int8(gy), dims.y - 2);
+    const int8 k = min(convert_int8(gz), dims.z - 2);
+    const float8 fx = gx - convert_float8(i), fy = gy - convert_float8(j), fz = gz - convert_float8(k);
+    const uint nx = (uint)dims.x, nxy = nx * (uint)dims.y;
+    const uint8 idx = convert_uint8(k) * nxy + convert_uint8(j) * nx + convert_uint8(i);
+    float8 a00x, a00y, a10x, a10y, a01x, a01y, a11x, a11y;
+#define CLVR_GATHER(L)                                                                                    \
+    {                                                                                                     \
+        global const float* q = v + idx.s##L;                                                             \
+        const float2 v00 = vload2(0, q), v10 = vload2(0, q + nx), v01 = vload2(0, q + nxy);               \
+        const float2 v11 = vload2(0, q + nxy + nx);                                                       \
+        a00x.s##L = v00.x, a00y.s##L = v00.y, a10x.s##L = v10.x, a10y.s##L = v10.y;                       \
+        a01x.s##L = v01.x, a01y.s##L = v01.y, a11x.s##L = v11.x, a11y.s##L = v11.y;                       \
+    }
+    CLVR_EACH_LANE(CLVR_GATHER)
+#undef CLVR_GATHER
+    const float8 c00 = a00x + fx * (a00y - a00x);
+    const float8 c10 = a10x + fx * (a10y - a10x);
+    const float8 c01 = a01x + fx * (a01y - a01x);
+    const float8 c11 = a11x + fx * (a11y - a11x);
+    const float8 c0 = c00 + fy * (c10 - c00);
+    const float8 c1 = c01 + fy * (c11 - c01);
+    return c0 + fz * (c1 - c0);
+}
+
+/* The smallest (largest) of 8 lanes. */
+int clvr_min8(const int8 v)
+{
+    const int4 a = min(v.lo, v.hi);
+    const int2 b = min(a.lo, a.hi);
+    return min(b.x, b.y);
+}
+
+int clvr_max8(const int8 v)
+{
+    const int4 a = max(v.lo, v.hi);
+    const int2 b = max(a.lo, a.hi);
+    return max(b.x, b.y);
+}
+
+#endif
