@@ -148,6 +148,21 @@ int8 clvr_grid_owned8(const float8 go_x, const float8 go_y, const float8 go_z, c
            isless(gy, hi.y) & isless(gz, hi.z);
 }
 
+/* clvr_trilinear's interpolation lane by lane: the four (i, i + 1) pairs of the cell's corners along x (rows j,
+ * j + 1 of slices k, k + 1) and the fractions. */
+float8 clvr_trilinear8_mix(const float8 a00x, const float8 a00y, const float8 a10x, const float8 a10y, const float8 a01x,
+                           const float8 a01y, const float8 a11x, const float8 a11y, const float8 fx, const float8 fy,
+                           const float8 fz)
+{
+    const float8 c00 = a00x + fx * (a00y - a00x);
+    const float8 c10 = a10x + fx * (a10y - a10x);
+    const float8 c01 = a01x + fx * (a01y - a01x);
+    const float8 c11 = a11x + fx * (a11y - a11x);
+    const float8 c0 = c00 + fy * (c10 - c00);
+    const float8 c1 = c01 + fy * (c11 - c01);
+    return c0 + fz * (c1 - c0);
+}
+
 /* clvr_trilinear (kernels/volume_sampling.h) lane by lane at grid coordinates (gx, gy, gz), which the caller
  * has checked in every lane (or set to 0 where the lane does not sample): the 4 pairs of loads per lane, the
  * interpolation as vectors. */
@@ -169,13 +184,7 @@ float8 clvr_trilinear8(global const float* v, const int4 dims, const float8 gx, 
     }
     CLVR_EACH_LANE(CLVR_GATHER)
 #undef CLVR_GATHER
-    const float8 c00 = a00x + fx * (a00y - a00x);
-    const float8 c10 = a10x + fx * (a10y - a10x);
-    const float8 c01 = a01x + fx * (a01y - a01x);
-    const float8 c11 = a11x + fx * (a11y - a11x);
-    const float8 c0 = c00 + fy * (c10 - c00);
-    const float8 c1 = c01 + fy * (c11 - c01);
-    return c0 + fz * (c1 - c0);
+    return clvr_trilinear8_mix(a00x, a00y, a10x, a10y, a01x, a01y, a11x, a11y, fx, fy, fz);
 }
 
 /* The smallest (largest) of 8 lanes. */

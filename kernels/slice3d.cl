@@ -541,13 +541,7 @@ kernel void slice3d_fused_packet(global float4* out, global uint* samples, globa
         SLICE3D_SPLIT(p11, a11x, a11y);
 #undef SLICE3D_PAIR
 #undef SLICE3D_SPLIT
-        const float8 c00 = a00x + fx * (a00y - a00x);
-        const float8 c10 = a10x + fx * (a10y - a10x);
-        const float8 c01 = a01x + fx * (a01y - a01x);
-        const float8 c11 = a11x + fx * (a11y - a11x);
-        const float8 c0 = c00 + fy * (c10 - c00);
-        const float8 c1 = c01 + fy * (c11 - c01);
-        const float8 value = c0 + fz * (c1 - c0);
+        const float8 value = clvr_trilinear8_mix(a00x, a00y, a10x, a10y, a01x, a01y, a11x, a11y, fx, fy, fz);
 #else
         const float8 value = clvr_trilinear8(volume, dims, lx, ly, lz);
 #endif

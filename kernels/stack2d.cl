@@ -239,6 +239,17 @@ kernel void stack2d_iso_finish(global float4* color, global const uchar* stencil
  * planes in bricks of the stack grid where nothing can show (kernels/empty_space.h; tau is 0, or all values
  * lie below the iso-value) are stepped over: the pixel is the same bit for bit. samples[pixel]: planes
  * met inside the box (taken or stepped over), skipped[pixel]: those stepped over. */
+/* The stack grid of dims points as the fused path samples it: the box in (b, c) as the quads cover it; along
+ * the axis every plane is inside by construction (the last one's j plane_step may round a hair above n - 1,
+ * which the trilinear clamp absorbs). */
+ClvrOwnedGrid stack2d_grid(const int4 dims)
+{
+    const ClvrOwnedGrid grid = {dims, (int4)(0), (float3)(0.0f, 0.0f, -INFINITY),
+                                (float3)(nextafter((float)(dims.x - 1), INFINITY), nextafter((float)(dims.y - 1), INFINITY),
+                                         INFINITY)};
+    return grid;
+}
+
 void stack2d_fused_pixel(const int x, const int y, global float4* out, global uint* samples, global uint* skipped,
                          global const float* stack, global const float* tf, global const float4* map,
                          global const uchar* space,
@@ -268,12 +279,8 @@ void stack2d_fused_pixel(const int x, const int y, global float4* out, global ui
         const float3 q1o = (float3)(qo.x - qo.z * q1d.x, qo.y - qo.z * q1d.y, 0.0f);
         const float step = p.plane_step;
         const int4 dims = p.dims;
-        /* The box in (b, c) as the quads cover it; along the axis every plane is inside by construction (the
-         * last one's j plane_step may round a hair above n - 1, which the trilinear clamp absorbs). */
-        const float3 own_lo = (float3)(0.0f, 0.0f, -INFINITY);
-        const float3 own_hi = (float3)(nextafter((float)(dims.x - 1), INFINITY), nextafter((float)(dims.y - 1), INFINITY),
-                                       INFINITY);
-        const ClvrOwnedGrid grid = {dims, (int4)(0), own_lo, own_hi};
+        const ClvrOwnedGrid grid = stack2d_grid(dims);
+        const float3 own_lo = grid.own_lo, own_hi = grid.own_hi;
         float uin, uout;
         clvr_box_chord(q1o, q1d, (float3)(0.0f), (float3)(own_hi.xy, (float)(dims.z - 1)), &uin, &uout);
         int j_lo, j_hi;
@@ -373,10 +380,8 @@ kernel void stack2d_fused_packet(global float4* out, global uint* samples, globa
         return;
     const float step = p.plane_step;
     const int4 dims = p.dims;
-    const float3 own_lo = (float3)(0.0f, 0.0f, -INFINITY);
-    const float3 own_hi = (float3)(nextafter((float)(dims.x - 1), INFINITY), nextafter((float)(dims.y - 1), INFINITY),
-                                   INFINITY);
-    const ClvrOwnedGrid grid = {dims, (int4)(0), own_lo, own_hi};
+    const ClvrOwnedGrid grid = stack2d_grid(dims);
+    const float3 own_lo = grid.own_lo, own_hi = grid.own_hi;
     const float4 r0 = p.to_stack[0], r1 = p.to_stack[1], r2 = p.to_stack[2];
     float q1ox[8], q1oy[8], q1dx[8], q1dy[8], qoz[8], nfl[8];
     int jlo[8], jhi[8];

@@ -325,6 +325,28 @@ TEST(Slice3dRenderer, NativeIntegerVoxelsGiveTheFloat32ImageBitForBit)
     }
 }
 
+
+// The empty-space tests' scenes: the sphere field (0 outside the unit sphere) and its transfer function with
+// tau 0 below 0.3, Marschner-Lobb's with tau 0 below 0.45, and a perspective camera on the z axis whose center
+// ray runs along grid lines (zero direction components, samples on brick faces).
+const Volume& sphereField()
+{
+    static const Volume v = generateVolume("sphere", {48, 40, 56});
+    return v;
+}
+const TransferFunction kSphereTf({{0.0, {0, 0, 0}, 0.0}, {0.3, {0.2, 0.4, 1}, 0.0}, {0.6, {1, 0.5, 0}, 6.0},
+                                  {1.0, {1, 1, 1}, 12.0}});
+const TransferFunction kMlThreshold({{0.0, {0, 0, 0}, 0.0}, {0.45, {0.3, 0.3, 1}, 0.0}, {1.0, {1, 1, 0.5}, 9.0}});
+Camera onAxisCamera()
+{
+    Camera c;
+    c.position = {0.0, 0.0, 3.0};
+    c.focalPoint = {0.0, 0.0, 0.0};
+    c.viewUp = {0.0, 1.0, 0.0};
+    c.viewAngle = 30.0;
+    return c;
+}
+
 // Skipped samples would have contributed alpha = 1 - exp2(0) = 0 exactly, so the image with
 // skipping must be bit-identical to the one without (memcmp), and the count of samples inside the
 // box the same. Scenes with large zero-tau regions: the sphere field (0 outside the unit sphere) with
@@ -334,15 +356,10 @@ TEST(Slice3dRenderer, NativeIntegerVoxelsGiveTheFloat32ImageBitForBit)
 // components, samples on brick faces).
 TEST(Slice3dEmptySpace, SkippingIsBitIdenticalToTheFullLoop)
 {
-    static const Volume sphere = generateVolume("sphere", {48, 40, 56});
-    const TransferFunction sphereTf({{0.0, {0, 0, 0}, 0.0}, {0.3, {0.2, 0.4, 1}, 0.0}, {0.6, {1, 0.5, 0}, 6.0},
-                                     {1.0, {1, 1, 1}, 12.0}});
-    const TransferFunction mlThreshold({{0.0, {0, 0, 0}, 0.0}, {0.45, {0.3, 0.3, 1}, 0.0}, {1.0, {1, 1, 0.5}, 9.0}});
-    Camera onAxis;
-    onAxis.position = {0.0, 0.0, 3.0};
-    onAxis.focalPoint = {0.0, 0.0, 0.0};
-    onAxis.viewUp = {0.0, 1.0, 0.0};
-    onAxis.viewAngle = 30.0;
+    const Volume& sphere = sphereField();
+    const TransferFunction& sphereTf = kSphereTf;
+    const TransferFunction& mlThreshold = kMlThreshold;
+    const Camera onAxis = onAxisCamera();
     struct Case {
         const char* name;
         const Volume* volume;
@@ -406,10 +423,9 @@ TEST(Slice3dEmptySpace, SkippingIsBitIdenticalToTheFullLoop)
 // narrower than one packet), and a sort-last part (its owned box and offset).
 TEST(Slice3dPackets, BitIdenticalToOnePixelPerWorkItem)
 {
-    static const Volume sphere = generateVolume("sphere", {48, 40, 56});
-    const TransferFunction sphereTf({{0.0, {0, 0, 0}, 0.0}, {0.3, {0.2, 0.4, 1}, 0.0}, {0.6, {1, 0.5, 0}, 6.0},
-                                     {1.0, {1, 1, 1}, 12.0}});
-    const TransferFunction mlThreshold({{0.0, {0, 0, 0}, 0.0}, {0.45, {0.3, 0.3, 1}, 0.0}, {1.0, {1, 1, 0.5}, 9.0}});
+    const Volume& sphere = sphereField();
+    const TransferFunction& sphereTf = kSphereTf;
+    const TransferFunction& mlThreshold = kMlThreshold;
     // Integer volumes (uint8 and uint16 on the device): Marschner-Lobb scaled to 0..255 and 0..4095 and rounded.
     const auto scaled = [](double top) {
         Volume v = marschnerLobb41();
@@ -438,11 +454,7 @@ TEST(Slice3dPackets, BitIdenticalToOnePixelPerWorkItem)
         const Volume& v = marschnerLobb41();
         return cutGridPart(v, partitionGrid(v.dims, v.origin, v.spacing, 3), 1);
     }();
-    Camera onAxis;
-    onAxis.position = {0.0, 0.0, 3.0};
-    onAxis.focalPoint = {0.0, 0.0, 0.0};
-    onAxis.viewUp = {0.0, 1.0, 0.0};
-    onAxis.viewAngle = 30.0;
+    const Camera onAxis = onAxisCamera();
     struct Case {
         const char* name;
         const Volume* volume;
@@ -518,7 +530,7 @@ TEST(Slice3dPackets, ClippedImagesAreBitIdenticalPreintegratedKeepsOnePixel)
 {
     const json sphereTexture = {{"shape", "sphere"}, {"center", {0.1, -0.05, 0.0}}, {"radius", 0.7}};
     const json sphereMesh = {{"generator", "sphere"}, {"center", {0.1, 0.0, 0.2}}, {"radius", 0.6}, {"segments", 32}};
-    const TransferFunction mlThreshold({{0.0, {0, 0, 0}, 0.0}, {0.45, {0.3, 0.3, 1}, 0.0}, {1.0, {1, 1, 0.5}, 9.0}});
+    const TransferFunction& mlThreshold = kMlThreshold;
     const json clips[] = {{{"clip_texture", sphereTexture}},
                           {{"clip_texture", {{"shape", "sphere"}, {"radius", 0.6}, {"inverse", true}}}},
                           {{"clip", {{"mesh", sphereMesh}}}},
