@@ -291,6 +291,36 @@ TEST(Slice3dEmptySpace, RadiiAreChebyshevDistancesToTheNearestNonEmptyBrick)
                 EXPECT_EQ(space[(z * n.y + y) * n.x + x], d) << x << " " << y << " " << z;  // r + 1 = d
             }
     EXPECT_EQ(emptySpaceRadii({2, 1, 1}, {1, 1}), (std::vector<cl_uchar>{255, 255}));  // all empty: capped
+    // Random grids (a few non-empty bricks among many empty ones, odd sizes) against the brute-force distance to
+    // the nearest non-empty brick, capped at 255; and a line longer than the cap with one non-empty brick at
+    // its end (300 bricks: the far ones stay at 255).
+    std::srand(7);
+    for (const glm::ivec3 m : {glm::ivec3(13, 9, 6), glm::ivec3(1, 17, 4), glm::ivec3(21, 1, 1)}) {
+        std::vector<cl_uchar> flags(static_cast<std::size_t>(m.x) * m.y * m.z);
+        std::vector<glm::ivec3> filled;
+        for (int z = 0; z < m.z; ++z)
+            for (int y = 0; y < m.y; ++y)
+                for (int x = 0; x < m.x; ++x) {
+                    const bool isEmpty = std::rand() % 23 != 0;
+                    flags[(static_cast<std::size_t>(z) * m.y + y) * m.x + x] = isEmpty ? 1 : 0;
+                    if (!isEmpty)
+                        filled.emplace_back(x, y, z);
+                }
+        const std::vector<cl_uchar> r = emptySpaceRadii(m, flags);
+        for (int z = 0; z < m.z; ++z)
+            for (int y = 0; y < m.y; ++y)
+                for (int x = 0; x < m.x; ++x) {
+                    int want = 255;
+                    for (const glm::ivec3& f : filled)
+                        want = std::min(want, std::max({std::abs(x - f.x), std::abs(y - f.y), std::abs(z - f.z)}));
+                    ASSERT_EQ(r[(static_cast<std::size_t>(z) * m.y + y) * m.x + x], want) << x << " " << y << " " << z;
+                }
+    }
+    std::vector<cl_uchar> longLine(300, 1);
+    longLine[299] = 0;
+    const std::vector<cl_uchar> r = emptySpaceRadii({300, 1, 1}, longLine);
+    for (int x = 0; x < 300; ++x)
+        ASSERT_EQ(r[x], std::min(299 - x, 255)) << x;
 }
 
 // Integer volumes go to the device as uint8 (values in [0, 255]) or uint16 (in [0, 65535]); the
