@@ -323,7 +323,9 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
  * so its pixel is the same bits: a lane whose sample is not owned, or whose ray has stopped, is masked; a
  * lane in an empty brick while another lane samples takes its sample, whose tau is 0 (empty bricks are
  * decided with a margin for float rounding), which changes nothing; the packet steps over slices only
- * when every active lane is in an empty brick, as far as the nearest of their runs' ends. */
+ * when every active lane is in an empty brick, as far as the nearest of their runs' ends. With a clip
+ * texture or mesh each lane's clip test runs slice3d_fused's code for that lane. The vector functions are
+ * kernels/packet.h's. */
 kernel void slice3d_fused_packet(global float4* out, global uint* samples, global uint* skipped,
                                  global const SLICE3D_VOXEL* volume, global const float* tf,
                                  global const uchar* space,
