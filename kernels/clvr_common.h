@@ -10,22 +10,23 @@
 
 /* 2^x for x <= 0, the attenuation of every sample and segment (alpha = 1 - 2^(-tau l log2 e)): Cephes'
  * exp2f — x = n + f with n = rint(x), f in [-1/2, 1/2], 2^f by its degree-6 polynomial, 2^n put into
- * the exponent bits. Relative error 7.9e-8 measured on [-126, 0] (Cephes states 1.7e-7;
+ * the exponent bits (CLVR_EXP2_POLYNOMIAL, also kernels/packet.h's clvr_exp2_8). Relative error 7.9e-8 measured on [-126, 0] (Cephes states 1.7e-7;
  * tests/device_test.cpp asserts < 3e-7 against the host's exp2). Below -126 it returns 0 (2^x < 1.2e-38
  * there; NaN also gives 0). PoCL's exp2 and exp took 13-40 % of slice3d's per-sample and harc's
  * per-piece time on this CPU; with this, slice3d frames are about 11 % and harc's 18 % shorter. */
+#define CLVR_EXP2_POLYNOMIAL(f)                                                                             \
+    (1.0f + (f) * (6.931472028550421e-1f +                                                                  \
+                   (f) * (2.402264791363012e-1f +                                                           \
+                          (f) * (5.550332471162809e-2f +                                                    \
+                                 (f) * (9.618437357674640e-3f +                                             \
+                                        (f) * (1.339887440266574e-3f + (f) * 1.535336188319500e-4f))))))
 float clvr_exp2(const float x)
 {
     if (!(x >= -126.0f))
         return 0.0f;
     const float n = rint(x);
     const float f = x - n;
-    const float p = 1.0f + f * (6.931472028550421e-1f +
-                                f * (2.402264791363012e-1f +
-                                     f * (5.550332471162809e-2f +
-                                          f * (9.618437357674640e-3f +
-                                               f * (1.339887440266574e-3f + f * 1.535336188319500e-4f)))));
-    return p * as_float(((int)n + 127) << 23);
+    return CLVR_EXP2_POLYNOMIAL(f) * as_float(((int)n + 127) << 23);
 }
 
 /* atan2(y, x) in (-pi, pi], the angle of (x, y): a = min(|x|, |y|) / max(|x|, |y|) in [0, 1], atan(a) =

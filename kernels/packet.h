@@ -9,27 +9,74 @@
 
 #include "empty_space.h"
 
-#define CLVR_LANES 8
+#include "clvr_common.h"
+
+#define CLVR_LANES 8  /* host: kPacketLanes (host/render/grid/slice3d.h) */
 #define CLVR_EACH_LANE(M) M(0) M(1) M(2) M(3) M(4) M(5) M(6) M(7)
+#define CLVR_LANE_INDEX ((int8)(0, 1, 2, 3, 4, 5, 6, 7))
+
+/* The smallest (largest) of 8 lanes. */
+int clvr_min8(const int8 v)
+{
+    const int4 a = min(v.lo, v.hi);
+    const int2 b = min(a.lo, a.hi);
+    return min(b.x, b.y);
+}
+
+int clvr_max8(const int8 v)
+{
+    const int4 a = max(v.lo, v.hi);
+    const int2 b = max(a.lo, a.hi);
+    return max(b.x, b.y);
+}
+
+/* clvr_grid_owned lane by lane: 1 where (gx, gy, gz) lies in the half-open box [lo, hi). */
+int8 clvr_in_box8(const float8 gx, const float8 gy, const float8 gz, const float3 lo, const float3 hi)
+{
+    return isgreaterequal(gx, lo.x) & isgreaterequal(gy, lo.y) & isgreaterequal(gz, lo.z) & isless(gx, hi.x) &
+           isless(gy, hi.y) & isless(gz, hi.z);
+}
+
+/* clvr_space lane by lane: the empty-space byte of brick (bx, by, bz) of each lane. */
+int8 clvr_space8(global const uchar* space, const int4 bdims, const int8 bx, const int8 by, const int8 bz)
+{
+    const uint8 i = (convert_uint8(bz) * (uint)bdims.y + convert_uint8(by)) * (uint)bdims.x + convert_uint8(bx);
+    int8 s;
+#define CLVR_SPACE(L) s.s##L = space[i.s##L];
+    CLVR_EACH_LANE(CLVR_SPACE)
+#undef CLVR_SPACE
+    return s;
+}
+
+/* Where a packet goes on from slice k (walking by step = +1 or -1 over k_begin .. k_end, the union of its lanes'
+ * ranges [lo, hi]) when every lane that samples at k (act) is in an empty brick, run_end being each such lane's
+ * last slice in its empty cube (clvr_empty_run8): the nearest of those ends, but no further than any other live
+ * lane's next slice — before its range the slice before its first, inside its range (outside its box there) k
+ * itself. The caller goes on at the result + step. */
+int clvr_packet_jump(const int8 run_end, const int8 act, const int8 live, const int k, const int step, const int8 lo,
+                     const int8 hi, const int k_begin, const int k_end)
+{
+    int8 bound;
+    if (step > 0)
+        bound = select(select(select((int8)(k_end), (int8)(k), k <= hi), lo - 1, k < lo), run_end, act);
+    else
+        bound = select(select(select((int8)(k_begin), (int8)(k), k >= lo), hi + 1, k > hi), run_end, act);
+    bound = select((int8)(step > 0 ? k_end : k_begin), bound, live);
+    return step > 0 ? clvr_min8(bound) : clvr_max8(bound);
+}
 
 /* clvr_exp2 (kernels/clvr_common.h) lane by lane, the same operations. */
 float8 clvr_exp2_8(const float8 x)
 {
     const float8 n = rint(x);
     const float8 f = x - n;
-    const float8 p = 1.0f + f * (6.931472028550421e-1f +
-                                 f * (2.402264791363012e-1f +
-                                      f * (5.550332471162809e-2f +
-                                           f * (9.618437357674640e-3f +
-                                                f * (1.339887440266574e-3f + f * 1.535336188319500e-4f)))));
-    const float8 r = p * as_float8((convert_int8(n) + 127) << 23);
+    const float8 r = CLVR_EXP2_POLYNOMIAL(f) * as_float8((convert_int8(n) + 127) << 23);
     return select((float8)(0.0f), r, isgreaterequal(x, -126.0f));
 }
 
 /* clvr_tf_eval (kernels/transfer_function.h) lane by lane: the same segment and expression per lane, found
  * by selects over the segments instead of a search. */
-void clvr_tf_eval8(global const float* tf, const int n, const float8 x, float8* r, float8* g, float8* b,
-                      float8* tau)
+void clvr_tf_eval8(global const float* tf, const int n, const float8 x, float8* r, float8* g, float8* b, float8* tau)
 {
     global const float* value = tf + ((n + 3) & ~3);
     global const float* slope = value + 4 * n;
@@ -57,14 +104,12 @@ void clvr_tf_eval8(global const float* tf, const int n, const float8 x, float8* 
  * (bx, by, bz) and every brick within Chebyshev distance r of it is empty; the last slice towards k_end still
  * in that cube of bricks (k where no candidate checks out; only the lanes that sample are meaningful). */
 int8 clvr_in_cube8(const float8 go_x, const float8 go_y, const float8 go_z, const float8 gd_x, const float8 gd_y,
-                      const float8 gd_z, const float depth0, const float delta_s, const int8 k, const ClvrOwnedGrid* grid,
-                      const int8 bx, const int8 by, const int8 bz, const int8 r)
+                   const float8 gd_z, const float depth0, const float delta_s, const int8 k, const ClvrOwnedGrid* grid,
+                   const int8 bx, const int8 by, const int8 bz, const int8 r)
 {
     const float8 z = depth0 + convert_float8(k) * delta_s;
     const float8 gx = go_x + z * gd_x, gy = go_y + z * gd_y, gz = go_z + z * gd_z;
-    const int8 in = isgreaterequal(gx, grid->own_lo.x) & isgreaterequal(gy, grid->own_lo.y) &
-                    isgreaterequal(gz, grid->own_lo.z) & isless(gx, grid->own_hi.x) & isless(gy, grid->own_hi.y) &
-                    isless(gz, grid->own_hi.z);
+    const int8 in = clvr_in_box8(gx, gy, gz, grid->own_lo, grid->own_hi);
     const float3 off = convert_float3(grid->offset.xyz);
     /* outside lanes read as 0: their answer is 0 anyway */
     const int8 cx = min(convert_int8(select((float8)(0.0f), gx - off.x, in)), grid->dims.x - 2) >> CLVR_BRICK_SHIFT;
@@ -75,9 +120,9 @@ int8 clvr_in_cube8(const float8 go_x, const float8 go_y, const float8 go_z, cons
 }
 
 int8 clvr_empty_run8(const float8 go_x, const float8 go_y, const float8 go_z, const float8 gd_x, const float8 gd_y,
-                        const float8 gd_z, const float depth0, const float delta_s, const int k, const int step,
-                        const int8 k_end, const ClvrOwnedGrid* grid, const int8 bx, const int8 by, const int8 bz,
-                        const int8 r)
+                     const float8 gd_z, const float depth0, const float delta_s, const int k, const int step,
+                     const int8 k_end, const ClvrOwnedGrid* grid, const int8 bx, const int8 by, const int8 bz,
+                     const int8 r)
 {
     const float3 off = convert_float3(grid->offset.xyz);
     const int4 dims = grid->dims;
@@ -107,9 +152,13 @@ int8 clvr_empty_run8(const float8 go_x, const float8 go_y, const float8 go_z, co
 }
 
 /* clvr_box_chord lane by lane (the same divisions and min/max per axis; an axis the ray runs parallel to
- * empties the chord where the ray lies outside [lo, hi) on it). */
+ * empties the chord where the ray lies outside [lo, hi) on it, an empty box, l >= h, every chord). */
 void clvr_chord_axis8(const float8 g0, const float8 gs, const float l, const float h, float8* z0, float8* z1)
 {
+    if (!(l < h)) {
+        *z1 = -INFINITY;
+        return;
+    }
     const float8 t0 = (l - g0) / gs, t1 = (h - g0) / gs;
     const int8 flat = gs == 0.0f;
     *z0 = select(fmax(*z0, fmin(t0, t1)), *z0, flat);
@@ -117,7 +166,7 @@ void clvr_chord_axis8(const float8 g0, const float8 gs, const float l, const flo
 }
 
 void clvr_box_chord8(const float8 go_x, const float8 go_y, const float8 go_z, const float8 gd_x, const float8 gd_y,
-                        const float8 gd_z, const float3 lo, const float3 hi, float8* zin, float8* zout)
+                     const float8 gd_z, const float3 lo, const float3 hi, float8* zin, float8* zout)
 {
     float8 z0 = -INFINITY, z1 = INFINITY;
     clvr_chord_axis8(go_x, gd_x, lo.x, hi.x, &z0, &z1);
@@ -129,7 +178,7 @@ void clvr_box_chord8(const float8 go_x, const float8 go_y, const float8 go_z, co
 
 /* clvr_slice_range lane by lane. */
 void clvr_slice_range8(const float8 zin, const float8 zout, const float depth0, const float delta_s, const int count,
-                          int8* k_lo, int8* k_hi)
+                       int8* k_lo, int8* k_hi)
 {
     const float n = (float)count;
     const int8 chord = islessequal(zin, zout);
@@ -139,13 +188,11 @@ void clvr_slice_range8(const float8 zin, const float8 zout, const float depth0, 
 
 /* clvr_grid_owned of each lane's slice-k point (clvr_slice_point's expression). */
 int8 clvr_grid_owned8(const float8 go_x, const float8 go_y, const float8 go_z, const float8 gd_x, const float8 gd_y,
-                    const float8 gd_z, const float depth0, const float delta_s, const int8 k, const float3 lo,
-                    const float3 hi)
+                      const float8 gd_z, const float depth0, const float delta_s, const int8 k, const float3 lo,
+                      const float3 hi)
 {
     const float8 z = depth0 + convert_float8(k) * delta_s;
-    const float8 gx = go_x + z * gd_x, gy = go_y + z * gd_y, gz = go_z + z * gd_z;
-    return isgreaterequal(gx, lo.x) & isgreaterequal(gy, lo.y) & isgreaterequal(gz, lo.z) & isless(gx, hi.x) &
-           isless(gy, hi.y) & isless(gz, hi.z);
+    return clvr_in_box8(go_x + z * gd_x, go_y + z * gd_y, go_z + z * gd_z, lo, hi);
 }
 
 /* clvr_trilinear's interpolation lane by lane: the four (i, i + 1) pairs of the cell's corners along x (rows j,
@@ -185,21 +232,6 @@ float8 clvr_trilinear8(global const float* v, const int4 dims, const float8 gx, 
     CLVR_EACH_LANE(CLVR_GATHER)
 #undef CLVR_GATHER
     return clvr_trilinear8_mix(a00x, a00y, a10x, a10y, a01x, a01y, a11x, a11y, fx, fy, fz);
-}
-
-/* The smallest (largest) of 8 lanes. */
-int clvr_min8(const int8 v)
-{
-    const int4 a = min(v.lo, v.hi);
-    const int2 b = min(a.lo, a.hi);
-    return min(b.x, b.y);
-}
-
-int clvr_max8(const int8 v)
-{
-    const int4 a = max(v.lo, v.hi);
-    const int2 b = max(a.lo, a.hi);
-    return max(b.x, b.y);
 }
 
 #endif

@@ -60,6 +60,27 @@ int slice3d_mesh_keep(global const float4* layers, const size_t stride, const in
     const int inside = mesh.z ? n <= last_back : (n < mesh.x && layers[(size_t)n * stride].y == 0.0f);
     return inside != mesh.y;
 }
+
+/* The deepest back face among a pixel's mesh layers (-1: none), for the naive rule. */
+int slice3d_mesh_last_back(global const float4* layers, const size_t stride, const int4 mesh)
+{
+    int last_back = -1;
+    for (int l = 0; l < mesh.x; ++l)
+        if (layers[(size_t)l * stride].y == 0.0f)
+            last_back = l;
+    return last_back;
+}
+#endif
+
+#ifdef SLICE3D_CLIP_TEXTURE
+/* Clip-texture coordinates are affine in the world position, so along the ray o + z d they are uo + z ud. */
+void slice3d_clip_ray(const ClSlice3dParams* p, const float3 o, const float3 d, float3* uo, float3* ud)
+{
+    const float4 clip_row0 = p->clip_row[0], clip_row1 = p->clip_row[1], clip_row2 = p->clip_row[2];
+    *uo = (float3)(dot(clip_row0.xyz, o) + clip_row0.w, dot(clip_row1.xyz, o) + clip_row1.w,
+                   dot(clip_row2.xyz, o) + clip_row2.w);
+    *ud = (float3)(dot(clip_row0.xyz, d), dot(clip_row1.xyz, d), dot(clip_row2.xyz, d));
+}
 #endif
 
 /* The volume's type on the device for the fused kernel: float by default; the host builds with
@@ -120,11 +141,8 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
     const float3 gd = d * p.inv_spacing.xyz;
     const float3 inv_gd = 1.0f / gd;  /* for empty-space runs only (inf where gd is 0, not used there) */
 #ifdef SLICE3D_CLIP_TEXTURE
-    /* Clip-texture coordinates are affine in the world position, so along the ray u = uo + z ud. */
-    const float4 clip_row0 = p.clip_row[0], clip_row1 = p.clip_row[1], clip_row2 = p.clip_row[2];
-    const float3 uo = (float3)(dot(clip_row0.xyz, o) + clip_row0.w, dot(clip_row1.xyz, o) + clip_row1.w,
-                               dot(clip_row2.xyz, o) + clip_row2.w);
-    const float3 ud = (float3)(dot(clip_row0.xyz, d), dot(clip_row1.xyz, d), dot(clip_row2.xyz, d));
+    float3 uo, ud;
+    slice3d_clip_ray(&p, o, d, &uo, &ud);
 #endif
 #ifdef SLICE3D_CLIP_MESH
     /* This pixel's mesh layers (one per image-sized layer), the deepest back face among them (naive), and the
@@ -132,10 +150,7 @@ kernel void slice3d_fused(global float4* out, global uint* samples, global uint*
     const int4 mesh = p.clip_mesh;
     const size_t mesh_stride = (size_t)p.width * (size_t)p.height;
     global const float4* layers = clip_layers + ((size_t)y * p.width + x);
-    int last_back = -1;
-    for (int l = 0; l < mesh.x; ++l)
-        if (layers[(size_t)l * mesh_stride].y == 0.0f)
-            last_back = l;
+    const int last_back = slice3d_mesh_last_back(layers, mesh_stride, mesh);
     int mesh_next = 0;
 #endif
 
@@ -352,7 +367,7 @@ kernel void slice3d_fused_packet(global float4* out, global uint* samples, globa
     const float2 size = (float2)((float)p.width, (float)p.height);
     const ClCamera cam = p.camera;
     const float sy = clvr_ray_window_offset(clvr_ray_pixel_centre(x0, y), size, cam).y;
-    const float8 wx = convert_float8(x0 + (int8)(0, 1, 2, 3, 4, 5, 6, 7)) + 0.5f;
+    const float8 wx = convert_float8(x0 + CLVR_LANE_INDEX) + 0.5f;
     const float8 sx = (wx / size.x * 2.0f - 1.0f) * cam.params.x * cam.params.y;
     /* s.y as a vector too: a product of two scalars would be rounded before the sum it is added to, where the
      * one-pixel kernel's float3 expressions fuse it (a * b + c as one rounding) */
@@ -383,11 +398,8 @@ kernel void slice3d_fused_packet(global float4* out, global uint* samples, globa
     /* clip-texture coordinates along each lane's ray, u = uo + z ud (slice3d_fused's expressions per lane) */
     float uox[8], uoy[8], uoz[8], udx[8], udy[8], udz[8];
     for (int l = 0; l < CLVR_LANES; ++l) {
-        const float3 o = (float3)(ox[l], oy[l], oz[l]), d = (float3)(dx[l], dy[l], dz[l]);
-        const float4 clip_row0 = p.clip_row[0], clip_row1 = p.clip_row[1], clip_row2 = p.clip_row[2];
-        const float3 uo = (float3)(dot(clip_row0.xyz, o) + clip_row0.w, dot(clip_row1.xyz, o) + clip_row1.w,
-                                   dot(clip_row2.xyz, o) + clip_row2.w);
-        const float3 ud = (float3)(dot(clip_row0.xyz, d), dot(clip_row1.xyz, d), dot(clip_row2.xyz, d));
+        float3 uo, ud;
+        slice3d_clip_ray(&p, (float3)(ox[l], oy[l], oz[l]), (float3)(dx[l], dy[l], dz[l]), &uo, &ud);
         uox[l] = uo.x, uoy[l] = uo.y, uoz[l] = uo.z, udx[l] = ud.x, udy[l] = ud.y, udz[l] = ud.z;
     }
     const float8 uo_x = vload8(0, uox), uo_y = vload8(0, uoy), uo_z = vload8(0, uoz);
@@ -399,11 +411,9 @@ kernel void slice3d_fused_packet(global float4* out, global uint* samples, globa
     const size_t mesh_stride = (size_t)p.width * (size_t)p.height;
     int last_back[8], mesh_next[8];
     for (int l = 0; l < CLVR_LANES; ++l) {
-        last_back[l] = -1, mesh_next[l] = 0;
-        global const float4* layers = clip_layers + ((size_t)y * p.width + min(x0 + l, p.width - 1));
-        for (int m = 0; m < mesh.x; ++m)
-            if (layers[(size_t)m * mesh_stride].y == 0.0f)
-                last_back[l] = m;
+        last_back[l] = slice3d_mesh_last_back(clip_layers + ((size_t)y * p.width + min(x0 + l, p.width - 1)),
+                                              mesh_stride, mesh);
+        mesh_next[l] = 0;
     }
 #endif
     const float8 go_x = (o_x - p.grid_origin.x) * p.inv_spacing.x, go_y = (o_y - p.grid_origin.y) * p.inv_spacing.y;
@@ -431,7 +441,7 @@ kernel void slice3d_fused_packet(global float4* out, global uint* samples, globa
         clvr_slice_range8(zin, zout, depth0, delta_s, p.slice_count, &lo8, &hi8);
     }
     /* lanes past the row's end: nothing to sample, nothing written */
-    const int8 in_row = x0 + (int8)(0, 1, 2, 3, 4, 5, 6, 7) < p.width;
+    const int8 in_row = x0 + CLVR_LANE_INDEX < p.width;
     lo8 = select((int8)(0), lo8, in_row), hi8 = select((int8)(-1), hi8, in_row);
     k_first = select((int8)(0), k_first, in_row), k_last = select((int8)(-1), k_last, in_row);
     const int8 ranged = lo8 <= hi8;
@@ -444,16 +454,14 @@ kernel void slice3d_fused_packet(global float4* out, global uint* samples, globa
 
     float8 cr = 0.0f, cg = 0.0f, cb = 0.0f;
     float8 transmittance = 1.0f, alpha_acc = 0.0f;
-    int8 live = lo8 <= hi8;           /* lanes with slices to sample and not stopped */
+    int8 live = ranged;               /* lanes with slices to sample and not stopped */
     int8 k_stop = k_last;             /* where early termination stopped each ray */
     int8 taken = 0;
     const int ftb = p.front_to_back, step = ftb ? 1 : -1;
     for (int k = ftb ? k_begin : k_end; ftb ? k <= k_end : k >= k_begin; k += step) {
         const float z = depth0 + (float)k * delta_s;
         const float8 gx = go_x + z * gd_x, gy = go_y + z * gd_y, gz = go_z + z * gd_z;
-        int8 act = live & (k >= lo8) & (k <= hi8) & isgreaterequal(gx, loop_lo.x) &
-                         isgreaterequal(gy, loop_lo.y) & isgreaterequal(gz, loop_lo.z) & isless(gx, loop_hi.x) &
-                         isless(gy, loop_hi.y) & isless(gz, loop_hi.z);
+        int8 act = live & (k >= lo8) & (k <= hi8) & clvr_in_box8(gx, gy, gz, loop_lo, loop_hi);
         if (!any(act))
             continue;
         /* the volume's own coordinates, 0 in the lanes that do not sample (their loads stay in the grid) */
@@ -464,25 +472,13 @@ kernel void slice3d_fused_packet(global float4* out, global uint* samples, globa
         const int8 iy = min(convert_int8(ly), dims.y - 2);
         const int8 iz = min(convert_int8(lz), dims.z - 2);
         if (skip) {
-            const uint8 bi = (convert_uint8(iz >> CLVR_BRICK_SHIFT) * (uint)bdims.y + convert_uint8(iy >> CLVR_BRICK_SHIFT)) *
-                                 (uint)bdims.x + convert_uint8(ix >> CLVR_BRICK_SHIFT);
-            int8 sp;
-#define SLICE3D_SPACE(L) sp.s##L = space[bi.s##L];
-            CLVR_EACH_LANE(SLICE3D_SPACE)
-#undef SLICE3D_SPACE
+            const int8 bx = ix >> CLVR_BRICK_SHIFT, by = iy >> CLVR_BRICK_SHIFT, bz = iz >> CLVR_BRICK_SHIFT;
+            const int8 sp = clvr_space8(space, bdims, bx, by, bz);
             if (!any(act & (sp == 0))) {
-                /* every sampling lane is in an empty brick: step to the nearest end of their runs, but no
-                 * further than any other live lane's next sample */
+                /* every sampling lane is in an empty brick: on from the nearest end of their runs */
                 const int8 run_end = clvr_empty_run8(go_x, go_y, go_z, gd_x, gd_y, gd_z, depth0, delta_s, k, step,
-                                                        ftb ? hi8 : lo8, &owned, ix >> CLVR_BRICK_SHIFT,
-                                                        iy >> CLVR_BRICK_SHIFT, iz >> CLVR_BRICK_SHIFT, sp - 1);
-                int8 bound;
-                if (ftb)
-                    bound = select(select(select((int8)(k_end), (int8)(k), k <= hi8), lo8 - 1, k < lo8), run_end, act);
-                else
-                    bound = select(select(select((int8)(k_begin), (int8)(k), k >= lo8), hi8 + 1, k > hi8), run_end, act);
-                bound = select((int8)(ftb ? k_end : k_begin), bound, live);
-                k = ftb ? clvr_min8(bound) : clvr_max8(bound);
+                                                     ftb ? hi8 : lo8, &owned, bx, by, bz, sp - 1);
+                k = clvr_packet_jump(run_end, act, live, k, step, lo8, hi8, k_begin, k_end);
                 continue;
             }
         }

@@ -381,7 +381,7 @@ kernel void stack2d_fused_packet(global float4* out, global uint* samples, globa
     const float step = p.plane_step;
     const int4 dims = p.dims;
     const ClvrOwnedGrid grid = stack2d_grid(dims);
-    const float3 own_lo = grid.own_lo, own_hi = grid.own_hi;
+    const float3 own_hi = grid.own_hi;
     const float4 r0 = p.to_stack[0], r1 = p.to_stack[1], r2 = p.to_stack[2];
     float q1ox[8], q1oy[8], q1dx[8], q1dy[8], qoz[8], nfl[8];
     int jlo[8], jhi[8];
@@ -428,8 +428,8 @@ kernel void stack2d_fused_packet(global float4* out, global uint* samples, globa
     for (int j = dir > 0 ? j_begin : j_end; dir > 0 ? j <= j_end : j >= j_begin; j += dir) {
         const float z = 0.0f + (float)j * step;  /* clvr_slice_point's depth of plane j */
         const float8 qx = q1o_x + z * q1d_x, qy = q1o_y + z * q1d_y, qz = q1o_z + z * q1d_z;
-        int8 act = live & (j >= lo8) & (j <= hi8) & isgreaterequal(qx, own_lo.x) & isgreaterequal(qy, own_lo.y) &
-                   isless(qx, own_hi.x) & isless(qy, own_hi.y) & isgreater((qz - qo_z) * (float)dir, 0.0f);
+        int8 act = live & (j >= lo8) & (j <= hi8) & clvr_in_box8(qx, qy, qz, grid.own_lo, grid.own_hi) &
+                   isgreater((qz - qo_z) * (float)dir, 0.0f);
         if (!any(act))
             continue;
         /* the stack's own coordinates, 0 in the lanes that do not sample */
@@ -439,21 +439,11 @@ kernel void stack2d_fused_packet(global float4* out, global uint* samples, globa
             const int8 bx = min(convert_int8(gx), dims.x - 2) >> CLVR_BRICK_SHIFT;
             const int8 by = min(convert_int8(gy), dims.y - 2) >> CLVR_BRICK_SHIFT;
             const int8 bz = min(convert_int8(gz), dims.z - 2) >> CLVR_BRICK_SHIFT;
-            const uint8 bi = (convert_uint8(bz) * (uint)p.bricks.y + convert_uint8(by)) * (uint)p.bricks.x + convert_uint8(bx);
-            int8 sp;
-#define STACK2D_SPACE(L) sp.s##L = space[bi.s##L];
-            CLVR_EACH_LANE(STACK2D_SPACE)
-#undef STACK2D_SPACE
+            const int8 sp = clvr_space8(space, p.bricks, bx, by, bz);
             if (!any(act & (sp == 0))) {
                 const int8 run_end = clvr_empty_run8(q1o_x, q1o_y, q1o_z, q1d_x, q1d_y, q1d_z, 0.0f, step, j, dir,
                                                      dir > 0 ? hi8 : lo8, &grid, bx, by, bz, sp - 1);
-                int8 bound;
-                if (dir > 0)
-                    bound = select(select(select((int8)(j_end), (int8)(j), j <= hi8), lo8 - 1, j < lo8), run_end, act);
-                else
-                    bound = select(select(select((int8)(j_begin), (int8)(j), j >= lo8), hi8 + 1, j > hi8), run_end, act);
-                bound = select((int8)(dir > 0 ? j_end : j_begin), bound, live);
-                const int jump = dir > 0 ? clvr_min8(bound) : clvr_max8(bound);
+                const int jump = clvr_packet_jump(run_end, act, live, j, dir, lo8, hi8, j_begin, j_end);
                 stepped += select((int8)(0), (int8)(dir * (jump - j) + 1), act);
                 j = jump;
                 continue;

@@ -13,7 +13,8 @@ int clvr_grid_inside(const float3 g, const int4 dims)
 
 /* The eye-depth interval [*zin, *zout] of the ray go + z gd (grid coordinates) inside the box [lo, hi)
  * (slab test; a ray parallel to an axis is inside for lo <= g < hi, so hi is the next float above the last
- * grid point); empty (*zin > *zout) when it misses. */
+ * grid point); empty (*zin > *zout) when it misses, and when the box is empty (lo >= hi on an axis: the
+ * slab test alone would give the chord between the two planes). */
 void clvr_box_chord(const float3 go, const float3 gd, const float3 lo, const float3 hi, float* zin, float* zout)
 {
     float z0 = -INFINITY, z1 = INFINITY;
@@ -22,8 +23,8 @@ void clvr_box_chord(const float3 go, const float3 gd, const float3 lo, const flo
         const float gs = a == 0 ? gd.x : (a == 1 ? gd.y : gd.z);
         const float l = a == 0 ? lo.x : (a == 1 ? lo.y : lo.z);
         const float h = a == 0 ? hi.x : (a == 1 ? hi.y : hi.z);
-        if (gs == 0.0f) {
-            if (g0 < l || g0 >= h)
+        if (gs == 0.0f || !(l < h)) {
+            if (g0 < l || g0 >= h)  /* always, when l >= h */
                 z1 = -INFINITY;
             continue;
         }

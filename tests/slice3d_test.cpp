@@ -535,8 +535,8 @@ TEST(Slice3dPackets, BitIdenticalToOnePixelPerWorkItem)
 }
 
 // A transfer function with tau 0 everywhere empties every brick (the box of the bricks that are not empty is
-// then one point, host/render/grid/slice3d.cpp): neither kernel takes a sample, the image is the background,
-// and the samples inside the box are still counted, all stepped over.
+// then empty, lo >= hi, and clvr_box_chord gives it no chord): neither kernel takes a sample, the image is the
+// background, and the samples inside the box are still counted, all stepped over.
 TEST(Slice3dPackets, TransparentTransferFunctionTakesNoSample)
 {
     const TransferFunction clear({{0.0, {1, 0, 0}, 0.0}, {1.0, {0, 1, 0}, 0.0}});

@@ -179,12 +179,10 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
 
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
     if (options_.path == Slice3dOptions::Path::Fused) {
-        fused_ = device_.kernel("slice3d.cl", "slice3d_fused", {}, trilinearOptions);
         // Ray packets (docs/slice3d.md): the same kernel's arithmetic on 8 pixels at once; the pre-integrated
         // slabs keep one pixel per work-item.
         packet_ = options_.packets && !options_.preintegrated;
-        if (packet_)
-            fused_ = device_.kernel("slice3d.cl", "slice3d_fused_packet", {}, trilinearOptions);
+        fused_ = device_.kernel("slice3d.cl", packet_ ? "slice3d_fused_packet" : "slice3d_fused", {}, trilinearOptions);
         out_ = device_.buffer("slice3d image", pixels * sizeof(cl_float4), CL_MEM_WRITE_ONLY);
         samples_ = device_.buffer("slice3d sample counts", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
         skipped_ = device_.buffer("slice3d skipped sample counts", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
@@ -311,12 +309,8 @@ Image4f Slice3dRenderer::renderFused(FrameStats& stats)
         params.tight_lo.s[a] = std::max(params.own_lo.s[a], partOffset[a] + static_cast<float>(filledLo_[a] * kBrickCells));
         params.tight_hi.s[a] = std::min(params.own_hi.s[a], partOffset[a] + static_cast<float>((filledHi_[a] + 1) * kBrickCells));
     }
-    // No brick holds anything (or the box misses the owned one): a box of one point, whose chord is at most
-    // that point's and whose half-open test no sample passes. An inverted box would not do: the slab test
-    // gives the chord between its faces' planes, and the loop would visit every slice there for nothing.
-    if (params.tight_lo.s[0] >= params.tight_hi.s[0] || params.tight_lo.s[1] >= params.tight_hi.s[1] ||
-        params.tight_lo.s[2] >= params.tight_hi.s[2])
-        params.tight_hi = params.tight_lo;
+    // (No brick holds anything, or the box misses the owned one: tight_lo >= tight_hi on an axis, a box whose
+    // chord clvr_box_chord makes empty.)
     // The whole grid's box, [0, n - 1] per axis, half open above as own_hi is (the next float above n - 1), so
     // that a ray lying in the last grid plane counts as inside, as its samples do.
     const glm::vec3 last = glm::vec3(part_.fullDims - 1);
@@ -349,8 +343,9 @@ Image4f Slice3dRenderer::renderFused(FrameStats& stats)
         params.psi_n = static_cast<cl_int>(psiTable().size);
     }
     fused_.setArg(a++, params);
-    // A packet work-item renders pixels 8x .. 8x + 7 of its row.
-    device_.launch("slice3d: fused", fused_, packet_ ? (image_.width + 7) / 8 : image_.width, image_.height);
+    // A packet work-item renders kPacketLanes pixels of its row.
+    device_.launch("slice3d: fused", fused_, packet_ ? (image_.width + kPacketLanes - 1) / kPacketLanes : image_.width,
+                   image_.height);
 
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
     Image4f image = readImage(device_, out_, image_.width, image_.height);

@@ -445,8 +445,9 @@ std::uint64_t Stack2dRenderer::renderFused(std::uint64_t& steppedOver)
     if (clipTexture_)
         fused_.setArg(a++, sliceTable_);  // one slice per quad: the table is empty, the texels start at 0
     fused_.setArg(a++, p);
-    // A packet work-item renders pixels 8x .. 8x + 7 of its row.
-    device_.launch("stack2d: fused planes", fused_, packet_ ? (image_.width + 7) / 8 : image_.width, image_.height);
+    // A packet work-item renders kPacketLanes pixels of its row.
+    device_.launch("stack2d: fused planes", fused_,
+                   packet_ ? (image_.width + kPacketLanes - 1) / kPacketLanes : image_.width, image_.height);
     const std::size_t pixels = framebuffer_->pixelCount();
     std::uint64_t samples = 0;
     steppedOver = 0;
