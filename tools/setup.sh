@@ -84,13 +84,8 @@ if [ "${CLVR_SKIP_ASAN:-0}" != 1 ]; then
         -DCLVR_POCL_CACHE_DIR="$PWD/build/pocl-cache" -DCLVR_TEST_EXCLUDE="$asan_exclude" >/dev/null
     cmake --build build-asan -j "$jobs"
     # Every suite again: the host code is instrumented, PoCL's compiled kernels are not. Leaks inside
-    # PoCL/LLVM (never freed compiler state) are suppressed; clvr's own are reported.
-    # intercept_tls_get_addr=0: LeakSanitizer otherwise scans a bogus dynamic-TLS range left by the
-    # libraries PoCL loads and its stop-the-world tracer crashes at exit ("Tracer caught signal 11 ...
-    # LeakSanitizer has encountered a fatal error" after the test passed; reproducible on
-    # DefaultScene.MatchesReferenceIntegral with a cold PoCL cache).
-    export LSAN_OPTIONS="suppressions=$PWD/tests/lsan.supp:print_suppressions=0:intercept_tls_get_addr=0"
-    export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+    # PoCL/LLVM (never freed compiler state) are suppressed; clvr's own are reported. The sanitizers'
+    # options (LSAN_OPTIONS, UBSAN_OPTIONS) are the tests' environment, set in tests/CMakeLists.txt.
     export POCL_CACHE_DIR="$PWD/build/pocl-cache"
     # Only PoCL's ICD: Mesa's (installed for the rusticl pass) leaks 128 bytes per process from a library it
     # unloads, which LeakSanitizer can neither name nor suppress; the second device is the release pass's.
