@@ -228,6 +228,30 @@ TEST(Device, BuildFailureCarriesTheLogWithFileAndLine)
     }
 }
 
+TEST(Device, CompilerPositionsInTheWholeSourceAreMappedToFileAndLine)
+{
+    // NVIDIA's OpenCL compiler ignores #line and names positions "<kernel>:LINE:COLUMN" of the whole
+    // submitted source (seen on an H200, driver 580.159.04); the log must still name the file and line.
+    const std::string source = "#line 1 \"kernels/a.cl\"\n"  // raw 1
+                               "float f(void);\n"              // raw 2 = a.cl:1
+                               "#line 1 \"kernels/b.h\"\n"   // raw 3
+                               "float g(void);\n"              // raw 4 = b.h:1
+                               "float h(void);\n"              // raw 5 = b.h:2
+                               "#line 3 \"kernels/a.cl\"\n"  // raw 6
+                               "kernel void k(void)\n"         // raw 7 = a.cl:3
+                               "#line 40\n"                    // raw 8: same file
+                               "{ x = 1; }\n";                 // raw 9 = a.cl:40
+    EXPECT_EQ(clvr::mapSourcePositions(source, "<kernel>:4:7: error: one\n<kernel>:9:3: error: two\n"),
+              "kernels/b.h:1:7: error: one\nkernels/a.cl:40:3: error: two\n");
+    EXPECT_EQ(clvr::mapSourcePositions(source, "<kernel>:5: warning\n<kernel>:7:1"),
+              "kernels/b.h:2: warning\nkernels/a.cl:3:1");
+    // Already named by file (PoCL, Mesa), beyond the source, or before any marker: unchanged.
+    EXPECT_EQ(clvr::mapSourcePositions(source, "kernels/a.cl:40:3: error: x\n<kernel>:99:1: y"),
+              "kernels/a.cl:40:3: error: x\n<kernel>:99:1: y");
+    EXPECT_EQ(clvr::mapSourcePositions("float f;\n", "<kernel>:1:1: e"), "<kernel>:1:1: e");
+    EXPECT_EQ(clvr::mapSourcePositions(source, ""), "");
+}
+
 TEST(Device, FragmentProgramIsAppendedAndCachedSeparately)
 {
     clvr::Device& device = clvr::test::device();

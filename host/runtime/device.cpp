@@ -227,6 +227,7 @@ cl::Program Device::program(std::string_view label, std::string_view source, std
         log.erase(std::find(log.begin(), log.end(), '\0'), log.end());
     } catch (const cl::Error&) {
     }
+    log = mapSourcePositions(source, log);
     if (status != CL_SUCCESS) {
         throw BuildError("building " + std::string(label) + " for \"" + listing_.name + "\" (" + listing_.version +
                              ") with \"" + std::string(options) + "\" failed: " + clErrorName(status),

@@ -3,6 +3,7 @@
 
 #include "host/runtime/errors.h"
 
+#include <regex>
 #include <string>
 
 namespace clvr {
@@ -13,6 +14,53 @@ std::string_view embeddedKernelSource(std::string_view name)
         if (k.name == name)
             return k.source;
     throw InternalError("kernels/" + std::string(name) + " is not embedded in this build");
+}
+
+std::string mapSourcePositions(std::string_view source, std::string_view log)
+{
+    // Where each line of the submitted source comes from: a "#line N \"file\"" marker says the next
+    // line is line N of file (the file unchanged when the marker names none).
+    struct Origin {
+        std::string file;
+        long line = 0;
+    };
+    std::vector<Origin> origins;  // origins[r - 1]: line r of `source`
+    static const std::regex marker(R"re(^[ \t]*#[ \t]*line[ \t]+([0-9]+)(?:[ \t]+"([^"]*)")?)re");
+    Origin next{"", 1};
+    std::size_t begin = 0;
+    while (begin <= source.size()) {
+        std::size_t end = source.find('\n', begin);
+        if (end == std::string_view::npos)
+            end = source.size();
+        const std::string line(source.substr(begin, end - begin));
+        origins.push_back(next);
+        std::smatch m;
+        if (std::regex_search(line, m, marker)) {
+            next.line = std::stol(m[1].str());
+            if (m[2].matched)
+                next.file = m[2].str();
+        } else {
+            ++next.line;
+        }
+        begin = end + 1;
+    }
+
+    static const std::regex position(R"re(<[A-Za-z ]{1,32}>:([0-9]{1,9}))re");
+    std::string mapped;
+    std::string text(log);
+    auto last = text.cbegin();
+    for (std::sregex_iterator it(text.begin(), text.end(), position), done; it != done; ++it) {
+        const std::smatch& m = *it;
+        const long raw = std::stol(m[1].str());
+        mapped.append(last, m[0].first);
+        if (raw >= 1 && raw <= static_cast<long>(origins.size()) && !origins[raw - 1].file.empty())
+            mapped += origins[raw - 1].file + ":" + std::to_string(origins[raw - 1].line);
+        else
+            mapped.append(m[0].first, m[0].second);
+        last = m[0].second;
+    }
+    mapped.append(last, text.cend());
+    return mapped;
 }
 
 }  // namespace clvr
