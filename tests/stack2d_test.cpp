@@ -737,6 +737,7 @@ TEST(Stack2dFused, PacketsAreBitIdenticalToOnePixelPerWorkItem)
             for (const json& options : sets)
                 for (int width : {61, 5}) {
                     Scene packets = makeScene(camera, width, options);
+                    packets.options["packets"] = true;  // the default on CPU devices only
                     packets.image.height = 47;
                     packets.transferFunction = tf;
                     Scene pixels = packets;
@@ -757,8 +758,8 @@ TEST(Stack2dFused, PacketsAreBitIdenticalToOnePixelPerWorkItem)
                 }
     EXPECT_EQ(compared, 4 * 2 * 4 * 2);
     FrameStats shaded, iso;
-    test::renderScene(shadedScene(perspectiveCamera(), {{"intermediate", 1}}), sphere33(), &shaded);
-    Scene isoScene = makeScene(perspectiveCamera(), 24, {{"intermediate", 1}});
+    test::renderScene(shadedScene(perspectiveCamera(), {{"intermediate", 1}, {"packets", true}}), sphere33(), &shaded);
+    Scene isoScene = makeScene(perspectiveCamera(), 24, {{"intermediate", 1}, {"packets", true}});
     isoScene.transferFunction = TransferFunction();
     isoScene.iso = test::isoSpec(0.75, {0.4, 0.6, 1.0}, 0.15, 0.8);
     test::renderScene(isoScene, marschnerLobb41(), &iso);

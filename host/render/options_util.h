@@ -14,6 +14,7 @@
 
 #include <cmath>
 #include <initializer_list>
+#include <optional>
 #include <string>
 
 namespace clvr {
@@ -149,9 +150,16 @@ inline OptionInfo reflectanceMapSizeInfo()
 }
 inline OptionInfo packetsInfo()
 {
-    return {"packets", true, "",
+    return {"packets", nullptr, "true on CPU devices, false on others",
             "fused path: 8 neighbouring pixels per work-item as vector lanes (the same image) where the technique's "
             "mode has them (docs/scene-format.md), or false: one pixel per work-item"};
+}
+// "packets" left out (or null): packets on CPU devices, where PoCL turns the lanes into SIMD and they took
+// slice3d's kernel from 141-155 to 51-52 ms (run PK1); one pixel per work-item elsewhere: on an NVIDIA H200
+// the packet kernel took 2.7-4.2x the one-pixel kernel's time (0.86 against 0.31 ms, run GPU2).
+inline bool packetsOnDevice(const std::optional<bool>& packets, const std::string& deviceType)
+{
+    return packets.value_or(deviceType == "CPU");
 }
 inline OptionInfo clipTextureInfo()
 {

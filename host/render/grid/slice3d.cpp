@@ -181,7 +181,7 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
     if (options_.path == Slice3dOptions::Path::Fused) {
         // Ray packets (docs/slice3d.md): the same kernel's arithmetic on 8 pixels at once; the pre-integrated
         // slabs keep one pixel per work-item.
-        packet_ = options_.packets && !options_.preintegrated;
+        packet_ = packetsOnDevice(options_.packets, device_.listing().type) && !options_.preintegrated;
         fused_ = device_.kernel("slice3d.cl", packet_ ? "slice3d_fused_packet" : "slice3d_fused", {}, trilinearOptions);
         out_ = device_.buffer("slice3d image", pixels * sizeof(cl_float4), CL_MEM_WRITE_ONLY);
         samples_ = device_.buffer("slice3d sample counts", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
@@ -665,7 +665,7 @@ Slice3dOptions parseSlice3dOptions(const nlohmann::json& options)
         } else if (key == "empty_space_skipping") {
             o.emptySpaceSkipping = booleanOption(key, value);
         } else if (key == "packets") {
-            o.packets = booleanOption(key, value);
+            o.packets = value.is_null() ? std::nullopt : std::optional<bool>(booleanOption(key, value));
         } else if (key == "clip") {
             o.clip = parseClip(value);
         } else if (key == "clip_texture") {

@@ -40,8 +40,9 @@ struct Slice3dOptions {
     bool emptySpaceSkipping = true;  // fused path: step over bricks where tau is 0 (bit-identical image)
     bool nativeVoxels = true;  // fused path: uint8/uint16 on the device when every value fits (same bits)
     // Fused path: 8 neighbouring pixels per work-item, one per float8 lane (kernels/slice3d.cl's
-    // slice3d_fused_packet; same bits as one pixel per work-item). Not with preintegrated.
-    bool packets = true;
+    // slice3d_fused_packet; same bits as one pixel per work-item). Not with preintegrated. Unset: on CPU
+    // devices only (packetsOnDevice, host/render/options_util.h).
+    std::optional<bool> packets;
     // Fused path: integrate each slab between consecutive samples with the scalar linear in between (partial
     // pre-integration, kernels/segment_integral.h) instead of one classified sample per slice.
     bool preintegrated = false;

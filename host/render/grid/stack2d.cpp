@@ -288,7 +288,7 @@ void Stack2dRenderer::setUpFused(const Volume& volume, const TransferFunction& t
         noMap_ = device_.upload("stack2d no reflectance map", std::vector<glm::vec4>(1));
     // Ray packets (kernels/stack2d.cl stack2d_fused_packet, the same bits): plain direct volume rendering
     // without a clip texture; shading, iso-surfaces and clip textures keep one pixel per work-item.
-    packet_ = options_.packets && !clipTexture_ && !iso_ && !lighting_.shaded();
+    packet_ = packetsOnDevice(options_.packets, device_.listing().type) && !clipTexture_ && !iso_ && !lighting_.shaded();
     fused_ = device_.kernel("stack2d.cl", packet_ ? "stack2d_fused_packet" : "stack2d_fused", {},
                             clipTexture_ ? "-DCLVR_STACK2D_CLIP_TEXTURE=1" : "");
     const std::size_t pixels = framebuffer_->pixelCount();
@@ -621,7 +621,7 @@ Stack2dOptions parseStack2dOptions(const nlohmann::json& options)
         else if (key == "empty_space_skipping")
             o.emptySpaceSkipping = booleanOption(key, value);
         else if (key == "packets")
-            o.packets = booleanOption(key, value);
+            o.packets = value.is_null() ? std::nullopt : std::optional<bool>(booleanOption(key, value));
         else if (key == "early_termination")
             o.earlyTermination = earlyTerminationOption(value);
         else

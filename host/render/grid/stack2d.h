@@ -35,8 +35,9 @@ struct Stack2dOptions {
     bool emptySpaceSkipping = true;  // fused path: step over bricks where nothing can show (same image)
     double earlyTermination = 1.0;   // fused path: stop a ray once its opacity reaches this (1: off)
     // Fused path, plain rendering without a clip texture: 8 neighbouring pixels per work-item, one per float8
-    // lane (kernels/stack2d.cl stack2d_fused_packet; the same bits as one pixel per work-item).
-    bool packets = true;
+    // lane (kernels/stack2d.cl stack2d_fused_packet; the same bits as one pixel per work-item). Unset: on CPU
+    // devices only (packetsOnDevice, host/render/options_util.h).
+    std::optional<bool> packets;
     int intermediate = 0;  // slices interpolated between two neighbouring stack slices (0: the stack itself)
     int reflectanceMapSize = 128;  // shaded ("lights" in the scene): n, 6 n^2 shades (host/optics/reflectance_map.h)
     int slicesPerPolygon = 1;      // slices one quad stands for (seeds/003's multi-texture speed-up)
