@@ -11,7 +11,7 @@
 
 #include "clvr_common.h"
 
-#define CLVR_LANES 8  /* host: kPacketLanes (host/render/grid/slice3d.h) */
+#define CLVR_LANES 8  /* host: kPacketLanes (host/render/options_util.h) */
 #define CLVR_EACH_LANE(M) M(0) M(1) M(2) M(3) M(4) M(5) M(6) M(7)
 #define CLVR_LANE_INDEX ((int8)(0, 1, 2, 3, 4, 5, 6, 7))
 
@@ -63,6 +63,27 @@ int clvr_packet_jump(const int8 run_end, const int8 act, const int8 live, const 
         bound = select(select(select((int8)(k_begin), (int8)(k), k >= lo), hi + 1, k > hi), run_end, act);
     bound = select((int8)(step > 0 ? k_end : k_begin), bound, live);
     return step > 0 ? clvr_min8(bound) : clvr_max8(bound);
+}
+
+/* clvr_atan2 (kernels/clvr_common.h) lane by lane, the same operations. */
+float8 clvr_atan2_8(const float8 y, const float8 x)
+{
+    const float8 ax = fabs(x), ay = fabs(y);
+    const float8 hi = fmax(ax, ay), lo = fmin(ax, ay);
+    const float8 a = select((float8)(0.0f), lo / hi, isgreater(hi, 0.0f));
+    const float8 s = a * a;
+    float8 r = 2.8501858469098806e-3f;
+    r = r * s - 1.6069890931248665e-2f;
+    r = r * s + 4.269373044371605e-2f;
+    r = r * s - 7.504499703645706e-2f;
+    r = r * s + 1.064104288816452e-1f;
+    r = r * s - 1.4203676581382751e-1f;
+    r = r * s + 1.999262422323227e-1f;
+    r = r * s - 3.3333075046539307e-1f;
+    r = (r * s + 1.0f) * a;
+    r = select(r, 1.5707963267948966f - r, isgreater(ay, ax));
+    r = select(r, 3.14159265358979323846f - r, isless(x, 0.0f));
+    return copysign(r, y);
 }
 
 /* clvr_exp2 (kernels/clvr_common.h) lane by lane, the same operations. */

@@ -7,6 +7,7 @@
 // opacity alpha = 1 - exp(-tau L) for the length L of the ray inside this shell's slab, and the
 // "over" blend into `image` (back to front, premultiplied): dst = (C alpha, alpha) + (1 - alpha) dst.
 #include "clvr_common.h"
+#include "packet.h"
 #include "ray.h"
 #include "spherical_params.h"
 #include "texture.h"
@@ -60,6 +61,13 @@ float clvr_spherical_wrap(const float s, const float s0, const float period)
         return s;
     const float u = (s - s0) / period;
     return s0 + (u - floor(u)) * period;
+}
+
+/* Row m of the color matrix applied to (u, v, w, 1), written out (not dot(), whose evaluation order is the
+ * implementation's) so that the packet kernel repeats it lane by lane. */
+float clvr_spherical_row(const float4 m, const float u, const float v, const float w)
+{
+    return m.x * u + m.y * v + m.z * w + m.w;
 }
 
 /* p.phi_s0, p.phi_period: the φ texture coordinate s.x wraps to [phi_s0, phi_s0 + phi_period)
@@ -136,9 +144,11 @@ kernel void spherical_fused(global float4* out, global uint* samples, global con
             float u = clvr_atan2(rel.y, rel.x) * inv_two_pi;
             u = u < 0.0f ? u + 1.0f : (u >= 1.0f ? 0.0f : u);
             const float v = clvr_atan2(sqrt(rel.x * rel.x + rel.y * rel.y), rel.z) * inv_pi;
-            const float4 uvw = (float4)(u, v, shell.w, 1.0f);
-            float4 q = p.bias + p.scale * (float4)(dot(p.matrix_row[0], uvw), dot(p.matrix_row[1], uvw),
-                                                   dot(p.matrix_row[2], uvw), dot(p.matrix_row[3], uvw));
+            const float w = shell.w;
+            float4 q = p.bias + p.scale * (float4)(clvr_spherical_row(p.matrix_row[0], u, v, w),
+                                                   clvr_spherical_row(p.matrix_row[1], u, v, w),
+                                                   clvr_spherical_row(p.matrix_row[2], u, v, w),
+                                                   clvr_spherical_row(p.matrix_row[3], u, v, w));
             q.x = clvr_spherical_wrap(q.x, p.phi_s0, p.phi_period);
             ++taken;
             /* clvr_tex3d's linear filter with clamp to edge, as clvr_trilinear on the grid: texel i centered at
@@ -159,4 +169,134 @@ kernel void spherical_fused(global float4* out, global uint* samples, global con
     const size_t i = (size_t)y * p.width + x;
     out[i] = (float4)(c + transmittance * p.background.xyz, 1.0f - transmittance);
     samples[i] = taken;
+}
+
+/* ---- ray packets (host: "packets"; docs/spherical.md) -------------------------------------------------- */
+
+/* clvr_spherical_wrap lane by lane. */
+float8 clvr_spherical_wrap8(const float8 s, const float s0, const float period)
+{
+    if (!(period > 0.0f))
+        return s;
+    const float8 u = (s - s0) / period;
+    return s0 + (u - floor(u)) * period;
+}
+
+/* clvr_spherical_row lane by lane; w is a vector so that m.z * w fuses into the sum as the scalar one does. */
+float8 clvr_spherical_row8(const float4 m, const float8 u, const float8 v, const float8 w)
+{
+    return m.x * u + m.y * v + m.z * w + m.w;
+}
+
+/* clvr_spherical_slab lane by lane (r_inner, r_lo, r_hi as vectors for the same fused products). */
+float8 clvr_spherical_slab8(const float8 tc, const float8 p2, const float8 r_inner, const float8 r_lo, const float8 r_hi,
+                            const float side)
+{
+    const float8 h_hi = sqrt(fmax(r_hi * r_hi - p2, 0.0f));
+    const float8 h_lo = select(sqrt(fmax(r_lo * r_lo - p2, 0.0f)), (float8)(0.0f), isgreaterequal(p2, r_inner * r_inner));
+    const float8 t0 = side > 0.0f ? tc + h_lo : tc - h_hi;
+    const float8 t1 = side > 0.0f ? tc + h_hi : tc - h_lo;
+    return fmax(t1 - fmax(t0, 0.0f), 0.0f);
+}
+
+/* spherical_fused for the 8 pixels (8 x .. 8 x + 7, y) of one work-item, one per float8 lane (kernels/packet.h):
+ * the shells are the same spheres for every ray, so the lanes step through them together, each lane doing
+ * spherical_fused's arithmetic (the same operations, the same bits) where its own loop would: a lane stops
+ * the near pass at the first sphere it misses, starts the far pass at its own innermost sphere, skips hits
+ * behind the eye, and stops once opaque. The ray set-up is the scalar code's, lane by lane. */
+kernel void spherical_fused_packet(global float4* out, global uint* samples, global const float* texels,
+                                   global const float* tf, global const float4* shells, const ClSphericalFusedParams p)
+{
+    const int x0 = (int)get_global_id(0) * CLVR_LANES, y = (int)get_global_id(1);
+    if (x0 >= p.width || y >= p.height)
+        return;
+    const float2 size = (float2)((float)p.width, (float)p.height);
+    float8 oc_x, oc_y, oc_z, dir_x, dir_y, dir_z, tc, p2;
+#define CLVR_SPHERICAL_SETUP(L)                                                                            \
+    {                                                                                                      \
+        float3 oc, dir;                                                                                    \
+        float t, q;                                                                                        \
+        clvr_spherical_ray((float)(x0 + L), (float)y, p.camera, size, p.center.xyz, &oc, &dir, &t, &q);    \
+        oc_x.s##L = oc.x, oc_y.s##L = oc.y, oc_z.s##L = oc.z;                                              \
+        dir_x.s##L = dir.x, dir_y.s##L = dir.y, dir_z.s##L = dir.z;                                        \
+        tc.s##L = t, p2.s##L = q;                                                                          \
+    }
+    CLVR_EACH_LANE(CLVR_SPHERICAL_SETUP)
+#undef CLVR_SPHERICAL_SETUP
+    const float inv_two_pi = 0.15915494309189535f, inv_pi = 0.3183098861837907f;
+    const int4 dims = (int4)((int)p.tex.width, (int)p.tex.height, (int)p.tex.depth, 0);
+    const float3 texels_n = convert_float3(dims.xyz);
+    float8 c_r = 0.0f, c_g = 0.0f, c_b = 0.0f, transmittance = 1.0f;
+    int8 taken = 0;
+    int8 go = x0 + CLVR_LANE_INDEX < p.width; /* lanes still walking: in the image, not opaque */
+    int8 innermost = p.shells;                /* each lane's innermost shell, found by pass 0 */
+    for (int pass = 0; pass < 2; ++pass) {
+        const float side = pass == 0 ? -1.0f : 1.0f;
+        int8 walk = go; /* pass 0: lanes that have not yet missed a sphere */
+        int n = 0;
+        if (pass == 1) {
+            /* each lane starts at its own innermost shell; lanes that met none have innermost = shells */
+            n = clvr_min8(select((int8)(p.shells), innermost, go));
+        }
+        for (; n < p.shells; ++n) {
+            const int k = pass == 0 ? p.shells - 1 - n : n;
+            const float4 shell = shells[k];
+            const float8 r = shell.x;
+            int8 act;
+            if (pass == 0) {
+                walk &= isless(p2, r * r); /* a lane that misses this sphere misses every inner one */
+                innermost = select(innermost, (int8)(k), walk);
+                act = walk;
+            } else {
+                act = walk & (k >= innermost); /* a lane whose innermost shell lies further out joins later */
+            }
+            if (!any(walk))
+                break;
+            if (!any(act))
+                continue;
+            const float8 t = tc + side * sqrt(r * r - p2);
+            act &= !isless(t, 0.0f); /* behind the eye */
+            if (!any(act))
+                continue;
+            const float8 rel_x = t * dir_x - oc_x, rel_y = t * dir_y - oc_y, rel_z = t * dir_z - oc_z;
+            float8 u = clvr_atan2_8(rel_y, rel_x) * inv_two_pi;
+            u = select(select(u, (float8)(0.0f), isgreaterequal(u, 1.0f)), u + 1.0f, isless(u, 0.0f));
+            const float8 v = clvr_atan2_8(sqrt(rel_x * rel_x + rel_y * rel_y), rel_z) * inv_pi;
+            const float8 w = shell.w;
+            const float8 q_x = clvr_spherical_wrap8(p.bias.x + p.scale.x * clvr_spherical_row8(p.matrix_row[0], u, v, w),
+                                                    p.phi_s0, p.phi_period);
+            const float8 q_y = p.bias.y + p.scale.y * clvr_spherical_row8(p.matrix_row[1], u, v, w);
+            const float8 q_z = p.bias.z + p.scale.z * clvr_spherical_row8(p.matrix_row[2], u, v, w);
+            /* the lanes that do not sample read texel 0 (their coordinates may be anything, NaN included) */
+            const float8 g_x = select((float8)(0.0f), clamp(q_x * texels_n.x - 0.5f, 0.0f, texels_n.x - 1.0f), act);
+            const float8 g_y = select((float8)(0.0f), clamp(q_y * texels_n.y - 0.5f, 0.0f, texels_n.y - 1.0f), act);
+            const float8 g_z = select((float8)(0.0f), clamp(q_z * texels_n.z - 0.5f, 0.0f, texels_n.z - 1.0f), act);
+            float8 cr, cg, cb, tau;
+            clvr_tf_eval8(tf, p.tf_count, clvr_trilinear8(texels, dims, g_x, g_y, g_z), &cr, &cg, &cb, &tau);
+            const float8 len = p.radial ? (float8)(shell.z - shell.y)
+                                        : clvr_spherical_slab8(tc, p2, (float8)(k > 0 ? shells[k - 1].x : -1.0f),
+                                                               (float8)(shell.y), (float8)(shell.z), side);
+            const float8 alpha = 1.0f - clvr_exp2_8(-tau * len * M_LOG2E_F);
+            const float8 ta = transmittance * alpha;
+            c_r = select(c_r, c_r + ta * cr, act);
+            c_g = select(c_g, c_g + ta * cg, act);
+            c_b = select(c_b, c_b + ta * cb, act);
+            transmittance = select(transmittance, transmittance * (1.0f - alpha), act);
+            taken -= act; /* act is -1 where true */
+            const int8 opaque = act & isgreaterequal(1.0f - transmittance, p.ert_alpha);
+            go &= !opaque;
+            walk &= !opaque;
+        }
+    }
+    const float8 a = 1.0f - transmittance;
+    const float8 o_r = c_r + transmittance * p.background.x, o_g = c_g + transmittance * p.background.y;
+    const float8 o_b = c_b + transmittance * p.background.z;
+    const size_t row = (size_t)y * p.width;
+#define CLVR_SPHERICAL_STORE(L)                                                                            \
+    if (x0 + L < p.width) {                                                                                \
+        out[row + x0 + L] = (float4)(o_r.s##L, o_g.s##L, o_b.s##L, a.s##L);                                \
+        samples[row + x0 + L] = (uint)taken.s##L;                                                          \
+    }
+    CLVR_EACH_LANE(CLVR_SPHERICAL_STORE)
+#undef CLVR_SPHERICAL_STORE
 }

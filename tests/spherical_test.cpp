@@ -81,7 +81,7 @@ TEST(SphericalOptions, BadOptionsAreOneClearLine)
         {{{"color_matrix", {1, 0, 0}}}, "options.color_matrix: must be 4 rows of 4 numbers, got [1,0,0]"},
         {{{"opacity", "exact"}}, "options.opacity: must be \"path\" or \"radial\", got \"exact\""},
         {{{"slices", 8}}, "options.slices: unknown option for spherical (known: shells, segments, r_min, r_max, "
-                          "center, color_matrix, scale, bias, opacity, path, early_termination)"},
+                          "center, color_matrix, scale, bias, opacity, path, early_termination, packets)"},
     };
     for (const auto& [options, message] : cases) {
         const std::string got = optionError(options);
@@ -89,6 +89,8 @@ TEST(SphericalOptions, BadOptionsAreOneClearLine)
         EXPECT_EQ(got.find('\n'), std::string::npos);
     }
     EXPECT_EQ(optionError({{"shells", 8}, {"segments", 12}, {"r_min", 0.0}, {"bias", {0.25, 0, 0}}}), "");
+    EXPECT_EQ(optionError({{"packets", "yes"}}).rfind("options.packets:", 0), 0u) << optionError({{"packets", "yes"}});
+    EXPECT_EQ(optionError({{"packets", nullptr}}), "");
 }
 
 TEST(SphericalOptions, SceneWithBadOptionFailsInMakeRenderer)
@@ -546,6 +548,62 @@ TEST(SphericalFused, EarlyTerminationLeavesOutAtMostTheRemainingTransmittance)
     EXPECT_LE(maxDiff, 0.1 + 1e-6);
     EXPECT_GT(maxDiff, 0.0);
     EXPECT_LT(early.samples, full.samples * 9 / 10);
+}
+
+// Ray packets (kernels/spherical.cl's spherical_fused_packet): 8 pixels of a row per work-item, each lane doing
+// spherical_fused's arithmetic, so the images are the same bits as one pixel per work-item — from outside,
+// from inside the shells (lanes whose innermost sphere differs start the far pass at different shells; some
+// hits lie behind the eye), with a parallel camera over a full ball off the origin, with radial opacity, a
+// rotating color matrix and φ bias (the wrap), early termination (lanes stop at different shells), and rows
+// of 61 and 5 pixels (a packet part outside the image).
+TEST(SphericalFused, PacketsAreBitIdenticalToOnePixelPerWorkItem)
+{
+    Camera inside;
+    inside.position = {0.8, 0.0, 0.1};
+    inside.focalPoint = {0.0, 0.3, 0.0};
+    inside.viewUp = {0.0, 0.0, 1.0};
+    inside.viewAngle = 70.0;
+    Camera parallel;
+    parallel.position = {0.4 - 3.0, 0.3 - 1.0, -0.2 + 1.5};
+    parallel.focalPoint = {0.4, 0.3, -0.2};
+    parallel.viewUp = {0.0, 0.0, 1.0};
+    parallel.parallel = true;
+    parallel.parallelScale = 1.1;
+    const json rotate = {{0, -1, 0, 0}, {1, 0, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}};
+    const json sets[] = {{{"shells", 33}},
+                         {{"shells", 17}, {"opacity", "radial"}},
+                         {{"shells", 33}, {"early_termination", 0.6}},
+                         {{"shells", 24}, {"color_matrix", rotate}, {"bias", {0.3, 0.0, 0.0, 0.0}}}};
+    const TransferFunction dense({{0.0, {0.1, 0.2, 0.6}, 2.0}, {0.5, {0.8, 0.4, 0.2}, 12.0}, {1.0, {1.0, 1.0, 0.9}, 30.0}});
+    int compared = 0;
+    for (const Camera& camera : {obliqueCamera(), inside, parallel})
+        for (const json& set : sets)
+            for (int width : {61, 5}) {
+                json options = set;
+                if (camera.parallel)
+                    options.update({{"r_min", 0.0}, {"r_max", 0.9}, {"center", {0.4, 0.3, -0.2}}});
+                options["packets"] = true;
+                Scene packets = makeScene(camera, width, options);
+                packets.image.height = 43;
+                if (set.contains("early_termination"))
+                    packets.transferFunction = dense;
+                Scene pixels = packets;
+                pixels.options["packets"] = false;
+                FrameStats ps, qs;
+                const Image4f p = test::renderScene(packets, atmosphere(), &ps);
+                const Image4f q = test::renderScene(pixels, atmosphere(), &qs);
+                const std::string label = options.dump() + " width " + std::to_string(width) +
+                                          (camera.parallel ? " parallel" : camera.position.x == 0.8 ? " inside" : " outside");
+                ASSERT_EQ(p.pixelCount(), q.pixelCount());
+                EXPECT_EQ(std::memcmp(p.pixels().data(), q.pixels().data(), p.pixelCount() * sizeof(glm::vec4)), 0)
+                    << label;
+                EXPECT_TRUE(ps.extra["packets"].get<bool>()) << label;
+                EXPECT_FALSE(qs.extra["packets"].get<bool>()) << label;
+                EXPECT_EQ(ps.samples, qs.samples) << label;
+                EXPECT_GT(qs.samples, 0u) << label;
+                ++compared;
+            }
+    EXPECT_EQ(compared, 3 * 4 * 2);
 }
 
 TEST(SphericalFused, PathOptions)

@@ -154,6 +154,11 @@ inline OptionInfo packetsInfo()
             "fused path: 8 neighbouring pixels per work-item as vector lanes (the same image) where the technique's "
             "mode has them (docs/scene-format.md), or false: one pixel per work-item"};
 }
+// Ray packets (slice3d's, stack2d's and spherical's "packets"): pixels per work-item, the lanes of
+// kernels/packet.h (CLVR_LANES); work-item x renders pixels kPacketLanes x .. kPacketLanes x + kPacketLanes - 1
+// of its row.
+constexpr int kPacketLanes = 8;
+
 // "packets" left out (or null): packets on CPU devices, where PoCL turns the lanes into SIMD and they took
 // slice3d's kernel from 141-155 to 51-52 ms (run PK1); one pixel per work-item elsewhere: on an NVIDIA H200
 // the packet kernel took 2.7-4.2x the one-pixel kernel's time (0.86 against 0.31 ms, run GPU2).

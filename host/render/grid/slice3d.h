@@ -68,9 +68,6 @@ SlicePlan planSlices(const Camera& camera, const glm::dvec3& lo, const glm::dvec
 // corner lies in it. The min-max grid is built once per volume.
 constexpr int kBrickCells = 4;
 
-// Ray packets (slice3d's and stack2d's "packets"): pixels per work-item, the lanes of kernels/packet.h
-// (CLVR_LANES); work-item x renders pixels kPacketLanes x .. kPacketLanes x + kPacketLanes - 1 of its row.
-constexpr int kPacketLanes = 8;
 struct BrickGrid {
     glm::ivec3 dims{0};             // bricks per axis: ceil((n - 1) / B)
     std::vector<glm::vec2> minMax;  // (min, max) of the brick's grid points, x fastest

@@ -81,6 +81,7 @@ TechniqueInfo sphericalTechnique()
         {"path", "fused", "", "\"fused\" (each pixel meets the exact spheres in one kernel) or \"raster\" (the "
                               "tessellated shells pass by pass)"},
         earlyTerminationInfo(1.0),
+        packetsInfo(),
     };
     t.makeForVolume = makeSphericalRenderer;
     return t;
@@ -129,6 +130,8 @@ SphericalOptions parseSphericalOptions(const nlohmann::json& options)
                                                                        : SphericalOptions::Path::Raster;
         } else if (key == "early_termination") {
             o.earlyTermination = earlyTerminationOption(value);
+        } else if (key == "packets") {
+            o.packets = value.is_null() ? std::nullopt : std::optional<bool>(booleanOption(key, value));
         } else {
             unparsedOption(info, key);
         }
@@ -266,7 +269,9 @@ SphericalRenderer::SphericalRenderer(Device& device, const Scene& scene, const V
             table.emplace_back(glm::dvec4(shell.radius, shell.rLo, shell.rHi, (shell.radius - d.rMin) / (d.rMax - d.rMin)));
         shellTable_ = device_.upload("spherical shell table", table);
         residentBytes_ += table.size() * sizeof(glm::vec4);
-        fused_ = device_.kernel("spherical.cl", "spherical_fused");
+        // Ray packets (docs/spherical.md): the same kernel's arithmetic on 8 pixels at once.
+        packet_ = packetsOnDevice(options_.packets, device_.listing().type);
+        fused_ = device_.kernel("spherical.cl", packet_ ? "spherical_fused_packet" : "spherical_fused");
         fusedSamples_ = device_.buffer("spherical fused samples per pixel",
                                        static_cast<std::size_t>(imageSpec_.width) * imageSpec_.height * sizeof(cl_uint),
                                        CL_MEM_WRITE_ONLY);
@@ -303,7 +308,9 @@ std::uint64_t SphericalRenderer::renderFused()
     fused_.setArg(a++, tf_.buffer());
     fused_.setArg(a++, shellTable_);
     fused_.setArg(a++, p);
-    device_.launch("spherical: fused shells", fused_, static_cast<std::size_t>(imageSpec_.width),
+    // A packet work-item renders kPacketLanes pixels of its row.
+    const std::size_t width = static_cast<std::size_t>(imageSpec_.width);
+    device_.launch("spherical: fused shells", fused_, packet_ ? (width + kPacketLanes - 1) / kPacketLanes : width,
                    static_cast<std::size_t>(imageSpec_.height));
     std::uint64_t samples = 0;
     for (const cl_uint n : device_.download<cl_uint>(fusedSamples_, image_->pixelCount()))
@@ -384,6 +391,7 @@ Image4f SphericalRenderer::render(FrameStats& stats)
         stats.extra["shells"] = shells_.size();
         stats.extra["opacity"] = options_.opacity == SphericalOptions::Opacity::Path ? "path" : "radial";
         stats.extra["early_termination"] = options_.earlyTermination;
+        stats.extra["packets"] = packet_;
         stats.extra["voxels"] = static_cast<std::uint64_t>(dims_.x) * dims_.y * dims_.z;
         stats.extra["resident_bytes"] = residentBytes_;
         return image;

@@ -21,6 +21,7 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
+#include <optional>
 #include <vector>
 
 namespace clvr {
@@ -51,6 +52,9 @@ struct SphericalOptions {
     // ray meets the exact spheres in one kernel, front to back (no tessellation: `segments` is unused).
     enum class Path { Fused, Raster } path = Path::Fused;
     double earlyTermination = 1.0;  // fused path: stop a ray once its opacity reaches this (1: off)
+    // Fused path: 8 neighbouring pixels per work-item, one per float8 lane (kernels/spherical.cl's
+    // spherical_fused_packet; the same bits). Unset: on CPU devices only (packetsOnDevice, options_util.h).
+    std::optional<bool> packets;
 };
 
 // Its registry entry (host/render/renderer.h): name, data kind, one line, options with defaults.
@@ -117,6 +121,7 @@ private:
     raster::DrawStats drawStats_;
     // The fused path: its kernel, the shell table (radius, r_lo, r_hi, w) and the samples per pixel.
     cl::Kernel fused_;
+    bool packet_ = false;  // fused_ is spherical_fused_packet
     cl::Buffer shellTable_, fusedSamples_;
     std::uint64_t renderFused();
 };
