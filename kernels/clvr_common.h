@@ -34,20 +34,25 @@ float clvr_exp2(const float x)
  * float on [0, 1]), then pi/2 - r where |y| > |x|, pi - r where x < 0, the sign of y. Absolute error below
  * 5e-7 (tests/device_test.cpp against the host's atan2); atan2(±0, 0) = ±0. PoCL's atan2 and acos took 57 %
  * of spherical's fused per-sample time on this CPU. */
+/* P(s), declared as r of type T, one Horner step per statement (each contracted alike for scalars and
+ * vectors); also kernels/packet.h's clvr_atan2_8. */
+#define CLVR_ATAN_POLYNOMIAL(T, r, s)  \
+    T r = 2.8501858469098806e-3f;      \
+    r = r * (s) - 1.6069890931248665e-2f; \
+    r = r * (s) + 4.269373044371605e-2f;  \
+    r = r * (s) - 7.504499703645706e-2f;  \
+    r = r * (s) + 1.064104288816452e-1f;  \
+    r = r * (s) - 1.4203676581382751e-1f; \
+    r = r * (s) + 1.999262422323227e-1f;  \
+    r = r * (s) - 3.3333075046539307e-1f;
+
 float clvr_atan2(const float y, const float x)
 {
     const float ax = fabs(x), ay = fabs(y);
     const float hi = fmax(ax, ay), lo = fmin(ax, ay);
     const float a = hi > 0.0f ? lo / hi : 0.0f;
     const float s = a * a;
-    float r = 2.8501858469098806e-3f;
-    r = r * s - 1.6069890931248665e-2f;
-    r = r * s + 4.269373044371605e-2f;
-    r = r * s - 7.504499703645706e-2f;
-    r = r * s + 1.064104288816452e-1f;
-    r = r * s - 1.4203676581382751e-1f;
-    r = r * s + 1.999262422323227e-1f;
-    r = r * s - 3.3333075046539307e-1f;
+    CLVR_ATAN_POLYNOMIAL(float, r, s)
     r = (r * s + 1.0f) * a;
     if (ay > ax)
         r = 1.5707963267948966f - r;

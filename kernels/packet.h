@@ -72,14 +72,7 @@ float8 clvr_atan2_8(const float8 y, const float8 x)
     const float8 hi = fmax(ax, ay), lo = fmin(ax, ay);
     const float8 a = select((float8)(0.0f), lo / hi, isgreater(hi, 0.0f));
     const float8 s = a * a;
-    float8 r = 2.8501858469098806e-3f;
-    r = r * s - 1.6069890931248665e-2f;
-    r = r * s + 4.269373044371605e-2f;
-    r = r * s - 7.504499703645706e-2f;
-    r = r * s + 1.064104288816452e-1f;
-    r = r * s - 1.4203676581382751e-1f;
-    r = r * s + 1.999262422323227e-1f;
-    r = r * s - 3.3333075046539307e-1f;
+    CLVR_ATAN_POLYNOMIAL(float8, r, s)
     r = (r * s + 1.0f) * a;
     r = select(r, 1.5707963267948966f - r, isgreater(ay, ax));
     r = select(r, 3.14159265358979323846f - r, isless(x, 0.0f));

@@ -38,6 +38,33 @@ Camera obliqueCamera()  // outside the domain, 35 degrees above the equator
     return c;
 }
 
+Camera insideCamera()  // inside the outer shells, outside the inner ones
+{
+    Camera c;
+    c.position = {0.8, 0.0, 0.1};
+    c.focalPoint = {0.0, 0.3, 0.0};
+    c.viewUp = {0.0, 0.0, 1.0};
+    c.viewAngle = 70.0;
+    return c;
+}
+
+Camera parallelBallCamera()  // parallel, towards the full ball of ballOptions()
+{
+    Camera c;
+    c.position = {0.4 - 3.0, 0.3 - 1.0, -0.2 + 1.5};
+    c.focalPoint = {0.4, 0.3, -0.2};
+    c.viewUp = {0.0, 0.0, 1.0};
+    c.parallel = true;
+    c.parallelScale = 1.1;
+    return c;
+}
+
+// A full ball (r_min = 0) of radius 0.9 off the origin.
+nlohmann::json ballOptions()
+{
+    return {{"r_min", 0.0}, {"r_max", 0.9}, {"center", {0.4, 0.3, -0.2}}};
+}
+
 const Volume& atmosphere()  // (φ, θ, r) grid; φ = 0 and φ = 2π columns agree
 {
     static const Volume v = generateVolume("atmosphere", {33, 17, 12});
@@ -371,11 +398,7 @@ TEST(SphericalRender, BiasOnPhiEqualsRotatedData)
 // order still holds; the image matches the reference as from outside.
 TEST(SphericalRender, CameraInsideTheDomain)
 {
-    Camera camera;
-    camera.position = {0.8, 0.0, 0.1};
-    camera.focalPoint = {0.0, 0.3, 0.0};
-    camera.viewUp = {0.0, 0.0, 1.0};
-    camera.viewAngle = 70.0;
+    const Camera camera = insideCamera();
     const int size = 48;
     Scene scene = makeScene(camera, size, {{"shells", 65}, {"segments", 128}});
     SphericalReferenceOptions o;
@@ -396,14 +419,10 @@ TEST(SphericalRender, CameraInsideTheDomain)
 // of the rays through it) off the origin.
 TEST(SphericalRender, ParallelCameraFullBall)
 {
-    Camera camera;
-    camera.position = {0.4 - 3.0, 0.3 - 1.0, -0.2 + 1.5};
-    camera.focalPoint = {0.4, 0.3, -0.2};
-    camera.viewUp = {0.0, 0.0, 1.0};
-    camera.parallel = true;
-    camera.parallelScale = 1.1;
+    const Camera camera = parallelBallCamera();
     const int size = 48;
-    const json options = {{"shells", 65}, {"segments", 128}, {"r_min", 0.0}, {"r_max", 0.9}, {"center", {0.4, 0.3, -0.2}}};
+    json options = {{"shells", 65}, {"segments", 128}};
+    options.update(ballOptions());
     Scene scene = makeScene(camera, size, options);
     const SphericalOptions parsed = parseSphericalOptions(options);
     const Image4d reference = sphericalReferenceIntegral(atmosphere(), atmosphereTransferFunction(), camera, scene.image,
@@ -558,17 +577,6 @@ TEST(SphericalFused, EarlyTerminationLeavesOutAtMostTheRemainingTransmittance)
 // of 61 and 5 pixels (a packet part outside the image).
 TEST(SphericalFused, PacketsAreBitIdenticalToOnePixelPerWorkItem)
 {
-    Camera inside;
-    inside.position = {0.8, 0.0, 0.1};
-    inside.focalPoint = {0.0, 0.3, 0.0};
-    inside.viewUp = {0.0, 0.0, 1.0};
-    inside.viewAngle = 70.0;
-    Camera parallel;
-    parallel.position = {0.4 - 3.0, 0.3 - 1.0, -0.2 + 1.5};
-    parallel.focalPoint = {0.4, 0.3, -0.2};
-    parallel.viewUp = {0.0, 0.0, 1.0};
-    parallel.parallel = true;
-    parallel.parallelScale = 1.1;
     const json rotate = {{0, -1, 0, 0}, {1, 0, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}};
     const json sets[] = {{{"shells", 33}},
                          {{"shells", 17}, {"opacity", "radial"}},
@@ -576,12 +584,12 @@ TEST(SphericalFused, PacketsAreBitIdenticalToOnePixelPerWorkItem)
                          {{"shells", 24}, {"color_matrix", rotate}, {"bias", {0.3, 0.0, 0.0, 0.0}}}};
     const TransferFunction dense({{0.0, {0.1, 0.2, 0.6}, 2.0}, {0.5, {0.8, 0.4, 0.2}, 12.0}, {1.0, {1.0, 1.0, 0.9}, 30.0}});
     int compared = 0;
-    for (const Camera& camera : {obliqueCamera(), inside, parallel})
+    for (const Camera& camera : {obliqueCamera(), insideCamera(), parallelBallCamera()})
         for (const json& set : sets)
             for (int width : {61, 5}) {
                 json options = set;
                 if (camera.parallel)
-                    options.update({{"r_min", 0.0}, {"r_max", 0.9}, {"center", {0.4, 0.3, -0.2}}});
+                    options.update(ballOptions());
                 options["packets"] = true;
                 Scene packets = makeScene(camera, width, options);
                 packets.image.height = 43;
@@ -594,9 +602,7 @@ TEST(SphericalFused, PacketsAreBitIdenticalToOnePixelPerWorkItem)
                 const Image4f q = test::renderScene(pixels, atmosphere(), &qs);
                 const std::string label = options.dump() + " width " + std::to_string(width) +
                                           (camera.parallel ? " parallel" : camera.position.x == 0.8 ? " inside" : " outside");
-                ASSERT_EQ(p.pixelCount(), q.pixelCount());
-                EXPECT_EQ(std::memcmp(p.pixels().data(), q.pixels().data(), p.pixelCount() * sizeof(glm::vec4)), 0)
-                    << label;
+                EXPECT_TRUE(test::sameBits(p, q)) << label;
                 EXPECT_TRUE(ps.extra["packets"].get<bool>()) << label;
                 EXPECT_FALSE(qs.extra["packets"].get<bool>()) << label;
                 EXPECT_EQ(ps.samples, qs.samples) << label;

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -65,6 +66,21 @@ std::string repoData(const std::string& relative)
     path += "/data/";
     path += relative;
     return path;
+}
+
+testing::AssertionResult sameBits(const Image4f& a, const Image4f& b)
+{
+    if (a.width() != b.width() || a.height() != b.height())
+        return testing::AssertionFailure() << "sizes differ: " << a.width() << "x" << a.height() << " against " << b.width()
+                                           << "x" << b.height();
+    for (std::size_t i = 0; i < a.pixelCount(); ++i)
+        if (std::memcmp(&a.pixels()[i], &b.pixels()[i], sizeof(glm::vec4)) != 0) {
+            const glm::vec4 u = a.pixels()[i], v = b.pixels()[i];
+            return testing::AssertionFailure() << "pixel (" << i % a.width() << ", " << i / a.width() << ") differs: (" << u.r
+                                               << ", " << u.g << ", " << u.b << ", " << u.a << ") against (" << v.r << ", "
+                                               << v.g << ", " << v.b << ", " << v.a << ")";
+        }
+    return testing::AssertionSuccess();
 }
 
 testing::AssertionResult imagesNear(const Image4f& actual, const Image4d& expected, Tolerance tolerance)

@@ -49,6 +49,10 @@ struct Tolerance {
 using clvr::ImageError;
 using clvr::imageError;
 
+// Success when `a` and `b` have the same size and the same bits (memcmp), else the first differing pixel:
+// for kernels that must agree exactly (ray packets against one pixel per work-item).
+testing::AssertionResult sameBits(const Image4f& a, const Image4f& b);
+
 // Per channel max and mean absolute error against `expected`; fails on NaN or size mismatch.
 // On failure writes test_output/<suite>.<test>/{actual,expected,diff}.exr and says so.
 testing::AssertionResult imagesNear(const Image4f& actual, const Image4d& expected, Tolerance tolerance);
