@@ -49,10 +49,10 @@ Camera orbitCamera(const Camera& camera, int k, int n);
 // data bounds when the scene has none, opens the device (unless given) and sets up the technique's
 // renderer (upload, kernel builds; the Device's program cache keeps kernels across renderers).
 //
-// Camera changes: no technique's Renderer takes a new camera in place today (host/render/renderer.h has
-// only setTransferFunction), so setCamera() recreates the renderer from the data the Session keeps on
-// the host, on the same device, with the programs already built; the data is uploaded again. The images
-// are those a new Session with that camera would give.
+// Camera changes: a renderer that can take a new view in place (Renderer::setCamera; slice3d, the same
+// image size) keeps its data on the device; any other is recreated from the data the Session keeps on the
+// host, on the same device, with the programs already built (the data is uploaded again). Either way the
+// images are those a new Session with that camera would give.
 class Session {
 public:
     // Loads the data, opens the device `deviceSpec` names (as Device's constructor), sets up the renderer.
@@ -66,10 +66,10 @@ public:
     // Renders one frame with the current camera. Blocks until done. InternalError if the renderer returns an
     // image of another size than the scene's.
     Frame render();
-    // The camera of the following frames (validated: InputError); recreates the renderer (see above).
+    // The camera of the following frames (validated: InputError); the renderer takes it or is recreated (above).
     void setCamera(const Camera& camera);
     // The camera and the image size of the following frames (sort-first gives each rank a band of rows
-    // as its image: Camera::bandFullHeight); recreates the renderer as setCamera does.
+    // as its image: Camera::bandFullHeight); as setCamera.
     void setView(const Camera& camera, const ImageSpec& image);
 
     const Scene& scene() const { return scene_; }

@@ -21,12 +21,6 @@ Scene tinyScene()
                          R"(volume={"generator": "marschner-lobb", "dims": [16, 16, 16]})"});
 }
 
-bool sameBits(const Image4f& a, const Image4f& b)
-{
-    return a.width() == b.width() && a.height() == b.height() &&
-           std::memcmp(a.pixels().data(), b.pixels().data(), a.pixelCount() * sizeof(glm::vec4)) == 0;
-}
-
 // The angle from u to v about `axis` (both projected onto the plane normal to it), in degrees in [0, 360).
 double angleAbout(const glm::dvec3& u, const glm::dvec3& v, const glm::dvec3& axis)
 {
@@ -81,7 +75,7 @@ TEST(Session, CameraChangeMatchesAFreshSession)
     ASSERT_EQ(first.image.width(), 24);
     ASSERT_EQ(first.image.height(), 20);
     EXPECT_GT(first.stats.frameMs, 0.0);
-    EXPECT_TRUE(sameBits(session.render().image, first.image)) << "two frames of one camera differ";
+    EXPECT_TRUE(test::sameBits(session.render().image, first.image)) << "two frames of one camera differ";
     const nlohmann::json stats = session.stats(first);
     EXPECT_EQ(stats["technique"], "slice3d");
     EXPECT_EQ(stats["width"], 24);
@@ -92,15 +86,15 @@ TEST(Session, CameraChangeMatchesAFreshSession)
 
     session.setCamera(orbitCamera(camera0, 1, 3));
     const Frame turned = session.render();
-    EXPECT_FALSE(sameBits(turned.image, first.image)) << "frame 1 of 3 equals frame 0";
+    EXPECT_FALSE(test::sameBits(turned.image, first.image)) << "frame 1 of 3 equals frame 0";
 
     Scene turnedScene = scene;
     turnedScene.camera = orbitCamera(camera0, 1, 3);
     Session fresh(device, turnedScene, loadSceneData(turnedScene), "tiny");
-    EXPECT_TRUE(sameBits(fresh.render().image, turned.image)) << "setCamera differs from a new Session";
+    EXPECT_TRUE(test::sameBits(fresh.render().image, turned.image)) << "setCamera differs from a new Session";
 
     session.setCamera(orbitCamera(camera0, 3, 3));
-    EXPECT_TRUE(sameBits(session.render().image, first.image)) << "frame 3 of 3 differs from frame 0";
+    EXPECT_TRUE(test::sameBits(session.render().image, first.image)) << "frame 3 of 3 differs from frame 0";
 
     Camera bad = camera0;
     bad.position = bad.focalPoint;

@@ -595,6 +595,43 @@ TEST(Slice3dPackets, ClippedImagesAreBitIdenticalPreintegratedKeepsOnePixel)
     EXPECT_FALSE(pre.extra["packets"].get<bool>());
 }
 
+// Renderer::setCamera: a slice3d renderer pointed at new cameras gives the images new renderers give, bit
+// for bit, on every path that depends on the view in its own way — the fused kernel (slices, chords), a clip
+// mesh (its depth range and peeled layers, peeled again), the raster path (the fragment program's camera and
+// slab) with a clip mesh's stencil passes, pre-integration; a clip texture's placement does not move. A new
+// image size is refused (false): the caller makes a new renderer.
+TEST(Slice3dRenderer, SetCameraEqualsANewRenderer)
+{
+    const json sphereMesh = {{"generator", "sphere"}, {"center", {0.1, 0.0, 0.2}}, {"radius", 0.6}, {"segments", 24}};
+    const json sets[] = {{{"slices", 48}},
+                         {{"slices", 48}, {"packets", false}, {"order", "front-to-back"}, {"early_termination", 0.9}},
+                         {{"slices", 32}, {"integration", "preintegrated"}},
+                         {{"slices", 40}, {"clip", {{"mesh", sphereMesh}}}},
+                         {{"slices", 40}, {"clip_texture", {{"shape", "sphere"}, {"radius", 0.6}, {"inverse", true}}}},
+                         {{"slices", 32}, {"path", "raster"}},
+                         {{"slices", 32}, {"path", "raster"}, {"clip", {{"mesh", sphereMesh}, {"inverse", true}}}}};
+    Camera inside = perspectiveCamera();
+    inside.position = glm::mix(inside.position, inside.focalPoint, 0.9);  // inside the box
+    const Camera cameras[] = {perspectiveCamera(), parallelCamera(), inside, perspectiveCamera()};
+    for (const json& options : sets) {
+        Scene scene = makeScene(cameras[0], test::designTransferFunction(), 27, options);
+        scene.image.height = 22;
+        std::unique_ptr<Renderer> moved = makeRenderer(test::device(), scene, marschnerLobb41());
+        FrameStats stats;
+        moved->render(stats);  // a frame at the first camera first: whatever it leaves behind must not matter
+        for (std::size_t c = 1; c < std::size(cameras); ++c) {
+            scene.camera = cameras[c];
+            ASSERT_TRUE(moved->setCamera(scene)) << options.dump();
+            const Image4f a = moved->render(stats);
+            const Image4f b = test::renderScene(scene, marschnerLobb41());
+            EXPECT_TRUE(test::sameBits(a, b)) << options.dump() << " camera " << c;
+        }
+        Scene wider = scene;
+        wider.image.width = 28;
+        EXPECT_FALSE(moved->setCamera(wider)) << options.dump();
+    }
+}
+
 // Left out (or null), "packets" is on for CPU devices and off for the others (run GPU2: on an NVIDIA H200
 // the packet kernel took 2.7-4.2x the one-pixel kernel's time); given, it is what it says.
 TEST(Slice3dPackets, DefaultIsOnForCpuDevicesOnly)

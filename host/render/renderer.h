@@ -38,6 +38,15 @@ public:
     // depends on it is rebuilt — the packed control points, and tables derived from them — never the
     // volume or the mesh on the device. The result is the same image a new renderer would give.
     virtual void setTransferFunction(const TransferFunction& tf) = 0;
+    // Points the following frames at scene.camera and scene.image (the rest of `scene` as at creation),
+    // keeping what does not depend on the view — the data on the device, bricks, tables, kernels — and
+    // gives the same image a new renderer would. False where the technique cannot (the default, or a
+    // different image size): the caller then makes a new renderer (Session::setView does).
+    virtual bool setCamera(const Scene& scene)
+    {
+        (void)scene;
+        return false;
+    }
 };
 
 // The technique registry (host/render/renderer.cpp): every technique by name, with the data it

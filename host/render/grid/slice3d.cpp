@@ -49,6 +49,7 @@ public:
     Image4f render(FrameStats& stats) override;
     std::uint64_t residentBytes() const override { return residentBytes_; }
     void setTransferFunction(const TransferFunction& tf) override;
+    bool setCamera(const Scene& scene) override;
     void setClipPlacement(const glm::dvec3& offset, const glm::dmat3& matrix);
 
 private:
@@ -57,6 +58,8 @@ private:
     raster::DrawStats drawClipped(const std::vector<raster::Vertex>& slices, const std::vector<std::size_t>& firsts,
                                   const raster::DrawState& sliceState, const glm::dmat4& viewProjection);
     void peelClipMesh();
+    void frameView(const Scene& scene);
+    void setFragmentView();
 
     Device& device_;
     Slice3dOptions options_;
@@ -117,14 +120,9 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
     origin_ = part_.fullOrigin;
     lo_ = part_.fullBoundsMin();
     hi_ = part_.fullBoundsMax(spacing_);
-    camera_ = frameCamera(scene, lo_, hi_);
-    plan_ = planSlices(camera_, lo_, hi_, options_);
-    if (options_.clip) {
+    if (options_.clip)
         clipMesh_ = loadClipMesh(options_.clip->mesh, scene.baseDir);
-        clipDepthMax_ = -std::numeric_limits<double>::infinity();
-        for (const glm::dvec3& p : clipMesh_->points)
-            clipDepthMax_ = std::max(clipDepthMax_, glm::dot(camera_.forward(), p - camera_.position));
-    }
+    frameView(scene);
 
     if (options_.clipTexture) {
         clipTexture_ = makeClipTexture(*options_.clipTexture, scene.baseDir);
@@ -209,22 +207,52 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
         fragmentProgram_.buffers[0] = volume_;
         fragmentProgram_.buffers[1] = tf_.buffer();
         const glm::dvec3 invSpacing = 1.0 / spacing_;
-        fragmentUniforms_.camera = toClCamera(camera_, image_.width, image_.height);
-        fragmentUniforms_.frame = cl_float4{{static_cast<float>(image_.width), static_cast<float>(image_.height),
-                                             static_cast<float>(plan_.deltaS), static_cast<float>(tf_.count())}};
         fragmentUniforms_.grid_origin = toCl4(origin_);
         fragmentUniforms_.inv_spacing = toCl4(invSpacing);
         fragmentUniforms_.dims = cl_float4{{static_cast<float>(dims_.x), static_cast<float>(dims_.y),
                                             static_cast<float>(dims_.z), 0.0f}};
-        fragmentUniforms_.slab = cl_float4{{static_cast<float>(plan_.depth(0)), 0.0f, 0.0f, 0.0f}};
         if (clipTexture_) {  // the second texture: buffer 2, u->clip_tex, coordinates in attribute 1
             fragmentProgram_.buffers[2] = clipTexels_->buffer();
             const glm::ivec3 n = clipTexture_->dims();
             fragmentUniforms_.clip_tex = cl_float4{{static_cast<float>(n.x), static_cast<float>(n.y),
                                                     static_cast<float>(n.z), options_.clipTexture->inverse ? 1.0f : 0.0f}};
         }
-        fragmentProgram_.uniforms = fragmentUniforms(fragmentUniforms_);
+        setFragmentView();
     }
+}
+
+// What depends on the view: the framed camera, the slices, the clip mesh's depth range and (on the raster path)
+// the fragment program's camera and slab; the clip mesh's peeled layers are peeled again at the next frame.
+void Slice3dRenderer::frameView(const Scene& scene)
+{
+    image_ = scene.image;
+    camera_ = frameCamera(scene, lo_, hi_);
+    plan_ = planSlices(camera_, lo_, hi_, options_);
+    if (clipMesh_) {
+        clipDepthMax_ = -std::numeric_limits<double>::infinity();
+        for (const glm::dvec3& p : clipMesh_->points)
+            clipDepthMax_ = std::max(clipDepthMax_, glm::dot(camera_.forward(), p - camera_.position));
+        clipLayerCount_ = -1;
+    }
+}
+
+void Slice3dRenderer::setFragmentView()
+{
+    fragmentUniforms_.camera = toClCamera(camera_, image_.width, image_.height);
+    fragmentUniforms_.frame = cl_float4{{static_cast<float>(image_.width), static_cast<float>(image_.height),
+                                         static_cast<float>(plan_.deltaS), static_cast<float>(tf_.count())}};
+    fragmentUniforms_.slab = cl_float4{{static_cast<float>(plan_.depth(0)), 0.0f, 0.0f, 0.0f}};
+    fragmentProgram_.uniforms = fragmentUniforms(fragmentUniforms_);
+}
+
+bool Slice3dRenderer::setCamera(const Scene& scene)
+{
+    if (scene.image.width != image_.width || scene.image.height != image_.height)
+        return false;  // the image-sized buffers and frame buffer would change
+    frameView(scene);
+    if (options_.path == Slice3dOptions::Path::Raster)
+        setFragmentView();
+    return true;
 }
 
 void Slice3dRenderer::setClipPlacement(const glm::dvec3& offset, const glm::dmat3& matrix)
