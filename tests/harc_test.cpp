@@ -423,6 +423,42 @@ TEST(Harc, IdenticalBitsTwice)
     EXPECT_EQ(std::memcmp(a.pixels().data(), b.pixels().data(), a.pixelCount() * sizeof(glm::vec4)), 0);
 }
 
+// Renderer::setCamera: a harc renderer pointed at new cameras (outside, the eye inside the non-convex mesh,
+// parallel) gives the images new renderers give, bit for bit, with host and raster entry lists and full
+// pre-integration; a new image size is refused.
+TEST(Harc, SetCameraEqualsAFreshRenderer)
+{
+    // EyeInsideTheMeshStartsEveryRayInItsCell's mesh and inside camera
+    const std::vector<Box> boxes = {{{0.0, 0.0, 0.0}, {2.0, 1.0, 1.0}, 4}, {{0.0, 1.0, 0.0}, {1.0, 2.0, 1.0}, 3}};
+    TetMesh mesh = boxMesh(boxes, {0.3, 0.35, -0.4}, 0.4);
+    checkMesh(mesh);  // orients the cells, as every loader does
+    ASSERT_GE(locatePoint(mesh, glm::dvec3(0.55, 0.45, 0.6)), 0);
+    Camera parallel = perspective({3.5, -1.5, 2.5}, {1.0, 1.0, 0.5});
+    parallel.parallel = true;
+    parallel.parallelScale = 1.4;
+    const Camera cameras[] = {perspective({3.2, 2.6, 2.4}, {1.0, 1.0, 0.5}, 40.0),
+                              perspective({0.55, 0.45, 0.6}, {1.6, 1.3, 0.3}, 95.0), parallel,
+                              perspective({-1.5, 3.0, 1.8}, {1.0, 1.0, 0.5}, 40.0)};
+    for (const json& options : {json::object(), json{{"entry", "raster"}}, json{{"integration", "full"}}}) {
+        Scene scene = makeScene(cameras[0], rampTf(), 33, options);
+        auto moved = makeHarcRenderer(test::device(), scene, mesh, handTopology(mesh));
+        FrameStats stats;
+        moved->render(stats);
+        for (std::size_t c = 1; c < std::size(cameras); ++c) {
+            scene.camera = cameras[c];
+            ASSERT_TRUE(moved->setCamera(scene)) << options.dump();
+            const Image4f a = moved->render(stats);
+            EXPECT_TRUE(test::sameBits(a, renderHarc(scene, mesh))) << options.dump() << " camera " << c;
+            if (c == 1) {
+                EXPECT_GE(stats.extra["eye_tet"].get<std::int64_t>(), 0) << "the eye is inside the mesh";
+            }
+        }
+        Scene wider = scene;
+        wider.image.width = 34;
+        EXPECT_FALSE(moved->setCamera(wider)) << options.dump();
+    }
+}
+
 TEST(Harc, TransferFunctionChangeBetweenFramesEqualsAFreshRenderer)
 {
     const TetMesh mesh = boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, 3}}, {0.5, 0.3, 0.2}, 0.1);

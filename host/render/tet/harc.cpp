@@ -39,6 +39,9 @@ public:
     Image4f render(FrameStats& stats) override;
     std::uint64_t residentBytes() const override { return residentBytes_; }
     void setTransferFunction(const TransferFunction& tf) override;
+    // The entry lists, the eye's cell and the walk's camera follow the camera every frame anyway: only the
+    // framed camera changes here (the mesh, its topology and the tables stay on the device).
+    bool setCamera(const Scene& scene) override;
     // Integration::Iso: the last frame's hits as eye depths (harcIsoHitDepth).
     std::vector<double> isoHitDepth() const;
 
@@ -53,6 +56,7 @@ private:
     TetMesh mesh_;          // copies: the renderer outlives the caller's mesh
     TetTopology topology_;
     glm::dvec3 shift_{0.0};
+    glm::dvec3 lo_{0.0}, hi_{0.0};  // the mesh's bounds, which frame the camera (harcBounds)
     std::optional<MeshPart> part_;  // the box to integrate in, for a part of a larger mesh
     TransferFunctionUpload tf_;
     std::uint64_t maxSteps_ = 0;
@@ -87,10 +91,9 @@ HarcRenderer::HarcRenderer(Device& device, const Scene& scene, const TetMesh& me
         throw InternalError(mesh.source + ": topology does not match the mesh");
     // A part of a larger mesh (sort-last) computes in the full mesh's frame and integrates only inside
     // its box (host/model/mesh.h's MeshPart), so that the parts' images composite to the full one.
-    glm::dvec3 lo, hi;
-    harcBounds(mesh, lo, hi);
-    shift_ = 0.5 * (lo + hi);
-    camera_ = frameCamera(scene, lo, hi);
+    harcBounds(mesh, lo_, hi_);
+    shift_ = 0.5 * (lo_ + hi_);
+    camera_ = frameCamera(scene, lo_, hi_);
     part_ = mesh.part;
 
     counts_ = MeshCounts::of(mesh);
@@ -151,6 +154,15 @@ void HarcRenderer::buildFullTable(const TransferFunction& tf)
     full_ = device_.upload("harc full pre-integration table", table.values);
     fullBytes_ = table.bytes();
     fullBuildMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+bool HarcRenderer::setCamera(const Scene& scene)
+{
+    if (scene.image.width != image_.width || scene.image.height != image_.height)
+        return false;  // the image-sized buffers (and the raster entry's frame buffers) would change
+    image_ = scene.image;
+    camera_ = frameCamera(scene, lo_, hi_);
+    return true;
 }
 
 void HarcRenderer::setTransferFunction(const TransferFunction& tf)
