@@ -612,6 +612,40 @@ TEST(SphericalFused, PacketsAreBitIdenticalToOnePixelPerWorkItem)
     EXPECT_EQ(compared, 3 * 4 * 2);
 }
 
+// Renderer::setCamera: pointed at new cameras, the renderer gives the images new renderers give, bit for bit
+// (fused with and without packets, the shell passes, radial opacity); a new image size is refused.
+TEST(SphericalRender, SetCameraEqualsANewRenderer)
+{
+    Camera farther = obliqueCamera();
+    farther.position = {-2.0, 2.9, -1.2};
+    const Camera cameras[] = {obliqueCamera(), insideCamera(), farther};
+    const json sets[] = {{{"shells", 17}},
+                         {{"shells", 17}, {"packets", false}},
+                         {{"shells", 9}, {"segments", 16}, {"path", "raster"}},
+                         {{"shells", 12}, {"opacity", "radial"}, {"path", "raster"}, {"segments", 12}}};
+    for (const json& options : sets) {
+        Scene scene = makeScene(cameras[0], 29, options);
+        std::unique_ptr<Renderer> moved = makeRenderer(test::device(), scene, atmosphere());
+        FrameStats stats;
+        moved->render(stats);
+        for (std::size_t c = 1; c < std::size(cameras); ++c) {
+            scene.camera = cameras[c];
+            ASSERT_TRUE(moved->setCamera(scene)) << options.dump();
+            const Image4f a = moved->render(stats);
+            EXPECT_TRUE(test::sameBits(a, test::renderScene(scene, atmosphere()))) << options.dump() << " camera " << c;
+        }
+        Scene wider = scene;
+        wider.image.width = 30;
+        EXPECT_FALSE(moved->setCamera(wider)) << options.dump();
+    }
+    Scene ball = makeScene(obliqueCamera(), 29, ballOptions());
+    std::unique_ptr<Renderer> moved = makeRenderer(test::device(), ball, atmosphere());
+    ball.camera = parallelBallCamera();
+    ASSERT_TRUE(moved->setCamera(ball));
+    FrameStats stats;
+    EXPECT_TRUE(test::sameBits(moved->render(stats), test::renderScene(ball, atmosphere()))) << "parallel, full ball";
+}
+
 TEST(SphericalFused, PathOptions)
 {
     EXPECT_EQ(parseSphericalOptions(json::object()).path, SphericalOptions::Path::Fused);

@@ -234,8 +234,7 @@ SphericalRenderer::SphericalRenderer(Device& device, const Scene& scene, const V
         throw InputError("iso: technique spherical renders no iso-surfaces (no \"iso\")");
     checkGridVolume(volume, "spherical");
     dims_ = volume.dims;
-    const SphericalDomain& d = options_.domain;
-    camera_ = frameCamera(scene, d.center - d.rMax, d.center + d.rMax);
+    frameView(scene);
     shells_ = planShells(options_);
     texturedTransfer_ = composeTextureMap(options_.transfer, dims_);
     raster::validate(texturedTransfer_);
@@ -255,15 +254,8 @@ SphericalRenderer::SphericalRenderer(Device& device, const Scene& scene, const V
     image_ = std::make_unique<raster::Framebuffer>(device_, imageSpec_.width, imageSpec_.height);
     shellKernel_ = device_.kernel("spherical.cl", "spherical_shell");
 
-    // Near and far planes around the outer sphere's eye-depth range, as stack2d does for its box:
-    // depth is not tested, only the near plane matters (it removes what lies behind the camera).
-    const double dc = glm::dot(camera_.forward(), d.center - camera_.position);
-    const double dMin = dc - d.rMax, dMax = dc + d.rMax;
-    const double nearZ = camera_.parallel ? 0.0 : (dMin > 0.0 ? 0.5 * dMin : 1e-4 * std::max(dMax, 1e-30));
-    const double farZ = 2.0 * std::max(dMax, 0.0) + 1.0;
-    viewProjection_ = camera_.projectionMatrix(imageSpec_.width, imageSpec_.height, nearZ, farZ) * camera_.viewMatrix();
-
     if (options_.path == SphericalOptions::Path::Fused) {
+        const SphericalDomain& d = options_.domain;
         std::vector<glm::vec4> table;
         for (const Shell& shell : shells_)
             table.emplace_back(glm::dvec4(shell.radius, shell.rLo, shell.rHi, (shell.radius - d.rMin) / (d.rMax - d.rMin)));
@@ -276,6 +268,29 @@ SphericalRenderer::SphericalRenderer(Device& device, const Scene& scene, const V
                                        static_cast<std::size_t>(imageSpec_.width) * imageSpec_.height * sizeof(cl_uint),
                                        CL_MEM_WRITE_ONLY);
     }
+}
+
+// What depends on the view: the framed camera and the shells' view-projection (near and far planes around the
+// outer sphere's eye-depth range, as stack2d does for its box: depth is not tested, only the near plane
+// matters, it removes what lies behind the camera). Everything else is the data and the domain.
+void SphericalRenderer::frameView(const Scene& scene)
+{
+    const SphericalDomain& d = options_.domain;
+    imageSpec_ = scene.image;
+    camera_ = frameCamera(scene, d.center - d.rMax, d.center + d.rMax);
+    const double dc = glm::dot(camera_.forward(), d.center - camera_.position);
+    const double dMin = dc - d.rMax, dMax = dc + d.rMax;
+    const double nearZ = camera_.parallel ? 0.0 : (dMin > 0.0 ? 0.5 * dMin : 1e-4 * std::max(dMax, 1e-30));
+    const double farZ = 2.0 * std::max(dMax, 0.0) + 1.0;
+    viewProjection_ = camera_.projectionMatrix(imageSpec_.width, imageSpec_.height, nearZ, farZ) * camera_.viewMatrix();
+}
+
+bool SphericalRenderer::setCamera(const Scene& scene)
+{
+    if (scene.image.width != imageSpec_.width || scene.image.height != imageSpec_.height)
+        return false;  // the frame buffers would change
+    frameView(scene);
+    return true;
 }
 
 // The fused path: spherical_fused leaves the finished image (over the background) in image()'s color.

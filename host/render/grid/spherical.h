@@ -92,6 +92,7 @@ public:
     Image4f render(FrameStats& stats) override;
     std::uint64_t residentBytes() const override { return residentBytes_; }
     void setTransferFunction(const TransferFunction& tf) override;
+    bool setCamera(const Scene& scene) override;  // the camera and the shells' view-projection
 
     // One pass (for tests): shell `shell` of planShells, its far (back = true) or near hemisphere,
     // drawn, transferred and blended into image() as render() does. render() clears image() first.
@@ -124,6 +125,7 @@ private:
     bool packet_ = false;  // fused_ is spherical_fused_packet
     cl::Buffer shellTable_, fusedSamples_;
     std::uint64_t renderFused();
+    void frameView(const Scene& scene);
 };
 
 // Renderer for "spherical": uploads the volume as a one-channel float 3D texture and the packed
