@@ -148,7 +148,8 @@ void Session::setView(const Camera& camera, const ImageSpec& image)
         throw InputError("image: width and height must be at least 1");
     scene_.camera = camera;
     scene_.image = image;
-    // The renderer keeps its data where it can take a new view (Renderer::setCamera: slice3d, spherical, harc); else a new one.
+    // The renderer keeps its data where it can take a new view (Renderer::setCamera: slice3d, spherical, planes,
+    // blend, harc); else a new one.
     const Clock::time_point t0 = Clock::now();
     if (renderer_ && renderer_->setCamera(scene_)) {
         setupMs_ = msSince(t0);

@@ -49,10 +49,10 @@ Camera orbitCamera(const Camera& camera, int k, int n);
 // data bounds when the scene has none, opens the device (unless given) and sets up the technique's
 // renderer (upload, kernel builds; the Device's program cache keeps kernels across renderers).
 //
-// Camera changes: a renderer that can take a new view in place (Renderer::setCamera; slice3d, spherical and
-// harc, the same image size) keeps its data on the device; any other is recreated from the data the Session
-// keeps on the host, on the same device, with the programs already built (the data is uploaded again).
-// Either way the images are those a new Session with that camera would give.
+// Camera changes: a renderer that can take a new view in place (Renderer::setCamera; slice3d, spherical,
+// planes, blend and harc, the same image size) keeps its data on the device; any other is recreated from the
+// data the Session keeps on the host, on the same device, with the programs already built (the data is uploaded
+// again). Either way the images are those a new Session with that camera would give.
 class Session {
 public:
     // Loads the data, opens the device `deviceSpec` names (as Device's constructor), sets up the renderer.

@@ -150,6 +150,27 @@ TEST(Blend, OpacityThresholdWithinBound)
 
 // The two methods approximate the same integral: planes (no early termination) and blend agree within
 // the sum of their tolerances against the reference (measured well inside).
+// Renderer::setCamera: pointed at new cameras, blend gives the images new renderers give, bit for bit (the
+// slices and the reflectance map follow the eye); a new image size is refused.
+TEST(Blend, SetCameraEqualsANewRenderer)
+{
+    Camera behind = perspectiveCamera();
+    behind.position = 2.0 * behind.focalPoint - behind.position;
+    Scene scene = makeScene(perspectiveCamera(), {{"slices", 48}});
+    auto moved = makeRenderer(test::device(), scene, sphere33());
+    FrameStats stats;
+    moved->render(stats);
+    for (const Camera& camera : {parallelCamera(), behind}) {
+        scene.camera = camera;
+        ASSERT_TRUE(moved->setCamera(scene));
+        const Image4f a = moved->render(stats);
+        EXPECT_TRUE(test::sameBits(a, render(scene)));
+    }
+    Scene wider = scene;
+    wider.image.width = 41;
+    EXPECT_FALSE(moved->setCamera(wider));
+}
+
 TEST(Blend, AgreesWithPlanes)
 {
     const Scene blend = makeScene(perspectiveCamera(), {{"slices", 256}});

@@ -258,6 +258,29 @@ TEST(Planes, IdenticalBitsTwice)
     EXPECT_EQ(std::memcmp(a.pixels().data(), b.pixels().data(), a.pixelCount() * sizeof(glm::vec4)), 0);
 }
 
+// Renderer::setCamera: pointed at new cameras, planes gives the images new renderers give, bit for bit, shaded
+// (the reflectance map faces the new eye) and unshaded; a new image size is refused.
+TEST(Planes, SetCameraEqualsANewRenderer)
+{
+    Camera behind = perspectiveCamera();
+    behind.position = 2.0 * behind.focalPoint - behind.position;  // the other side
+    for (bool shaded : {true, false}) {
+        Scene scene = makeScene(perspectiveCamera(), json::object(), shaded, 31);
+        auto moved = makeRenderer(test::device(), scene, sphere33());
+        FrameStats stats;
+        moved->render(stats);
+        for (const Camera& camera : {parallelCamera(), behind}) {
+            scene.camera = camera;
+            ASSERT_TRUE(moved->setCamera(scene));
+            const Image4f a = moved->render(stats);
+            EXPECT_TRUE(test::sameBits(a, test::renderScene(scene, sphere33()))) << (shaded ? "shaded" : "unshaded");
+        }
+        Scene wider = scene;
+        wider.image.width = 32;
+        EXPECT_FALSE(moved->setCamera(wider));
+    }
+}
+
 // A blob at world (-0.5, +0.5, 0) seen from +z with y up lands in the image's upper left (row 0 at the
 // top), both cameras; lit from the upper left, its upper-left half is the brighter.
 TEST(Planes, AsymmetricBlobLandsUpperLeftLitFromUpperLeft)

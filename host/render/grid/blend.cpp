@@ -24,6 +24,7 @@ public:
     Image4f render(FrameStats& stats) override;
     std::uint64_t residentBytes() const override { return residentBytes_; }
     void setTransferFunction(const TransferFunction& tf) override;
+    bool setCamera(const Scene& scene) override;  // the camera, the slices and the reflectance map
 
 private:
     Device& device_;
@@ -32,6 +33,7 @@ private:
     ImageSpec image_;
     glm::ivec3 dims_;
     glm::dvec3 origin_, spacing_;  // the full grid's origin (a part's point 0 is inside it)
+    glm::dvec3 lo_{0.0}, hi_{0.0};  // the full grid's box, which frames the camera and bounds the slices
     GridPart part_;                // where the volume sits in the full grid (sort-last; else the whole)
     Lighting lighting_;
     SlicePlan plan_;
@@ -51,10 +53,11 @@ BlendRenderer::BlendRenderer(Device& device, const Scene& scene, const Volume& v
     // its ghost layer gives the Sobel gradients at its own points their neighbours (planes.cpp).
     part_ = volume.gridPart();
     origin_ = part_.fullOrigin;
-    const glm::dvec3 lo = part_.fullBoundsMin(), hi = part_.fullBoundsMax(spacing_);
-    camera_ = frameCamera(scene, lo, hi);
+    lo_ = part_.fullBoundsMin();
+    hi_ = part_.fullBoundsMax(spacing_);
+    camera_ = frameCamera(scene, lo_, hi_);
     // the same slab planning as slice3d
-    plan_ = planSlices(camera_, lo, hi, options_.slices, options_.sliceSpacing);
+    plan_ = planSlices(camera_, lo_, hi_, options_.slices, options_.sliceSpacing);
 
     const std::vector<glm::vec4> rgba = sobelGradientVolume(volume);
     volume_ = device_.upload("blend RGBA volume (gradient, value; float32)", rgba);
@@ -68,6 +71,19 @@ BlendRenderer::BlendRenderer(Device& device, const Scene& scene, const Volume& v
     out_ = device_.buffer("blend image", pixels * sizeof(cl_float4), CL_MEM_WRITE_ONLY);
     samples_ = device_.buffer("blend sample counts", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
     skipped_ = device_.buffer("blend skipped sample counts", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
+}
+
+bool BlendRenderer::setCamera(const Scene& scene)
+{
+    if (scene.image.width != image_.width || scene.image.height != image_.height)
+        return false;  // the image-sized buffers would change
+    image_ = scene.image;
+    camera_ = frameCamera(scene, lo_, hi_);
+    plan_ = planSlices(camera_, lo_, hi_, options_.slices, options_.sliceSpacing);
+    lighting_ = scene.lighting;
+    const ReflectanceMap map = buildReflectanceMap(lighting_, -camera_.forward(), options_.reflectanceMapSize);
+    map_ = device_.upload("blend reflectance map", map.entries);  // the same size: resident bytes unchanged
+    return true;
 }
 
 void BlendRenderer::setTransferFunction(const TransferFunction& tf)

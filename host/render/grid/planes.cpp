@@ -27,6 +27,7 @@ public:
     Image4f render(FrameStats& stats) override;
     std::uint64_t residentBytes() const override { return residentBytes_; }
     void setTransferFunction(const TransferFunction& tf) override;
+    bool setCamera(const Scene& scene) override;  // the camera and the reflectance map (it faces the eye)
 
 private:
     Device& device_;
@@ -41,6 +42,7 @@ private:
     glm::dvec3 toEye_;
     TransferFunctionUpload tf_;
     double gradientMs_ = 0.0, mapMs_ = 0.0;
+    std::uint64_t uploadReflectanceMap();
     cl::Buffer volume_, map_;
     cl::Buffer out_, samples_, skipped_, terminated_;
     cl::Kernel kernel_;
@@ -76,12 +78,7 @@ PlanesRenderer::PlanesRenderer(Device& device, const Scene& scene, const Volume&
     volume_ = device_.upload("planes RGBA volume (gradient, value; float32)", rgba);
     residentBytes_ = rgba.size() * sizeof(glm::vec4);
 
-    // The reflectance map, for these lights and this view direction (rebuilt with either).
-    t0 = std::chrono::steady_clock::now();
-    const ReflectanceMap map = buildReflectanceMap(lighting_, toEye_, options_.reflectanceMapSize);
-    mapMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    map_ = device_.upload("planes reflectance map", map.entries);
-    residentBytes_ += map.entries.size() * sizeof(glm::vec4);
+    residentBytes_ += uploadReflectanceMap();
 
     setTransferFunction(scene.transferFunction);
 
@@ -91,6 +88,28 @@ PlanesRenderer::PlanesRenderer(Device& device, const Scene& scene, const Volume&
     samples_ = device_.buffer("planes sample counts", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
     skipped_ = device_.buffer("planes skipped sample counts", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
     terminated_ = device_.buffer("planes terminated-ray flags", pixels, CL_MEM_WRITE_ONLY);
+}
+
+// The reflectance map, for these lights and this view direction (rebuilt with either); its bytes.
+std::uint64_t PlanesRenderer::uploadReflectanceMap()
+{
+    const auto t0 = std::chrono::steady_clock::now();
+    const ReflectanceMap map = buildReflectanceMap(lighting_, toEye_, options_.reflectanceMapSize);
+    mapMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    map_ = device_.upload("planes reflectance map", map.entries);
+    return map.entries.size() * sizeof(glm::vec4);
+}
+
+bool PlanesRenderer::setCamera(const Scene& scene)
+{
+    if (scene.image.width != image_.width || scene.image.height != image_.height)
+        return false;  // the image-sized buffers would change
+    image_ = scene.image;
+    camera_ = frameCamera(scene, lo_, hi_);
+    toEye_ = -camera_.forward();
+    lighting_ = scene.lighting;
+    uploadReflectanceMap();  // the same size: resident bytes unchanged
+    return true;
 }
 
 void PlanesRenderer::setTransferFunction(const TransferFunction& tf)
