@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstddef>
 #include <initializer_list>
 #include <optional>
 #include <string>
@@ -165,6 +166,17 @@ constexpr int kPacketLanes = 8;
 inline bool packetsOnDevice(const std::optional<bool>& packets, const std::string& deviceType)
 {
     return packets.value_or(deviceType == "CPU");
+}
+// "packets": true or false, or null for the device's default.
+inline std::optional<bool> packetsOption(const std::string& key, const nlohmann::json& value)
+{
+    return value.is_null() ? std::nullopt : std::optional<bool>(booleanOption(key, value));
+}
+// Work-items across a row of `width` pixels: one per pixel, or one per kPacketLanes with packets.
+inline std::size_t rowWorkItems(int width, bool packets)
+{
+    const auto w = static_cast<std::size_t>(width);
+    return packets ? (w + kPacketLanes - 1) / kPacketLanes : w;
 }
 inline OptionInfo clipTextureInfo()
 {

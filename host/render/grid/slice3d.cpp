@@ -371,9 +371,7 @@ Image4f Slice3dRenderer::renderFused(FrameStats& stats)
         params.psi_n = static_cast<cl_int>(psiTable().size);
     }
     fused_.setArg(a++, params);
-    // A packet work-item renders kPacketLanes pixels of its row.
-    device_.launch("slice3d: fused", fused_, packet_ ? (image_.width + kPacketLanes - 1) / kPacketLanes : image_.width,
-                   image_.height);
+    device_.launch("slice3d: fused", fused_, rowWorkItems(image_.width, packet_), image_.height);
 
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
     Image4f image = readImage(device_, out_, image_.width, image_.height);
@@ -693,7 +691,7 @@ Slice3dOptions parseSlice3dOptions(const nlohmann::json& options)
         } else if (key == "empty_space_skipping") {
             o.emptySpaceSkipping = booleanOption(key, value);
         } else if (key == "packets") {
-            o.packets = value.is_null() ? std::nullopt : std::optional<bool>(booleanOption(key, value));
+            o.packets = packetsOption(key, value);
         } else if (key == "clip") {
             o.clip = parseClip(value);
         } else if (key == "clip_texture") {

@@ -131,7 +131,7 @@ SphericalOptions parseSphericalOptions(const nlohmann::json& options)
         } else if (key == "early_termination") {
             o.earlyTermination = earlyTerminationOption(value);
         } else if (key == "packets") {
-            o.packets = value.is_null() ? std::nullopt : std::optional<bool>(booleanOption(key, value));
+            o.packets = packetsOption(key, value);
         } else {
             unparsedOption(info, key);
         }
@@ -323,9 +323,7 @@ std::uint64_t SphericalRenderer::renderFused()
     fused_.setArg(a++, tf_.buffer());
     fused_.setArg(a++, shellTable_);
     fused_.setArg(a++, p);
-    // A packet work-item renders kPacketLanes pixels of its row.
-    const std::size_t width = static_cast<std::size_t>(imageSpec_.width);
-    device_.launch("spherical: fused shells", fused_, packet_ ? (width + kPacketLanes - 1) / kPacketLanes : width,
+    device_.launch("spherical: fused shells", fused_, rowWorkItems(imageSpec_.width, packet_),
                    static_cast<std::size_t>(imageSpec_.height));
     std::uint64_t samples = 0;
     for (const cl_uint n : device_.download<cl_uint>(fusedSamples_, image_->pixelCount()))

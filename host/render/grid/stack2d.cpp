@@ -445,9 +445,7 @@ std::uint64_t Stack2dRenderer::renderFused(std::uint64_t& steppedOver)
     if (clipTexture_)
         fused_.setArg(a++, sliceTable_);  // one slice per quad: the table is empty, the texels start at 0
     fused_.setArg(a++, p);
-    // A packet work-item renders kPacketLanes pixels of its row.
-    device_.launch("stack2d: fused planes", fused_,
-                   packet_ ? (image_.width + kPacketLanes - 1) / kPacketLanes : image_.width, image_.height);
+    device_.launch("stack2d: fused planes", fused_, rowWorkItems(image_.width, packet_), image_.height);
     const std::size_t pixels = framebuffer_->pixelCount();
     std::uint64_t samples = 0;
     steppedOver = 0;
@@ -621,7 +619,7 @@ Stack2dOptions parseStack2dOptions(const nlohmann::json& options)
         else if (key == "empty_space_skipping")
             o.emptySpaceSkipping = booleanOption(key, value);
         else if (key == "packets")
-            o.packets = value.is_null() ? std::nullopt : std::optional<bool>(booleanOption(key, value));
+            o.packets = packetsOption(key, value);
         else if (key == "early_termination")
             o.earlyTermination = earlyTerminationOption(value);
         else
