@@ -18,6 +18,11 @@ std::string_view embeddedKernelSource(std::string_view name)
 
 std::string mapSourcePositions(std::string_view source, std::string_view log)
 {
+    static const std::regex position(R"re(<[A-Za-z ]{1,32}>:([0-9]{1,9}))re");
+    const std::string text(log);
+    if (!std::regex_search(text, position))
+        return text;  // nothing to map (PoCL and Mesa name files themselves): the source is not read
+
     // Where each line of the submitted source comes from: a "#line N \"file\"" marker says the next
     // line is line N of file (the file unchanged when the marker names none).
     struct Origin {
@@ -27,15 +32,21 @@ std::string mapSourcePositions(std::string_view source, std::string_view log)
     std::vector<Origin> origins;  // origins[r - 1]: line r of `source`
     static const std::regex marker(R"re(^[ \t]*#[ \t]*line[ \t]+([0-9]+)(?:[ \t]+"([^"]*)")?)re");
     Origin next{"", 1};
+    std::string line;
     std::size_t begin = 0;
     while (begin <= source.size()) {
         std::size_t end = source.find('\n', begin);
         if (end == std::string_view::npos)
             end = source.size();
-        const std::string line(source.substr(begin, end - begin));
+        const std::string_view view = source.substr(begin, end - begin);
         origins.push_back(next);
         std::smatch m;
-        if (std::regex_search(line, m, marker)) {
+        bool isMarker = false;
+        if (const std::size_t first = view.find_first_not_of(" \t"); first != std::string_view::npos && view[first] == '#') {
+            line.assign(view);  // only directives go through the regex
+            isMarker = std::regex_search(line, m, marker);
+        }
+        if (isMarker) {
             next.line = std::stol(m[1].str());
             if (m[2].matched)
                 next.file = m[2].str();
@@ -45,9 +56,7 @@ std::string mapSourcePositions(std::string_view source, std::string_view log)
         begin = end + 1;
     }
 
-    static const std::regex position(R"re(<[A-Za-z ]{1,32}>:([0-9]{1,9}))re");
     std::string mapped;
-    std::string text(log);
     auto last = text.cbegin();
     for (std::sregex_iterator it(text.begin(), text.end(), position), done; it != done; ++it) {
         const std::smatch& m = *it;
