@@ -27,6 +27,8 @@ public:
     bool setCamera(const Scene& scene) override;  // the camera, the slices and the reflectance map
 
 private:
+    std::uint64_t uploadReflectanceMap();
+
     Device& device_;
     BlendOptions options_;
     Camera camera_;
@@ -61,9 +63,7 @@ BlendRenderer::BlendRenderer(Device& device, const Scene& scene, const Volume& v
 
     const std::vector<glm::vec4> rgba = sobelGradientVolume(volume);
     volume_ = device_.upload("blend RGBA volume (gradient, value; float32)", rgba);
-    const ReflectanceMap map = buildReflectanceMap(lighting_, -camera_.forward(), options_.reflectanceMapSize);
-    map_ = device_.upload("blend reflectance map", map.entries);
-    residentBytes_ = (rgba.size() + map.entries.size()) * sizeof(glm::vec4);
+    residentBytes_ = rgba.size() * sizeof(glm::vec4) + uploadReflectanceMap();
     setTransferFunction(scene.transferFunction);
 
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
@@ -81,9 +81,16 @@ bool BlendRenderer::setCamera(const Scene& scene)
     camera_ = frameCamera(scene, lo_, hi_);
     plan_ = planSlices(camera_, lo_, hi_, options_.slices, options_.sliceSpacing);
     lighting_ = scene.lighting;
-    const ReflectanceMap map = buildReflectanceMap(lighting_, -camera_.forward(), options_.reflectanceMapSize);
-    map_ = device_.upload("blend reflectance map", map.entries);  // the same size: resident bytes unchanged
+    uploadReflectanceMap();  // the same size: resident bytes unchanged
     return true;
+}
+
+// The reflectance map, for these lights and this view direction; its bytes.
+std::uint64_t BlendRenderer::uploadReflectanceMap()
+{
+    const ReflectanceMap map = buildReflectanceMap(lighting_, -camera_.forward(), options_.reflectanceMapSize);
+    map_ = device_.upload("blend reflectance map", map.entries);
+    return map.entries.size() * sizeof(glm::vec4);
 }
 
 void BlendRenderer::setTransferFunction(const TransferFunction& tf)
