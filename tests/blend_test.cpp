@@ -156,19 +156,8 @@ TEST(Blend, SetCameraEqualsANewRenderer)
 {
     Camera behind = perspectiveCamera();
     behind.position = 2.0 * behind.focalPoint - behind.position;
-    Scene scene = makeScene(perspectiveCamera(), {{"slices", 48}});
-    auto moved = makeRenderer(test::device(), scene, sphere33());
-    FrameStats stats;
-    moved->render(stats);
-    for (const Camera& camera : {parallelCamera(), behind}) {
-        scene.camera = camera;
-        ASSERT_TRUE(moved->setCamera(scene));
-        const Image4f a = moved->render(stats);
-        EXPECT_TRUE(test::sameBits(a, render(scene)));
-    }
-    Scene wider = scene;
-    wider.image.width = 41;
-    EXPECT_FALSE(moved->setCamera(wider));
+    test::expectSetCameraEqualsNewRenderer(makeScene(perspectiveCamera(), {{"slices", 48}}), sphere33(),
+                                           {perspectiveCamera(), parallelCamera(), behind}, "blend");
 }
 
 TEST(Blend, AgreesWithPlanes)

@@ -264,21 +264,10 @@ TEST(Planes, SetCameraEqualsANewRenderer)
 {
     Camera behind = perspectiveCamera();
     behind.position = 2.0 * behind.focalPoint - behind.position;  // the other side
-    for (bool shaded : {true, false}) {
-        Scene scene = makeScene(perspectiveCamera(), json::object(), shaded, 31);
-        auto moved = makeRenderer(test::device(), scene, sphere33());
-        FrameStats stats;
-        moved->render(stats);
-        for (const Camera& camera : {parallelCamera(), behind}) {
-            scene.camera = camera;
-            ASSERT_TRUE(moved->setCamera(scene));
-            const Image4f a = moved->render(stats);
-            EXPECT_TRUE(test::sameBits(a, test::renderScene(scene, sphere33()))) << (shaded ? "shaded" : "unshaded");
-        }
-        Scene wider = scene;
-        wider.image.width = 32;
-        EXPECT_FALSE(moved->setCamera(wider));
-    }
+    for (bool shaded : {true, false})
+        test::expectSetCameraEqualsNewRenderer(makeScene(perspectiveCamera(), json::object(), shaded, 31), sphere33(),
+                                               {perspectiveCamera(), parallelCamera(), behind},
+                                               shaded ? "shaded" : "unshaded");
 }
 
 // A blob at world (-0.5, +0.5, 0) seen from +z with y up lands in the image's upper left (row 0 at the

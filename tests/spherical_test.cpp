@@ -618,32 +618,15 @@ TEST(SphericalRender, SetCameraEqualsANewRenderer)
 {
     Camera farther = obliqueCamera();
     farther.position = {-2.0, 2.9, -1.2};
-    const Camera cameras[] = {obliqueCamera(), insideCamera(), farther};
+    const std::vector<Camera> cameras = {obliqueCamera(), insideCamera(), farther};
     const json sets[] = {{{"shells", 17}},
                          {{"shells", 17}, {"packets", false}},
                          {{"shells", 9}, {"segments", 16}, {"path", "raster"}},
                          {{"shells", 12}, {"opacity", "radial"}, {"path", "raster"}, {"segments", 12}}};
-    for (const json& options : sets) {
-        Scene scene = makeScene(cameras[0], 29, options);
-        std::unique_ptr<Renderer> moved = makeRenderer(test::device(), scene, atmosphere());
-        FrameStats stats;
-        moved->render(stats);
-        for (std::size_t c = 1; c < std::size(cameras); ++c) {
-            scene.camera = cameras[c];
-            ASSERT_TRUE(moved->setCamera(scene)) << options.dump();
-            const Image4f a = moved->render(stats);
-            EXPECT_TRUE(test::sameBits(a, test::renderScene(scene, atmosphere()))) << options.dump() << " camera " << c;
-        }
-        Scene wider = scene;
-        wider.image.width = 30;
-        EXPECT_FALSE(moved->setCamera(wider)) << options.dump();
-    }
-    Scene ball = makeScene(obliqueCamera(), 29, ballOptions());
-    std::unique_ptr<Renderer> moved = makeRenderer(test::device(), ball, atmosphere());
-    ball.camera = parallelBallCamera();
-    ASSERT_TRUE(moved->setCamera(ball));
-    FrameStats stats;
-    EXPECT_TRUE(test::sameBits(moved->render(stats), test::renderScene(ball, atmosphere()))) << "parallel, full ball";
+    for (const json& options : sets)
+        test::expectSetCameraEqualsNewRenderer(makeScene(cameras[0], 29, options), atmosphere(), cameras, options.dump());
+    test::expectSetCameraEqualsNewRenderer(makeScene(obliqueCamera(), 29, ballOptions()), atmosphere(),
+                                           {obliqueCamera(), parallelBallCamera()}, "parallel, full ball");
 }
 
 TEST(SphericalFused, PathOptions)

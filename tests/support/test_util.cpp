@@ -68,6 +68,25 @@ std::string repoData(const std::string& relative)
     return path;
 }
 
+void expectSetCameraEqualsNewRenderer(Scene scene, const Volume& volume, const std::vector<Camera>& cameras,
+                                      const std::string& label)
+{
+    ASSERT_FALSE(cameras.empty());
+    scene.camera = cameras[0];
+    std::unique_ptr<Renderer> moved = makeRenderer(device(), scene, volume);
+    FrameStats stats;
+    moved->render(stats);
+    for (std::size_t c = 1; c < cameras.size(); ++c) {
+        scene.camera = cameras[c];
+        ASSERT_TRUE(moved->setCamera(scene)) << label;
+        const Image4f a = moved->render(stats);
+        EXPECT_TRUE(sameBits(a, renderScene(scene, volume))) << label << " camera " << c;
+    }
+    Scene wider = scene;
+    wider.image.width += 1;
+    EXPECT_FALSE(moved->setCamera(wider)) << label;
+}
+
 testing::AssertionResult sameBits(const Image4f& a, const Image4f& b)
 {
     if (a.width() != b.width() || a.height() != b.height())

@@ -49,6 +49,12 @@ struct Tolerance {
 using clvr::ImageError;
 using clvr::imageError;
 
+// Renderer::setCamera's promise, for a volume technique: a renderer made for `scene` at cameras[0] (one frame
+// rendered there first, so whatever it leaves behind is exercised) and pointed at each further camera
+// renders the bits a new renderer renders there; a wider image it refuses. `label` names the case in failures.
+void expectSetCameraEqualsNewRenderer(Scene scene, const Volume& volume, const std::vector<Camera>& cameras,
+                                      const std::string& label);
+
 // Success when `a` and `b` have the same size and the same bits (memcmp), else the first differing pixel:
 // for kernels that must agree exactly (ray packets against one pixel per work-item).
 testing::AssertionResult sameBits(const Image4f& a, const Image4f& b);
