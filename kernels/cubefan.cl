@@ -14,6 +14,7 @@
 #include "clvr_common.h"
 #include "cubefan_params.h"
 #include "transfer_function.h"
+#include "packet.h"
 
 #if defined(CLVR_CUBEFAN_FAN) || defined(CLVR_CUBEFAN_BOX)
 
@@ -101,6 +102,33 @@ static int cubefan_next(const int exit_axis, const int v, const int lo, const in
     return positive ? max(v, along) : min(v, along);
 }
 
+/* A pixel's ray in the selection grid's coordinates q = e + d t (t: world length, d a unit vector): e, its
+ * direction d (1e-30 along an axis the ray is parallel to: its exits there lie beyond any other), 1 / d, and
+ * [t, t_out), its part inside the box of the bricks that add color (outside it every cube is transparent) in
+ * front of the eye; t_out <= t: none. s: the pixel's image-plane offset (clvr_ray_window_offset). The
+ * perspective direction is normalized here, component by component, so that cubefan_fused_packet can repeat
+ * it lane by lane (normalize() has no 8-lane twin). */
+static void cubefan_ray(const float2 s, const ClCubefanFusedParams* p, float3* qe, float3* qd, float3* inv,
+                        float* t, float* t_out)
+{
+    const ClCamera cam = p->camera;
+    float3 e, d;
+    clvr_ray_depth(s, cam, &e, &d);
+    if (!clvr_ray_parallel(cam)) {
+        const float n2 = d.x * d.x + d.y * d.y + d.z * d.z;
+        d *= 1.0f / sqrt(n2);
+    }
+    *qe = (e - p->field_lo.xyz) * p->inv_spacing.xyz;
+    float3 q = d * p->inv_spacing.xyz;
+    q = select(q, copysign((float3)(1e-30f), q), isless(fabs(q), (float3)(1e-30f)));
+    *qd = q;
+    *inv = 1.0f / q;
+    const float3 t0 = (convert_float3(p->filled_lo.xyz) - *qe) * *inv, t1 = (convert_float3(p->filled_hi.xyz) - *qe) * *inv;
+    const float3 tn = fmin(t0, t1), tx = fmax(t0, t1);
+    *t = fmax(fmax(fmax(tn.x, tn.y), tn.z), 0.0f);
+    *t_out = fmin(fmin(tx.x, tx.y), tx.z);
+}
+
 kernel void cubefan_fused(global float4* out, global uint* steps, global uint* skipped, global const uchar* level,
                           global const float* value, global const uchar* space, global const float* tf,
                           const ClCubefanFusedParams p)
@@ -108,22 +136,13 @@ kernel void cubefan_fused(global float4* out, global uint* steps, global uint* s
     CLVR_GUARD_2D(p.width, p.height);
     const int x = (int)get_global_id(0), y = (int)get_global_id(1);
     const size_t pixel = (size_t)y * (size_t)p.width + (size_t)x;
-    float3 e, d;
-    clvr_ray_unit(clvr_ray_window_offset(clvr_ray_pixel_centre(x, y), (float2)((float)p.width, (float)p.height), p.camera),
-                  p.camera, &e, &d);
-    const float3 qe3 = (e - p.field_lo.xyz) * p.inv_spacing.xyz;
-    float3 qd3 = d * p.inv_spacing.xyz;
-    /* A ray parallel to an axis gets a direction of 1e-30 along it: its exits there lie beyond any other. */
-    qd3 = select(qd3, copysign((float3)(1e-30f), qd3), isless(fabs(qd3), (float3)(1e-30f)));
-    const float3 inv3 = 1.0f / qd3;
-    /* The ray's part inside the box of the bricks that add color: outside it every cube is transparent. */
+    float3 qe3, qd3, inv3;
+    float t, t_out;
+    cubefan_ray(clvr_ray_window_offset(clvr_ray_pixel_centre(x, y), (float2)((float)p.width, (float)p.height), p.camera),
+                &p, &qe3, &qd3, &inv3, &t, &t_out);
     const int3 box_lo = p.filled_lo.xyz, box_hi = p.filled_hi.xyz;
-    const float3 t0 = (convert_float3(box_lo) - qe3) * inv3, t1 = (convert_float3(box_hi) - qe3) * inv3;
-    const float3 tn = fmin(t0, t1), tx = fmax(t0, t1);
-    float t = fmax(fmax(fmax(tn.x, tn.y), tn.z), 0.0f);
-    const float t_out = fmin(fmin(tx.x, tx.y), tx.z);
-    /* The walk in scalars: PoCL runs it one work-item at a time (the rays diverge), and three-component
-     * vectors cost shuffles there. */
+    /* The walk in scalars (three-component vectors cost shuffles on CPUs; cubefan_fused_packet below walks 8
+     * rays as vector lanes, the same operations). */
     const float qex = qe3.x, qey = qe3.y, qez = qe3.z, qdx = qd3.x, qdy = qd3.y, qdz = qd3.z;
     const float ix = inv3.x, iy = inv3.y, iz = inv3.z;
     const int nx = p.dims.x, ny = p.dims.y, nz = p.dims.z;
@@ -181,5 +200,159 @@ kernel void cubefan_fused(global float4* out, global uint* steps, global uint* s
     out[pixel] = (float4)(c + transmittance * p.background.xyz, 1.0f - transmittance);
     steps[pixel] = crossed;
     skipped[pixel] = stepped_over;
+}
+
+/* cubefan_fused for 8 pixels of a row at once, one per lane of 8-wide vectors (kernels/packet.h; docs/cubefan.md,
+ * "Ray packets"): every lane walks its own ray through its own cubes, the same operations as cubefan_fused lane
+ * by lane, so the pixels are the same bits. A lane that has left the box or become opaque keeps its state
+ * while the others go on; the packet ends when none is left. The grid's entries are indexed in 32 bits (the
+ * host runs cubefan_fused where they do not fit). */
+static int8 cubefan_gather_level(global const uchar* level, const uint8 at)
+{
+    int8 v;
+#define CUBEFAN_GATHER(L) v.s##L = level[at.s##L];
+    CLVR_EACH_LANE(CUBEFAN_GATHER)
+#undef CUBEFAN_GATHER
+    return v;
+}
+
+static float8 cubefan_gather_value(global const float* value, const uint8 at)
+{
+    float8 v;
+#define CUBEFAN_GATHER(L) v.s##L = value[at.s##L];
+    CLVR_EACH_LANE(CUBEFAN_GATHER)
+#undef CUBEFAN_GATHER
+    return v;
+}
+
+/* cubefan_next lane by lane (exit: the lanes leaving by this axis' face; positive: the lanes whose ray goes up it). */
+static int8 cubefan_next8(const int8 exit, const int8 v, const int8 lo, const int8 hi, const int8 positive,
+                          const float8 e, const float8 d, const float8 t)
+{
+    const int8 along = clamp(convert_int8(floor(e + d * t)), lo, hi - 1);
+    return select(select(min(v, along), max(v, along), positive), select(lo - 1, hi, positive), exit);
+}
+
+kernel void cubefan_fused_packet(global float4* out, global uint* steps, global uint* skipped,
+                                 global const uchar* level, global const float* value, global const uchar* space,
+                                 global const float* tf, const ClCubefanFusedParams p)
+{
+    const int x0 = (int)get_global_id(0) * CLVR_LANES, y = (int)get_global_id(1);
+    if (x0 >= p.width || y >= p.height)
+        return;
+    const int3 box_lo = p.filled_lo.xyz, box_hi = p.filled_hi.xyz;
+    /* each lane's ray, cubefan_ray's expressions lane by lane (as slice3d_fused_packet: the row's offset s.y
+     * is one scalar, made a vector so that its products fuse into the sums as the float3 expressions' do) */
+    const ClCamera cam = p.camera;
+    const float2 size = (float2)((float)p.width, (float)p.height);
+    const float8 sy = clvr_ray_window_offset(clvr_ray_pixel_centre(x0, y), size, cam).y;
+    const float8 sx = (convert_float8(x0 + CLVR_LANE_INDEX) + 0.5f) / size.x * 2.0f - 1.0f;
+    const float8 s_x = sx * cam.params.x * cam.params.y;
+    float8 e_x, e_y, e_z, d_x, d_y, d_z;
+    if (clvr_ray_parallel(cam)) {
+        e_x = cam.position.x + s_x * cam.right.x + sy * cam.up.x;
+        e_y = cam.position.y + s_x * cam.right.y + sy * cam.up.y;
+        e_z = cam.position.z + s_x * cam.right.z + sy * cam.up.z;
+        d_x = cam.forward.x, d_y = cam.forward.y, d_z = cam.forward.z;
+    } else {
+        e_x = cam.position.x, e_y = cam.position.y, e_z = cam.position.z;
+        d_x = cam.forward.x + s_x * cam.right.x + sy * cam.up.x;
+        d_y = cam.forward.y + s_x * cam.right.y + sy * cam.up.y;
+        d_z = cam.forward.z + s_x * cam.right.z + sy * cam.up.z;
+        const float8 n2 = d_x * d_x + d_y * d_y + d_z * d_z;
+        const float8 inv_len = 1.0f / sqrt(n2);
+        d_x *= inv_len, d_y *= inv_len, d_z *= inv_len;
+    }
+    const float8 qex = (e_x - p.field_lo.x) * p.inv_spacing.x, qey = (e_y - p.field_lo.y) * p.inv_spacing.y,
+                 qez = (e_z - p.field_lo.z) * p.inv_spacing.z;
+    float8 qdx = d_x * p.inv_spacing.x, qdy = d_y * p.inv_spacing.y, qdz = d_z * p.inv_spacing.z;
+    qdx = select(qdx, copysign((float8)(1e-30f), qdx), isless(fabs(qdx), (float8)(1e-30f)));
+    qdy = select(qdy, copysign((float8)(1e-30f), qdy), isless(fabs(qdy), (float8)(1e-30f)));
+    qdz = select(qdz, copysign((float8)(1e-30f), qdz), isless(fabs(qdz), (float8)(1e-30f)));
+    const float8 ix = 1.0f / qdx, iy = 1.0f / qdy, iz = 1.0f / qdz;
+    const float8 t0x = ((float)box_lo.x - qex) * ix, t1x = ((float)box_hi.x - qex) * ix;
+    const float8 t0y = ((float)box_lo.y - qey) * iy, t1y = ((float)box_hi.y - qey) * iy;
+    const float8 t0z = ((float)box_lo.z - qez) * iz, t1z = ((float)box_hi.z - qez) * iz;
+    float8 t = fmax(fmax(fmax(fmin(t0x, t1x), fmin(t0y, t1y)), fmin(t0z, t1z)), 0.0f);
+    const float8 t_out = fmin(fmin(fmax(t0x, t1x), fmax(t0y, t1y)), fmax(t0z, t1z));
+    int8 vx = 0, vy = 0, vz = 0;
+    const int nx = p.dims.x, ny = p.dims.y, nz = p.dims.z;
+    const int8 px = isgreater(qdx, 0.0f), py = isgreater(qdy, 0.0f), pz = isgreater(qdz, 0.0f);
+    const uint bricks_x = (uint)((nx + 3) >> 2), bricks_y = (uint)((ny + 3) >> 2);
+    float8 c_r = 0.0f, c_g = 0.0f, c_b = 0.0f, transmittance = 1.0f;
+    int8 crossed = 0, stepped_over = 0;
+    /* lanes still walking: in the image, in the box, not opaque */
+    int8 live = (x0 + CLVR_LANE_INDEX < p.width) & isgreater(t_out, t);
+    vx = select(vx, clamp(convert_int8(floor(qex + qdx * t)), box_lo.x, box_hi.x - 1), live);
+    vy = select(vy, clamp(convert_int8(floor(qey + qdy * t)), box_lo.y, box_hi.y - 1), live);
+    vz = select(vz, clamp(convert_int8(floor(qez + qdz * t)), box_lo.z, box_hi.z - 1), live);
+    while (any(live)) {
+        /* cubefan_at lane by lane; the lanes that have stopped read entry 0 */
+        const uint8 brick = (convert_uint8(vz >> 2) * bricks_y + convert_uint8(vy >> 2)) * bricks_x + convert_uint8(vx >> 2);
+        const uint8 at = select((uint8)(0u), (brick << 6) | convert_uint8(((vz & 3) << 4) | ((vy & 3) << 2) | (vx & 3)), live);
+        const int8 code = cubefan_gather_level(level, at);
+        const int8 l = code & 0x7f;
+        const int8 side = (int8)(1) << l;
+        int8 lox = (vx >> l) << l, loy = (vy >> l) << l, loz = (vz >> l) << l;
+        int8 hix = min(lox + side, nx), hiy = min(loy + side, ny), hiz = min(loz + side, nz);
+        const int8 transparent = (code & 0x80) != 0;
+        if (any(transparent & live)) {
+            /* the cube of empty bricks around a transparent cube, where it is wider than the cube */
+            int8 r;
+#define CUBEFAN_SPACE(L) r.s##L = (int)space[at.s##L >> 6] - 1;
+            CLVR_EACH_LANE(CUBEFAN_SPACE)
+#undef CUBEFAN_SPACE
+            const int8 wide = transparent & (r >= 0) & (8 * r + 4 > side);
+            lox = select(lox, max(((vx >> 2) - r) << 2, 0), wide);
+            loy = select(loy, max(((vy >> 2) - r) << 2, 0), wide);
+            loz = select(loz, max(((vz >> 2) - r) << 2, 0), wide);
+            hix = select(hix, min(((vx >> 2) + r + 1) << 2, nx), wide);
+            hiy = select(hiy, min(((vy >> 2) + r + 1) << 2, ny), wide);
+            hiz = select(hiz, min(((vz >> 2) + r + 1) << 2, nz), wide);
+        }
+        const float8 tbx = (convert_float8(select(lox, hix, px)) - qex) * ix;
+        const float8 tby = (convert_float8(select(loy, hiy, py)) - qey) * iy;
+        const float8 tbz = (convert_float8(select(loz, hiz, pz)) - qez) * iz;
+        const int8 xy = islessequal(tbx, tby);
+        const int8 exit_x = xy & islessequal(tbx, tbz);
+        const int8 exit_y = ~xy & islessequal(tby, tbz);
+        const int8 exit_z = ~(exit_x | exit_y);
+        const float8 t_exit = fmax(select(select(tbz, tby, exit_y), tbx, exit_x), t);
+        const int8 opaque = live & ~transparent;
+        stepped_over -= live & transparent;
+        crossed -= opaque;
+        if (any(opaque)) {
+            float8 cr, cg, cb, tau;
+            clvr_tf_eval8(tf, p.tf_count, cubefan_gather_value(value, at), &cr, &cg, &cb, &tau);
+            const float8 alpha = 1.0f - clvr_exp2_8(tau * ((t - t_exit) * M_LOG2E_F));
+            const float8 ta = transmittance * alpha;
+            c_r = select(c_r, c_r + ta * cr, opaque);
+            c_g = select(c_g, c_g + ta * cg, opaque);
+            c_b = select(c_b, c_b + ta * cb, opaque);
+            transmittance = select(transmittance, transmittance * (1.0f - alpha), opaque);
+            live &= ~(opaque & isgreaterequal(1.0f - transmittance, p.ert_alpha));
+        }
+        t = t_exit;
+        const int8 nvx = cubefan_next8(exit_x, vx, lox, hix, px, qex, qdx, t);
+        const int8 nvy = cubefan_next8(exit_y, vy, loy, hiy, py, qey, qdy, t);
+        const int8 nvz = cubefan_next8(exit_z, vz, loz, hiz, pz, qez, qdz, t);
+        /* out of the box (a line leaves a box once) */
+        live &= (nvx >= box_lo.x) & (nvy >= box_lo.y) & (nvz >= box_lo.z) & (nvx < box_hi.x) & (nvy < box_hi.y) &
+                (nvz < box_hi.z);
+        vx = select(vx, nvx, live);
+        vy = select(vy, nvy, live);
+        vz = select(vz, nvz, live);
+    }
+    const size_t row = (size_t)y * (size_t)p.width;
+#define CUBEFAN_STORE(L)                                                                                             \
+    if (x0 + L < p.width) {                                                                                          \
+        const size_t pixel = row + (size_t)(x0 + L);                                                                 \
+        out[pixel] = (float4)((float3)(c_r.s##L, c_g.s##L, c_b.s##L) + transmittance.s##L * p.background.xyz,        \
+                              1.0f - transmittance.s##L);                                                            \
+        steps[pixel] = (uint)crossed.s##L;                                                                           \
+        skipped[pixel] = (uint)stepped_over.s##L;                                                                    \
+    }
+    CLVR_EACH_LANE(CUBEFAN_STORE)
+#undef CUBEFAN_STORE
 }
 #endif

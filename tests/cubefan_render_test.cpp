@@ -373,5 +373,55 @@ TEST(CubefanFused, EarlyTerminationStopsAtTheThreshold)
     EXPECT_GT(stopped, 48 * 48 / 10);
 }
 
+// Ray packets: cubefan_fused_packet walks 8 pixels' rays as vector lanes, each through its own cubes. The
+// same bits as one pixel per work-item, and the same cubes crossed and stepped over: perspective, parallel,
+// rays along the axes (two directions at 1e-30), the eye inside, three tolerances, a transfer function that
+// makes cubes transparent (the walk's empty-brick steps), early termination, and widths that leave lanes
+// out of the image (61) or hold a single partial packet (5).
+TEST(CubefanFused, PacketsAreBitIdenticalToOnePixelPerWorkItem)
+{
+    const Volume blobs = generateVolume("blobs", {41, 37, 30});
+    const TransferFunction sparse({{0.0, {0, 0, 0}, 0.0}, {0.35, {0, 0, 0}, 0.0}, {0.6, {1, 0.5, 0}, 6.0}, {1.0, {1, 1, 1}, 14.0}});
+    Camera inside;
+    inside.position = {0.13, -0.07, 0.41};
+    inside.focalPoint = {0.3, 0.2, -1.0};
+    inside.viewAngle = 70.0;
+    Camera down;
+    down.parallel = true;
+    down.focalPoint = glm::dvec3(0.0);
+    down.position = {0.0, 0.0, 3.0};
+    down.viewUp = {0, 1, 0};
+    down.parallelScale = 1.1;
+    const Camera cameras[] = {test::obliquePerspectiveCamera(30.0), test::obliqueParallelCamera(1.3), inside, down};
+    const json sets[] = {{{"error", 0.0}}, {{"error", 0.1}}, {{"error", 0.3}}, {{"error", 0.05}, {"early_termination", 0.6}}};
+    int compared = 0;
+    std::uint64_t steppedOver = 0;
+    for (const Camera& camera : cameras)
+        for (const json& set : sets)
+            for (const int width : {61, 5}) {
+                json options = set;
+                options["packets"] = true;
+                Scene packets = makeScene(camera, sparse, width, options);
+                packets.image.height = 23;
+                Scene pixels = packets;
+                pixels.options["packets"] = false;
+                FrameStats ps, qs;
+                const Image4f p = render(packets, blobs, &ps);
+                const Image4f q = render(pixels, blobs, &qs);
+                const std::string label = options.dump() + " width " + std::to_string(width) + " camera " +
+                                          std::to_string(&camera - cameras);
+                EXPECT_TRUE(test::sameBits(p, q)) << label;
+                EXPECT_TRUE(ps.extra["packets"].get<bool>()) << label;
+                EXPECT_FALSE(qs.extra["packets"].get<bool>()) << label;
+                EXPECT_EQ(count(ps, "cubes_crossed"), count(qs, "cubes_crossed")) << label;
+                EXPECT_EQ(count(ps, "cubes_stepped_over"), count(qs, "cubes_stepped_over")) << label;
+                EXPECT_GT(count(qs, "cubes_crossed"), 0u) << label;
+                steppedOver += count(qs, "cubes_stepped_over");
+                ++compared;
+            }
+    EXPECT_EQ(compared, 4 * 4 * 2);
+    EXPECT_GT(steppedOver, 0u);  // the transparent cubes' steps were compared too
+}
+
 }  // namespace
 }  // namespace clvr

@@ -249,6 +249,7 @@ private:
     glm::ivec3 dims_{0};
     glm::dvec3 spacing_{1.0};
     cl::Kernel fused_;
+    bool packet_ = false;  // fused_ is cubefan_fused_packet
     cl::Buffer gridLevel_, gridValue_, gridSpace_, fusedSteps_, fusedSkipped_;
     bool gridCurrent_ = false;
     cubefan::SelectionStats gridStats_;
@@ -292,7 +293,9 @@ CubefanRenderer::CubefanRenderer(Device& device, const Scene& scene, const Volum
         const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
         fusedSteps_ = device_.buffer("cubefan cubes crossed per pixel", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
         fusedSkipped_ = device_.buffer("cubefan cubes stepped over per pixel", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
-        fused_ = device_.kernel("cubefan.cl", "cubefan_fused");
+        // Ray packets (docs/cubefan.md): the same walk on 8 pixels at once, its entries indexed in 32 bits.
+        packet_ = packetsOnDevice(options_.packets, device_.listing().type) && entries <= 0xffffffffu;
+        fused_ = device_.kernel("cubefan.cl", packet_ ? "cubefan_fused_packet" : "cubefan_fused");
         return;
     }
     overBackground_.emplace(device_);
@@ -372,7 +375,7 @@ Image4f CubefanRenderer::renderFused(FrameStats& stats)
     fused_.setArg(a++, gridSpace_);
     fused_.setArg(a++, tf_.buffer());
     fused_.setArg(a++, p);
-    device_.launch("cubefan: fused cube walk", fused_, image_.width, image_.height);
+    device_.launch("cubefan: fused cube walk", fused_, rowWorkItems(image_.width, packet_), image_.height);
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
     std::uint64_t crossed = 0, steppedOver = 0;
     for (const cl_uint n : device_.download<cl_uint>(fusedSteps_, pixels))
@@ -388,6 +391,7 @@ Image4f CubefanRenderer::renderFused(FrameStats& stats)
     stats.extra["selection_ms"] = gridMs;
     stats.extra["selection_grid_ms"] = gridMs_;
     stats.extra["selection_visited"] = gridStats_.visited;
+    stats.extra["packets"] = packet_;
     stats.extra["cubes"] = gridStats_.selected;
     stats.extra["cubes_transparent"] = gridStats_.transparent;
     stats.extra["cubes_crossed"] = crossed;
@@ -541,6 +545,7 @@ TechniqueInfo cubefanTechnique()
          "(the paper's triangle fans through the raster stage); opacity, texture_size or thickness other than "
          "their defaults take \"raster\""},
         earlyTerminationInfo(1.0),
+        packetsInfo(),
     };
     t.makeForVolume = [](Device& device, const Scene& scene, const Volume& volume) -> std::unique_ptr<Renderer> {
         return makeCubefanRenderer(device, scene, volume);
@@ -577,6 +582,8 @@ CubefanOptions parseCubefanOptions(const nlohmann::json& options)
                                                                        : CubefanOptions::Path::Raster;
         } else if (key == "early_termination") {
             o.earlyTermination = earlyTerminationOption(value);
+        } else if (key == "packets") {
+            o.packets = packetsOption(key, value);
         } else {
             unparsedOption(info, key);
         }

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include <memory>
+#include <optional>
 #include <vector>
 
 namespace clvr {
@@ -39,6 +40,9 @@ struct CubefanOptions {
     enum class Path { Fused, Raster };
     Path path = Path::Fused;
     double earlyTermination = 1.0;  // fused path: stop a ray once its opacity reaches this (1 = off)
+    // Fused path: 8 neighbouring pixels per work-item, one per float8 lane (kernels/cubefan.cl's
+    // cubefan_fused_packet; the same bits). Unset: on CPU devices only (packetsOnDevice, options_util.h).
+    std::optional<bool> packets;
 };
 
 const char* opacityName(CubefanOptions::Opacity opacity);
@@ -48,7 +52,7 @@ TechniqueInfo cubefanTechnique();
 
 // Reads the scene's "options" for cubefan: "error" (a number in [0, 1]), "opacity" ("texture" | "exp" |
 // "linear"), "texture_size" (an integer in [2, 4096]), "thickness" ("interpolated" | "exact"), "path"
-// ("fused" | "raster"), "early_termination" (in (0, 1], fused path). InputError naming the key otherwise.
+// ("fused" | "raster"), "early_termination" (in (0, 1], fused path), "packets" (true | false | null, fused path). InputError naming the key otherwise.
 CubefanOptions parseCubefanOptions(const nlohmann::json& options);
 
 // The exp-opacity texture of §7, N x N floats, x fastest: texel (i, j) = 1 - exp(-k u v) with
