@@ -423,5 +423,24 @@ TEST(CubefanFused, PacketsAreBitIdenticalToOnePixelPerWorkItem)
     EXPECT_GT(steppedOver, 0u);  // the transparent cubes' steps were compared too
 }
 
+// Renderer::setCamera, both paths: pointed at new cameras (perspective, parallel, the eye inside) the renderer
+// gives the bits a new renderer gives — the fused walk with and without packets, the fans selecting and
+// projecting for the new eye —; a wider image it refuses.
+TEST(CubefanRenderer, SetCameraEqualsANewRenderer)
+{
+    const Volume volume = generateVolume("marschner-lobb", {21, 21, 21});
+    Camera inside;
+    inside.position = {0.13, -0.07, 0.41};
+    inside.focalPoint = {0.3, 0.2, -1.0};
+    inside.viewAngle = 70.0;
+    const std::vector<Camera> cameras = {test::obliquePerspectiveCamera(30.0), test::obliqueParallelCamera(1.3), inside};
+    Scene scene = makeScene(cameras[0], test::designTransferFunction(), 23);
+    for (const json& options : {json{{"error", 0.1}}, json{{"error", 0.1}, {"packets", false}},
+                                json{{"error", 0.1}, {"path", "raster"}}, json{{"thickness", "exact"}}}) {
+        scene.options = options;
+        test::expectSetCameraEqualsNewRenderer(scene, volume, cameras, options.dump());
+    }
+}
+
 }  // namespace
 }  // namespace clvr

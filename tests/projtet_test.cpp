@@ -668,5 +668,18 @@ TEST(ProjtetMeshes, PostMatchesExactReference)
     }
 }
 
+// Renderer::setCamera: pointed at new cameras (perspective, the eye inside the mesh, parallel) the renderer
+// sorts, projects and draws what a new renderer draws, bit for bit; a wider image it refuses.
+TEST(Projtet, SetCameraEqualsANewRenderer)
+{
+    const TetMesh mesh = boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, 3}}, {0.6, 0.25, -0.4}, 0.35);
+    const std::vector<Camera> cameras = {boxCamera(false), perspective({0.45, 0.55, 0.5}, {1.5, 1.2, 0.2}, 90.0),
+                                         boxCamera(true), perspective({-1.2, 2.1, -0.8})};
+    test::expectSetCameraEqualsNewRenderer(
+        makeScene(cameras[0], test::rampTransferFunction(), 31),
+        [&](const Scene& s) { return makeProjtetRenderer(test::device(), s, mesh, buildTopology(mesh)); }, cameras,
+        "projtet");
+}
+
 }  // namespace
 }  // namespace clvr

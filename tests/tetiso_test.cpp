@@ -439,5 +439,21 @@ TEST(TetisoFused, IdenticalBitsTwiceAndTheColorFromTheTransferFunction)
     EXPECT_FALSE(edited.pixels() == a.pixels());
 }
 
+// Renderer::setCamera, both paths: pointed at new cameras the renderer draws (and lights: the headlight
+// follows the view) what a new renderer draws, bit for bit; a wider image it refuses.
+TEST(Tetiso, SetCameraEqualsANewRenderer)
+{
+    const TetMesh mesh = coneMesh(6, kConeCenter);
+    Camera parallel = perspective({2.0, -1.0, 1.0}, {0.5, 0.5, 0.5});
+    parallel.parallel = true;
+    parallel.parallelScale = 0.8;
+    const std::vector<Camera> cameras = {perspective({1.7, 1.3, 2.4}, {0.5, 0.5, 0.5}, 30.0),
+                                         perspective({-1.1, 0.2, 2.0}, {0.5, 0.5, 0.5}, 30.0), parallel};
+    for (const char* path : {"fused", "raster"})
+        test::expectSetCameraEqualsNewRenderer(
+            isoScene(cameras[0], 27, 0.6, json::object(), path),
+            [&](const Scene& s) { return makeTetisoRenderer(test::device(), s, mesh); }, cameras, path);
+}
+
 }  // namespace
 }  // namespace clvr

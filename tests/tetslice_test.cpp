@@ -285,5 +285,25 @@ TEST(Tetslice, StatsCountReorientedAndDegenerateCells)
     EXPECT_EQ(stats.extra["tets_degenerate"].get<std::uint64_t>(), mesh.tetsDegenerate);
 }
 
+// Renderer::setCamera, both paths: pointed at new cameras (the slices planned again: their count and depths
+// follow the view) the renderer draws what a new renderer draws, bit for bit; a wider image it refuses.
+TEST(Tetslice, SetCameraEqualsANewRenderer)
+{
+    const TetMesh mesh = test::boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, 3}}, {0.6, 0.25, -0.4}, 0.35);
+    Camera parallel = perspective({2.2, -0.9, 1.1}, {0.5, 0.5, 0.5});
+    parallel.parallel = true;
+    parallel.parallelScale = 0.9;
+    const std::vector<Camera> cameras = {perspective({1.9, 1.4, 2.6}, {0.5, 0.5, 0.5}, 35.0),
+                                         perspective({-0.8, 2.5, 0.3}, {0.5, 0.5, 0.5}, 35.0), parallel};
+    for (const char* path : {"fused", "raster"})
+        for (const json& slices : {json{{"slices", 40}}, json{{"slice_spacing", 0.05}}}) {
+            json options = slices;
+            options["path"] = path;
+            test::expectSetCameraEqualsNewRenderer(
+                makeScene(cameras[0], rampTf(), 29, options),
+                [&](const Scene& s) { return makeTetsliceRenderer(test::device(), s, mesh); }, cameras, options.dump());
+        }
+}
+
 }  // namespace
 }  // namespace clvr

@@ -68,23 +68,31 @@ std::string repoData(const std::string& relative)
     return path;
 }
 
-void expectSetCameraEqualsNewRenderer(Scene scene, const Volume& volume, const std::vector<Camera>& cameras,
-                                      const std::string& label)
+void expectSetCameraEqualsNewRenderer(Scene scene, const std::function<std::unique_ptr<Renderer>(const Scene&)>& make,
+                                      const std::vector<Camera>& cameras, const std::string& label)
 {
     ASSERT_FALSE(cameras.empty());
     scene.camera = cameras[0];
-    std::unique_ptr<Renderer> moved = makeRenderer(device(), scene, volume);
+    std::unique_ptr<Renderer> moved = make(scene);
     FrameStats stats;
     moved->render(stats);
     for (std::size_t c = 1; c < cameras.size(); ++c) {
         scene.camera = cameras[c];
         ASSERT_TRUE(moved->setCamera(scene)) << label;
         const Image4f a = moved->render(stats);
-        EXPECT_TRUE(sameBits(a, renderScene(scene, volume))) << label << " camera " << c;
+        FrameStats fresh;
+        EXPECT_TRUE(sameBits(a, make(scene)->render(fresh))) << label << " camera " << c;
     }
     Scene wider = scene;
     wider.image.width += 1;
     EXPECT_FALSE(moved->setCamera(wider)) << label;
+}
+
+void expectSetCameraEqualsNewRenderer(Scene scene, const Volume& volume, const std::vector<Camera>& cameras,
+                                      const std::string& label)
+{
+    expectSetCameraEqualsNewRenderer(
+        std::move(scene), [&](const Scene& s) { return makeRenderer(device(), s, volume); }, cameras, label);
 }
 
 testing::AssertionResult sameBits(const Image4f& a, const Image4f& b)

@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <string>
 
 namespace clvr::test {
@@ -49,9 +50,12 @@ struct Tolerance {
 using clvr::ImageError;
 using clvr::imageError;
 
-// Renderer::setCamera's promise, for a volume technique: a renderer made for `scene` at cameras[0] (one frame
-// rendered there first, so whatever it leaves behind is exercised) and pointed at each further camera
-// renders the bits a new renderer renders there; a wider image it refuses. `label` names the case in failures.
+// Renderer::setCamera's promise: a renderer made by `make` for `scene` at cameras[0] (one frame rendered there
+// first, so whatever it leaves behind is exercised) and pointed at each further camera renders the bits a new
+// renderer renders there; a wider image it refuses. `label` names the case in failures.
+void expectSetCameraEqualsNewRenderer(Scene scene, const std::function<std::unique_ptr<Renderer>(const Scene&)>& make,
+                                      const std::vector<Camera>& cameras, const std::string& label);
+// The same for a volume technique (makeRenderer).
 void expectSetCameraEqualsNewRenderer(Scene scene, const Volume& volume, const std::vector<Camera>& cameras,
                                       const std::string& label);
 

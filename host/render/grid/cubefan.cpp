@@ -219,6 +219,16 @@ public:
         textureK_ = -1.0;  // tau_max may have changed
         gridCurrent_ = false;  // which cubes are transparent may have changed
     }
+    // Both paths work from camera_ every frame (the raster path selects and projects per frame; the fused path's
+    // selection grid does not depend on the view): a new view is a new camera.
+    bool setCamera(const Scene& scene) override
+    {
+        if (scene.image.width != image_.width || scene.image.height != image_.height)
+            return false;  // the frame buffer and the per-pixel counts would change
+        image_ = scene.image;
+        camera_ = frameCamera(scene, volumeLo_, volumeHi_);
+        return true;
+    }
 
 private:
     Image4f renderRaster(FrameStats& stats);
@@ -231,6 +241,7 @@ private:
     Camera camera_;
     ImageSpec image_;
     glm::dvec3 shift_{0.0}, lo_{0.0}, hi_{0.0};  // the cube field's box
+    glm::dvec3 volumeLo_{0.0}, volumeHi_{0.0};     // the volume's bounds, which frame the camera
     TransferFunction tfHost_;
     TransferFunctionUpload tf_;
     std::unique_ptr<cubefan::CubeOctree> octree_;
@@ -266,7 +277,9 @@ CubefanRenderer::CubefanRenderer(Device& device, const Scene& scene, const Volum
     checkGridVolume(volume, "cubefan");
     if (volume.part)
         throw InputError(volume.source + ": cubefan renders whole volumes only (no sort-last parts)");
-    camera_ = frameCamera(scene, volume.boundsMin(), volume.boundsMax());
+    volumeLo_ = volume.boundsMin();
+    volumeHi_ = volume.boundsMax();
+    camera_ = frameCamera(scene, volumeLo_, volumeHi_);
     cubefan::cubeFieldBounds(volume, lo_, hi_);
     shift_ = 0.5 * (lo_ + hi_);
     // The octree holds mean, min and max per cube of every level (8/7 of the voxels): 12 bytes a voxel

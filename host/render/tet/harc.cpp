@@ -42,6 +42,17 @@ public:
     // The entry lists, the eye's cell and the walk's camera follow the camera every frame anyway: only the
     // framed camera changes here (the mesh, its topology and the tables stay on the device).
     bool setCamera(const Scene& scene) override;
+    // setCamera with the view-dependent options of tetslice's and tetiso's fused paths (harcSetView).
+    bool setView(const Scene& scene, const HarcOptions& view)
+    {
+        if (!setCamera(scene))
+            return false;
+        options_.sliceDepth0 = view.sliceDepth0;
+        options_.sliceSpacing = view.sliceSpacing;
+        options_.sliceCount = view.sliceCount;
+        options_.iso.light = view.iso.light;
+        return true;
+    }
     // Integration::Iso: the last frame's hits as eye depths (harcIsoHitDepth).
     std::vector<double> isoHitDepth() const;
 
@@ -339,6 +350,14 @@ std::vector<double> harcIsoHitDepth(const Renderer& renderer)
     if (!harc)
         throw InternalError("harcIsoHitDepth: not a harc renderer");
     return harc->isoHitDepth();
+}
+
+bool harcSetView(Renderer& renderer, const Scene& scene, const HarcOptions& view)
+{
+    auto* harc = dynamic_cast<HarcRenderer*>(&renderer);
+    if (!harc)
+        throw InternalError("harcSetView: not a harc renderer");
+    return harc->setView(scene, view);
 }
 
 TechniqueInfo harcTechnique()

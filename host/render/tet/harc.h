@@ -112,6 +112,11 @@ std::unique_ptr<Renderer> makeHarcRenderer(Device& device, const Scene& scene, c
 std::unique_ptr<Renderer> makeHarcRenderer(Device& device, const Scene& scene, const TetMesh& mesh,
                                            const TetTopology& topology, const HarcOptions& options);
 
+// Renderer::setCamera for tetslice's and tetiso's fused paths: points a harc renderer at the scene's camera
+// with the view's slices (sliceDepth0, sliceSpacing, sliceCount) and iso light taken from `view`; false where
+// setCamera refuses (another image size). InternalError for any other renderer.
+bool harcSetView(Renderer& renderer, const Scene& scene, const HarcOptions& view);
+
 // For a harc renderer made with Integration::Iso, after a frame: the eye depth of each pixel's iso-surface
 // hit (row 0 at the top), +infinity where its ray found none. InternalError for any other renderer.
 std::vector<double> harcIsoHitDepth(const Renderer& renderer);

@@ -582,11 +582,21 @@ public:
     {
         tf_.replace(device_, "projtet transfer function", tf, residentBytes_);
     }
+    // Every frame sorts, projects and draws from camera_: a new view is a new camera.
+    bool setCamera(const Scene& scene) override
+    {
+        if (scene.image.width != image_.width || scene.image.height != image_.height)
+            return false;  // the frame buffer would change
+        image_ = scene.image;
+        camera_ = frameCamera(scene, meshLo_, meshHi_);
+        return true;
+    }
 
 private:
     Device& device_;
     ProjtetOptions options_;
     Camera camera_;  // world coordinates (the host's sort and projection are in double)
+    glm::dvec3 meshLo_{0.0}, meshHi_{0.0};  // the mesh's bounds, which frame the camera
     ImageSpec image_;
     glm::dvec3 shift_{0.0};
     std::vector<glm::dvec3> points_;
@@ -613,7 +623,9 @@ ProjtetRenderer::ProjtetRenderer(Device& device, const Scene& scene, const TetMe
         throw InputError(mesh.source + ": projtet needs a mesh with at least one tetrahedron");
     if (mesh.tets.size() >= (std::size_t(1) << 24))
         throw InputError(mesh.source + ": projtet takes fewer than 2^24 tetrahedra (ids in two 12-bit halves)");
-    camera_ = frameCamera(scene, mesh.boundsMin(), mesh.boundsMax());
+    meshLo_ = mesh.boundsMin();
+    meshHi_ = mesh.boundsMax();
+    camera_ = frameCamera(scene, meshLo_, meshHi_);
     counts_ = MeshCounts::of(mesh);
     const std::vector<cl_float4> cells = packHarcTets(mesh, topology, shift_);
     cells_ = device_.upload("projtet tetrahedra (harc's 80 bytes each)", cells);

@@ -171,6 +171,17 @@ public:
     std::uint64_t residentBytes() const override { return 0; }  // everything is drawn from the host
     void setTransferFunction(const TransferFunction& tf) override { color_ = surfaceColor(tf); }
     std::vector<double> hitDepth() override;
+    // Every frame draws from camera_ (and lights from it): a new view is a new camera.
+    bool setCamera(const Scene& scene) override
+    {
+        if (scene.image.width != image_.width || scene.image.height != image_.height)
+            return false;  // the frame buffer and the per-pixel buffers would change
+        image_ = scene.image;
+        camera_ = frameCamera(scene, meshLo_, meshHi_);
+        camera_.position -= shift_;
+        camera_.focalPoint -= shift_;
+        return true;
+    }
 
 private:
     glm::dvec3 surfaceColor(const TransferFunction& tf) const
@@ -185,6 +196,7 @@ private:
     Camera camera_;  // relative to shift_
     ImageSpec image_;
     glm::dvec3 shift_{0.0};
+    glm::dvec3 meshLo_{0.0}, meshHi_{0.0};  // the mesh box in world coordinates, which frames the camera
     CellFaces cells_;
     std::vector<float> scalars_;            // normalized to [0, 1] over the mesh's range
     std::vector<glm::dvec3> normals_;       // -gradient / |gradient| per point (0 where the gradient is 0)
@@ -213,8 +225,9 @@ Tetiso::Tetiso(Device& device, const Scene& scene, const TetMesh& mesh)
 {
     iso_ = checkedIso(scene);
     color_ = surfaceColor(scene.transferFunction);
-    const glm::dvec3 lo = mesh.boundsMin(), hi = mesh.boundsMax();
-    camera_ = frameCamera(scene, lo, hi);
+    meshLo_ = mesh.boundsMin();
+    meshHi_ = mesh.boundsMax();
+    camera_ = frameCamera(scene, meshLo_, meshHi_);
     camera_.position -= shift_;
     camera_.focalPoint -= shift_;
     counts_ = MeshCounts::of(mesh);
@@ -424,20 +437,19 @@ std::vector<double> Tetiso::hitDepth()
 class TetisoFused final : public TetisoRenderer {
 public:
     TetisoFused(Device& device, const Scene& scene, const TetMesh& mesh)
+        : iso_(checkedIso(scene)), lo_(mesh.boundsMin()), hi_(mesh.boundsMax())
     {
         const TetisoOptions options = parseTetisoOptions(scene.options);
-        const IsoSpec iso = checkedIso(scene);
         HarcOptions harc;
         harc.integration = HarcOptions::Integration::Iso;
-        harc.iso.value = iso.value;
+        harc.iso.value = iso_.value;
         harc.iso.normals = vertexNormals(mesh);
-        harc.iso.light = iso.lightFor(frameCamera(scene, mesh.boundsMin(), mesh.boundsMax()));
-        harc.iso.ambient = iso.ambient;
-        harc.iso.diffuse = iso.diffuse;
-        harc.iso.shaded = iso.shading != IsoSpec::Shading::None;
+        harc.iso.light = iso_.lightFor(frameCamera(scene, lo_, hi_));
+        harc.iso.ambient = iso_.ambient;
+        harc.iso.diffuse = iso_.diffuse;
+        harc.iso.shaded = iso_.shading != IsoSpec::Shading::None;
         harc.iso.equalWeights = options.weights == TetisoOptions::Weights::Equal;
         weights_ = options.weights == TetisoOptions::Weights::Equal ? "equal" : "interpolated";
-        isoValue_ = iso.value;
         walk_ = makeHarcRenderer(device, scene, mesh, buildTopology(mesh), harc);
     }
     Image4f render(FrameStats& stats) override
@@ -446,17 +458,25 @@ public:
         stats.samples = 0;
         stats.extra["path"] = "fused";
         stats.extra["pixels_hit"] = stats.extra["pieces"];  // the walk's count of rays that found a crossing
-        stats.extra["iso_value"] = isoValue_;
+        stats.extra["iso_value"] = iso_.value;
         stats.extra["weights"] = weights_;
         return image;
     }
     std::uint64_t residentBytes() const override { return walk_->residentBytes(); }
     void setTransferFunction(const TransferFunction& tf) override { walk_->setTransferFunction(tf); }
     std::vector<double> hitDepth() override { return harcIsoHitDepth(*walk_); }
+    // The walk takes the new camera and the light that follows it (IsoSpec::lightFor).
+    bool setCamera(const Scene& scene) override
+    {
+        HarcOptions view;
+        view.iso.light = iso_.lightFor(frameCamera(scene, lo_, hi_));
+        return harcSetView(*walk_, scene, view);
+    }
 
 private:
+    IsoSpec iso_;
+    glm::dvec3 lo_, hi_;  // the mesh box, which frames the camera
     std::unique_ptr<Renderer> walk_;
-    double isoValue_ = 0.0;
     std::string weights_;
 };
 

@@ -111,6 +111,17 @@ public:
     {
         tf_.replace(device_, "tetslice transfer function", tf, residentBytes_);
     }
+    // Every frame plans its slices and draws them from camera_: a new view is a new camera.
+    bool setCamera(const Scene& scene) override
+    {
+        if (scene.image.width != image_.width || scene.image.height != image_.height)
+            return false;  // the frame buffer and the image would change
+        image_ = scene.image;
+        camera_ = frameCamera(scene, meshLo_, meshHi_);
+        camera_.position -= shift_;
+        camera_.focalPoint -= shift_;
+        return true;
+    }
 
 private:
     Device& device_;
@@ -118,6 +129,7 @@ private:
     Camera camera_;  // relative to shift_
     ImageSpec image_;
     glm::dvec3 shift_{0.0}, lo_{0.0}, hi_{0.0};  // lo_, hi_: the mesh box, shifted
+    glm::dvec3 meshLo_{0.0}, meshHi_{0.0};       // the mesh box in world coordinates, which frames the camera
     CellFaces cells_;
     std::vector<float> scalars_;
     MeshCounts counts_;
@@ -138,6 +150,8 @@ TetsliceRenderer::TetsliceRenderer(Device& device, const Scene& scene, const Tet
     const glm::dvec3 lo = mesh.boundsMin(), hi = mesh.boundsMax();
     lo_ = lo - shift_;
     hi_ = hi - shift_;
+    meshLo_ = lo;
+    meshHi_ = hi;
     camera_ = frameCamera(scene, lo, hi);
     camera_.position -= shift_;
     camera_.focalPoint -= shift_;
@@ -332,19 +346,9 @@ namespace {
 class TetsliceFusedRenderer final : public Renderer {
 public:
     TetsliceFusedRenderer(Device& device, const Scene& scene, const TetMesh& mesh)
+        : options_(parseTetsliceOptions(scene.options)), lo_(mesh.boundsMin()), hi_(mesh.boundsMax())
     {
-        const TetsliceOptions options = parseTetsliceOptions(scene.options);
-        const glm::dvec3 lo = mesh.boundsMin(), hi = mesh.boundsMax(), shift = 0.5 * (lo + hi);
-        Camera camera = frameCamera(scene, lo, hi);
-        camera.position -= shift;
-        camera.focalPoint -= shift;
-        plan_ = planSlices(camera, lo - shift, hi - shift, options.slices, options.sliceSpacing);
-        HarcOptions harc;
-        harc.integration = HarcOptions::Integration::Slices;
-        harc.sliceDepth0 = plan_.count ? plan_.depth(0) : 0.0;
-        harc.sliceSpacing = plan_.deltaS > 0.0 ? plan_.deltaS : 1.0;
-        harc.sliceCount = plan_.count;
-        walk_ = makeHarcRenderer(device, scene, mesh, buildTopology(mesh), harc);
+        walk_ = makeHarcRenderer(device, scene, mesh, buildTopology(mesh), view(scene));
     }
     Image4f render(FrameStats& stats) override
     {
@@ -357,8 +361,35 @@ public:
     }
     std::uint64_t residentBytes() const override { return walk_->residentBytes(); }
     void setTransferFunction(const TransferFunction& tf) override { walk_->setTransferFunction(tf); }
+    bool setCamera(const Scene& scene) override
+    {
+        const SlicePlan previous = plan_;
+        if (harcSetView(*walk_, scene, view(scene)))
+            return true;
+        plan_ = previous;  // refused: the walk keeps its view
+        return false;
+    }
 
 private:
+    // The walk's options for the scene's view: the slices the raster path plans (its camera frame and mesh box,
+    // so the same eye depths); plan_ becomes that plan.
+    HarcOptions view(const Scene& scene)
+    {
+        const glm::dvec3 shift = 0.5 * (lo_ + hi_);
+        Camera camera = frameCamera(scene, lo_, hi_);
+        camera.position -= shift;
+        camera.focalPoint -= shift;
+        plan_ = planSlices(camera, lo_ - shift, hi_ - shift, options_.slices, options_.sliceSpacing);
+        HarcOptions harc;
+        harc.integration = HarcOptions::Integration::Slices;
+        harc.sliceDepth0 = plan_.count ? plan_.depth(0) : 0.0;
+        harc.sliceSpacing = plan_.deltaS > 0.0 ? plan_.deltaS : 1.0;
+        harc.sliceCount = plan_.count;
+        return harc;
+    }
+
+    TetsliceOptions options_;
+    glm::dvec3 lo_, hi_;  // the mesh box
     SlicePlan plan_;
     std::unique_ptr<Renderer> walk_;
 };
