@@ -834,5 +834,26 @@ TEST(Iso3dHeadlight, HeadsqSkinIsLitWithoutALight)
     EXPECT_GT(luminance / covered, kHeadsqMinLuminance) << "covered pixels are nearly black";
 }
 
+// Renderer::setCamera: pointed at new cameras (perspective, parallel, inside the box) the renderer plans its
+// slices again and turns the headlight with the view, and renders the bits a new renderer renders — the fused
+// walk, the slice draws, bricks, gradientless shading's shifted lookup —; a wider image it refuses.
+TEST(Iso3d, SetCameraEqualsANewRenderer)
+{
+    const std::vector<Camera> cameras = {perspectiveCamera(), parallelCamera(), insideCamera()};
+    const json sets[] = {{{"slices", 96}}, {{"slices", 96}, {"path", "raster"}}, {{"slices", 64}, {"bricks", {2, 1, 2}}}};
+    for (const json& options : sets)
+        for (const IsoSpec::Shading shading : {IsoSpec::Shading::Gradient, IsoSpec::Shading::Gradientless}) {
+            if (options.contains("bricks") && shading == IsoSpec::Shading::Gradientless)
+                continue;  // refused: gradientless shading's lookup leaves the brick
+            Scene scene = makeScene(cameras[0], 0.5, options);
+            scene.image.width = scene.image.height = 37;
+            scene.iso->light.reset();  // the headlight: it turns with the camera
+            scene.iso->shading = shading;
+            test::expectSetCameraEqualsNewRenderer(scene, sphere33(), cameras,
+                                                   options.dump() + (shading == IsoSpec::Shading::Gradient ? " gradient"
+                                                                                                           : " gradientless"));
+        }
+}
+
 }  // namespace
 }  // namespace clvr

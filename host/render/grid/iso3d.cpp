@@ -42,6 +42,19 @@ public:
     void setTransferFunction(const TransferFunction& tf) override;
     std::vector<double> hitDepth() override;
     double sliceSpacing() const override { return plan_.deltaS; }
+    // The volumes, bricks and programs do not depend on the view: a new camera plans its slices again, and
+    // the headlight (IsoSpec::lightFor) follows it, with gradientless shading's shift along the light.
+    bool setCamera(const Scene& scene) override
+    {
+        if (scene.image.width != image_.width || scene.image.height != image_.height)
+            return false;  // the frame buffer and the per-pixel buffers would change
+        image_ = scene.image;
+        camera_ = frameCamera(scene, lo_, hi_);
+        iso_.light = isoSurface(scene, camera_).light;  // the color stays: setTransferFunction may have set it
+        plan_ = planSlices(camera_, lo_, hi_, options_.slices, options_.sliceSpacing);
+        setTextureShift();
+        return true;
+    }
 
 private:
     Device& device_;
@@ -77,6 +90,12 @@ private:
     MemoryBricks bricks_;
     std::vector<std::vector<glm::vec4>> brickData_;
 
+    // Gradientless shading's Delta L along the light, in texture coordinates (textureShift_).
+    void setTextureShift()
+    {
+        if (iso_.shading == IsoSurface::Shading::Gradientless)
+            textureShift_ = glm::vec4(glm::vec3(gradientlessStep_ * iso_.light / (spacing_ * glm::dvec3(dims_))), 0.0f);
+    }
     raster::DrawStats drawSlices(const glm::dmat4& viewProjection, FrameStats& stats);
     raster::DrawStats drawFused();
     raster::DrawStats drawBricks(const raster::DrawState& state, const std::vector<raster::Vertex>& vertices,
@@ -210,7 +229,7 @@ Iso3dRendererImpl::Iso3dRendererImpl(Device& device, const Scene& scene, const V
                                  ? options_.gradientlessScale
                                  : 1.0 / (gradientlessStep_ * medianGradientAtIso(volume, iso_.value));
         // Delta L in world units -> grid units (/ spacing) -> texture coordinates (/ n).
-        textureShift_ = glm::vec4(glm::vec3(gradientlessStep_ * iso_.light / (volume.spacing * glm::dvec3(volume.dims))), 0.0f);
+        setTextureShift();
     }
 }
 
