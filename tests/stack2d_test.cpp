@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <cstring>
 #include <map>
+#include <set>
 
 namespace clvr {
 namespace {
@@ -781,6 +782,51 @@ TEST(Stack2dFused, PathOptions)
     test::renderScene(makeScene(perspectiveCamera(), 16, {{"slices_per_polygon", 3}}), marschnerLobb41(), &stats);
     EXPECT_EQ(stats.extra["path"], "raster");
     EXPECT_EQ(stats.extra["polygons"], 14);  // 41 planes, 3 per quad
+}
+
+// Renderer::setCamera: pointed at cameras that draw other stacks (z, x, y and the eye inside) the renderer plans
+// its slices again, renames its bricks for the new stack, rebuilds the reflectance map and the slice table and
+// turns the headlight, and renders the bits a new renderer renders, on both paths and in every mode; a wider
+// image it refuses.
+TEST(Stack2dRender, SetCameraEqualsANewRenderer)
+{
+    Camera alongY = perspectiveCamera();
+    alongY.position = {0.4, -3.2, 0.7};
+    const std::vector<Camera> cameras = {perspectiveCamera(), parallelCamera(), alongY, insideCamera()};
+    std::set<int> axes;
+    for (const Camera& c : cameras)
+        axes.insert(stackAxis(c));
+    ASSERT_EQ(axes.size(), 3u) << "the cameras draw all three stacks";
+    // blobs on a grid of three sizes, zero on the lower part of the range: empty bricks, other ones per stack, for
+    // the fused path to rename and skip
+    const Volume blobs = generateVolume("blobs", {41, 36, 27});
+    const TransferFunction sparse({{0.0, {0, 0, 0}, 0.0}, {0.45, {0, 0, 0}, 0.0}, {0.7, {1, 0.5, 0}, 6.0}, {1.0, {1, 1, 1}, 12.0}});
+    struct Case {
+        const char* name;
+        json options;
+        int mode;  // 0 plain, 1 shaded, 2 iso-surface
+    };
+    const Case cases[] = {{"fused", {{"intermediate", 1}}, 0},
+                          {"fused, one pixel per work-item", {{"packets", false}}, 0},
+                          {"raster", {{"path", "raster"}}, 0},
+                          {"raster, 3 slices per polygon", {{"path", "raster"}, {"slices_per_polygon", 3}}, 0},
+                          {"fused, clip texture", {{"clip_texture", {{"shape", "sphere"}, {"center", {0.1, -0.1, 0.2}}, {"radius", 0.55}}}}, 0},
+                          {"fused, shaded", json::object(), 1},
+                          {"raster, shaded", {{"path", "raster"}}, 1},
+                          {"fused, iso-surface", json::object(), 2},
+                          {"raster, iso-surface, 2 slices per polygon", {{"path", "raster"}, {"slices_per_polygon", 2}}, 2}};
+    for (const Case& c : cases) {
+        Scene scene = c.mode == 1 ? shadedScene(cameras[0], c.options) : makeScene(cameras[0], 29, c.options);
+        scene.image.width = scene.image.height = 29;
+        if (c.mode == 0)
+            scene.transferFunction = sparse;
+        if (c.mode == 2) {
+            scene.transferFunction = TransferFunction();
+            scene.iso = test::isoSpec(0.5, {0.4, 0.6, 1.0}, 0.15, 0.8);
+            scene.iso->light.reset();  // the headlight: it turns with the camera
+        }
+        test::expectSetCameraEqualsNewRenderer(scene, c.mode == 0 ? blobs : sphere33(), cameras, c.name);
+    }
 }
 
 }  // namespace

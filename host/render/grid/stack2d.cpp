@@ -77,11 +77,14 @@ public:
     Image4f render(FrameStats& stats) override;
     std::uint64_t residentBytes() const override { return residentBytes_; }
     void setTransferFunction(const TransferFunction& tf) override;
+    bool setCamera(const Scene& scene) override;
     void setClipPlacement(const glm::dvec3& offset, const glm::dmat3& matrix);
 
 private:
     void setClipCoordinateUniforms();
-    void setUpFused(const Volume& volume, const TransferFunction& tf);
+    void setView(const Scene& scene);
+    void setUpFused(const Volume& volume);
+    void setEmptySpace();
     std::uint64_t renderFused(std::uint64_t& steppedOver);
     raster::DrawStats drawQuads();
 
@@ -97,7 +100,7 @@ private:
     struct Iso {
         double value = 0.0;
         bool gradientShading = true;  // "shading": "gradient"; "none": flat surface color
-        glm::dvec3 light{0.0};        // towards the light; default: the headlight, -forward
+        glm::dvec3 light{0.0};        // towards the light; default: the headlight, -forward (setView)
         double ambient = 0.1, diffuse = 0.9;
         glm::dvec3 color{1.0};        // the transfer function's color at the value, or white
         double dataMin = 0.0, dataMax = 1.0;
@@ -106,12 +109,15 @@ private:
     int axis_ = 2;
     std::vector<StackSlice> slices_;
     SliceGroups grouped_;  // slices_per_polygon > 1 only
+    int channels_ = 1;     // per texel of the stacks: the value, or (gradient, value)
     cl::Buffer sliceTable_;  // buffer[3]: the slice table (slices_per_polygon > 1), then the clip texels
+    std::uint64_t sliceTableBytes_ = 0;
     // Clip texture: the texture and world -> clip-texture coordinates.
     std::optional<ClipTexture> clipTexture_;
     glm::dmat4 clipCoordinates_{1.0};
     std::vector<raster::Texture> stacks_;  // x, y, z: all three stay resident, as on the paper's boards
     TransferFunctionUpload tf_;
+    TransferFunction tfHost_;  // which bricks are empty depends on it
     cl::Buffer map_;
     std::uint64_t residentBytes_ = 0;
     std::unique_ptr<raster::Framebuffer> framebuffer_;
@@ -121,11 +127,12 @@ private:
     cl::Kernel isoFinish_;
     // The fused path: its kernel, samples per pixel (planes met in the box, and of them stepped over), and
     // the empty-space radii of the bricks of the drawn stack's grid (kernels/empty_space.h), kept with the
-    // bricks' min-max for a new transfer function.
+    // bricks' min-max for a new transfer function; volumeBricks_: the same bricks in the volume's axis order,
+    // renamed into brickGrid_ for each stack drawn.
     cl::Kernel fused_;
     bool packet_ = false;  // fused_ is stack2d_fused_packet
     cl::Buffer fusedSamples_, fusedSkipped_, space_, noMap_;
-    BrickGrid brickGrid_;
+    BrickGrid volumeBricks_, brickGrid_;
     std::uint64_t emptyBrickCount_ = 0;
 };
 
@@ -139,14 +146,12 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
     spacing_ = volume.spacing;
     lo_ = volume.boundsMin();
     hi_ = volume.boundsMax();
-    camera_ = frameCamera(scene, lo_, hi_);
     if (scene.iso) {
         Iso iso;
         iso.value = scene.iso->value;
         if (scene.iso->shading == IsoSpec::Shading::Gradientless)
             throw InputError("iso.shading: stack2d knows \"gradient\" and \"none\", got \"gradientless\"");
         iso.gradientShading = scene.iso->shading == IsoSpec::Shading::Gradient;
-        iso.light = scene.iso->lightFor(camera_);
         iso.ambient = scene.iso->ambient;
         iso.diffuse = scene.iso->diffuse;
         if (!scene.transferFunction.points().empty())
@@ -161,13 +166,11 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
         clipCoordinates_ =
             clipTextureCoordinates(*clipTexture_, options_.clipTexture->offset, options_.clipTexture->matrix);
     }
-    axis_ = stackAxis(camera_);
-    slices_ = planStack(camera_, origin_, spacing_, dims_, axis_, options_.intermediate);
 
     // Unshaded: the values (1 channel). Shaded or iso-surface: (gradient, value) per texel, the paper's
     // RGBA slices with the gradient in RGB, so that one bilinear fetch (and the lerp) interpolates both.
     const bool gradients = lighting_.shaded() || iso_;
-    const int channels = gradients ? 4 : 1;
+    channels_ = gradients ? 4 : 1;
     std::vector<glm::vec4> rgba;
     if (gradients)
         rgba = sobelGradientVolume(volume);
@@ -178,17 +181,11 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
         desc.width = dims_[s.b];
         desc.height = dims_[s.c];
         desc.depth = dims_[a];
-        desc.channels = channels;
+        desc.channels = channels_;
         desc.filter = raster::Filter::Linear;
         desc.wrap = raster::Wrap::ClampToEdge;
-        stacks_.emplace_back(device_, desc, stackTexels(points, dims_, channels, a));
+        stacks_.emplace_back(device_, desc, stackTexels(points, dims_, channels_, a));
         residentBytes_ += stacks_.back().bytes();
-    }
-    // The map holds one view direction for the image (-forward), as in planes and blend.
-    if (lighting_.shaded()) {
-        const ReflectanceMap map = buildReflectanceMap(lighting_, -camera_.forward(), options_.reflectanceMapSize);
-        map_ = device_.upload("stack2d reflectance map", map.entries);
-        residentBytes_ += map.entries.size() * sizeof(glm::vec4);
     }
     setTransferFunction(scene.transferFunction);
 
@@ -197,25 +194,68 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
     fragmentProgram_.source = "#define CLVR_STACK2D_FRAGMENT 1\n" +
                               std::string(clipTexture_ ? "#define CLVR_STACK2D_CLIP_TEXTURE 1\n" : "") + std::string(source);
     fragmentProgram_.attributes = clipTexture_ ? 3 : 2;  // texture coordinates, slab, clip-texture coordinates
-    fragmentProgram_.buffers[0] = stacks_[axis_].buffer();
-    const StackShape s = stackShape(axis_);
-    ClStack2dUniforms& u = uniforms_;  // fields of a mode that is off stay 0
-    u.camera = toClCamera(camera_, image_.width, image_.height);
-    u.frame = cl4(image_.width, image_.height, 0.0f, 0.0f);  // z: tf_count, set with the transfer function
-    u.axis.s[axis_] = 1.0f;
-    u.slice_tex = cl4(dims_[s.b], dims_[s.c], channels, 0.0f);
+    // The uniforms that do not depend on the view (setView sets the others); fields of a mode that is off stay 0.
+    ClStack2dUniforms& u = uniforms_;
+    u.frame = cl4(image_.width, image_.height, static_cast<float>(scene.transferFunction.points().size()), 0.0f);
     u.shading = cl4(options_.reflectanceMapSize, lighting_.shaded() ? 1.0f : 0.0f, 0.0f, 0.0f);
-    u.to_eye = toCl4(-camera_.forward());
     if (iso_) {
-        const double range = iso_->dataMax > iso_->dataMin ? iso_->dataMax - iso_->dataMin : 1.0;
         u.iso = cl4(static_cast<float>(iso_->dataMin), 1.0f, static_cast<float>(iso_->ambient),
                     static_cast<float>(iso_->diffuse));
         u.surface = toCl4(iso_->color, iso_->gradientShading ? 1.0 : 0.0);
-        u.light = cl4(static_cast<float>(iso_->light.x), static_cast<float>(iso_->light.y),
-                      static_cast<float>(iso_->light.z), static_cast<float>(1.0 / range));
         isoFinish_ = device_.kernel("stack2d.cl", "stack2d_iso_finish");
     }
+    if (options_.slicesPerPolygon > 1) {
+        const double alphaRef =
+            iso_ ? std::clamp((iso_->value - iso_->dataMin) / (iso_->dataMax > iso_->dataMin ? iso_->dataMax - iso_->dataMin : 1.0),
+                              0.0, 1.0)
+                 : 0.0;
+        u.alpha_ref = cl4(static_cast<float>(alphaRef), 0.0f, 0.0f, 0.0f);
+    }
+    if (clipTexture_) {
+        const glm::ivec3 n = clipTexture_->dims();
+        u.clip_tex = cl4(n.x, n.y, n.z, options_.clipTexture->inverse ? 1.0f : 0.0f);
+        for (int r = 0; r < 3; ++r)
+            u.clip_row[r] =
+                cl4(static_cast<float>(clipCoordinates_[0][r]), static_cast<float>(clipCoordinates_[1][r]),
+                    static_cast<float>(clipCoordinates_[2][r]), static_cast<float>(clipCoordinates_[3][r]));
+    }
+    fragmentProgram_.buffers[1] = tf_.buffer();
+    if (options_.path == Stack2dOptions::Path::Fused)
+        setUpFused(volume);
+    setView(scene);
+}
+
+// Everything that follows the view, for the constructor and setCamera: the camera and the headlight, the stack
+// drawn (the axis most parallel to the view) and its slices, the reflectance map (one view direction for the
+// image, -forward, as in planes and blend), the uniforms and slice table of the draws, and the fused path's
+// bricks of the drawn stack's grid.
+void Stack2dRenderer::setView(const Scene& scene)
+{
+    camera_ = frameCamera(scene, lo_, hi_);
+    if (iso_)
+        iso_->light = scene.iso->lightFor(camera_);
+    axis_ = stackAxis(camera_);
+    slices_ = planStack(camera_, origin_, spacing_, dims_, axis_, options_.intermediate);
+    if (lighting_.shaded()) {
+        const ReflectanceMap map = buildReflectanceMap(lighting_, -camera_.forward(), options_.reflectanceMapSize);
+        if (!map_())
+            residentBytes_ += map.entries.size() * sizeof(glm::vec4);
+        map_ = device_.upload("stack2d reflectance map", map.entries);
+    }
+    fragmentProgram_.buffers[0] = stacks_[axis_].buffer();
     fragmentProgram_.buffers[2] = map_;
+    const StackShape s = stackShape(axis_);
+    ClStack2dUniforms& u = uniforms_;
+    u.camera = toClCamera(camera_, image_.width, image_.height);
+    u.axis = cl4(0.0f, 0.0f, 0.0f, 0.0f);
+    u.axis.s[axis_] = 1.0f;
+    u.slice_tex = cl4(dims_[s.b], dims_[s.c], channels_, 0.0f);
+    u.to_eye = toCl4(-camera_.forward());
+    if (iso_) {
+        const double range = iso_->dataMax > iso_->dataMin ? iso_->dataMax - iso_->dataMin : 1.0;
+        u.light = cl4(static_cast<float>(iso_->light.x), static_cast<float>(iso_->light.y),
+                      static_cast<float>(iso_->light.z), static_cast<float>(1.0 / range));
+    }
     // buffer[3]: the slice table (several slices per polygon), then the clip texels (four buffers in
     // all, and the reflectance map takes the third): one upload, the texels at a float offset.
     std::vector<glm::vec4> table;
@@ -224,67 +264,68 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
         for (const StackSlice& slice : grouped_.slices)
             table.emplace_back(static_cast<float>(origin_[axis_] + slice.position * spacing_[axis_]),
                                static_cast<float>(slice.lower), slice.weight, static_cast<float>(slice.thickness));
-    }
-    if (clipTexture_) {
-        std::vector<float> packed(reinterpret_cast<const float*>(table.data()),
-                                  reinterpret_cast<const float*>(table.data() + table.size()));
-        packed.insert(packed.end(), clipTexture_->texels.begin(), clipTexture_->texels.end());
-        sliceTable_ = device_.upload("stack2d slice table and clip texture", packed);
-        residentBytes_ += packed.size() * sizeof(float);
-        fragmentProgram_.buffers[3] = sliceTable_;
-    } else if (!table.empty()) {
-        sliceTable_ = device_.upload("stack2d slice table", table);
-        residentBytes_ += table.size() * sizeof(glm::vec4);
-        fragmentProgram_.buffers[3] = sliceTable_;
-    }
-    if (options_.slicesPerPolygon > 1) {
-        const double alphaRef =
-            iso_ ? std::clamp((iso_->value - iso_->dataMin) / (iso_->dataMax > iso_->dataMin ? iso_->dataMax - iso_->dataMin : 1.0),
-                              0.0, 1.0)
-                 : 0.0;
+        u.axis_b = cl4(0.0f, 0.0f, 0.0f, 0.0f);
+        u.axis_c = cl4(0.0f, 0.0f, 0.0f, 0.0f);
         u.axis_b.s[s.b] = 1.0f;
         u.axis_c.s[s.c] = 1.0f;
         u.box = cl4(lo_[s.b], lo_[s.c], hi_[s.b], hi_[s.c]);
         u.uv_box = cl4(0.5f / dims_[s.b], 0.5f / dims_[s.c], (dims_[s.b] - 0.5f) / dims_[s.b],
                        (dims_[s.c] - 0.5f) / dims_[s.c]);  // as the quads' corners
-        u.alpha_ref = cl4(static_cast<float>(alphaRef), 0.0f, 0.0f, 0.0f);
     }
+    residentBytes_ -= sliceTableBytes_;
+    sliceTableBytes_ = 0;
     if (clipTexture_) {
-        const glm::ivec3 n = clipTexture_->dims();
-        u.clip_tex = cl4(n.x, n.y, n.z, options_.clipTexture->inverse ? 1.0f : 0.0f);
+        std::vector<float> packed(reinterpret_cast<const float*>(table.data()),
+                                  reinterpret_cast<const float*>(table.data() + table.size()));
+        packed.insert(packed.end(), clipTexture_->texels.begin(), clipTexture_->texels.end());
+        sliceTable_ = device_.upload("stack2d slice table and clip texture", packed);
+        sliceTableBytes_ = packed.size() * sizeof(float);
+        fragmentProgram_.buffers[3] = sliceTable_;
         u.clip_offset = cl4(static_cast<float>(table.size() * 4), 0.0f, 0.0f, 0.0f);
-        setClipCoordinateUniforms();  // u.clip_row
+    } else if (!table.empty()) {
+        sliceTable_ = device_.upload("stack2d slice table", table);
+        sliceTableBytes_ = table.size() * sizeof(glm::vec4);
+        fragmentProgram_.buffers[3] = sliceTable_;
     }
-    u.frame.s[2] = static_cast<float>(scene.transferFunction.points().size());
+    residentBytes_ += sliceTableBytes_;
     fragmentProgram_.uniforms = fragmentUniforms(u);
-    fragmentProgram_.buffers[1] = tf_.buffer();
-    if (options_.path == Stack2dOptions::Path::Fused)
-        setUpFused(volume, scene.transferFunction);
+    if (options_.path == Stack2dOptions::Path::Fused) {
+        // The drawn stack's grid is the volume with its axes renamed (b, c, axis): so are its bricks, which
+        // slice3d's grid cuts the same way along every axis.
+        const int stackAxes[3] = {s.b, s.c, axis_};
+        const glm::ivec3 n = volumeBricks_.dims;
+        brickGrid_.dims = glm::ivec3(n[s.b], n[s.c], n[axis_]);
+        brickGrid_.minMax.resize(volumeBricks_.minMax.size());
+        glm::ivec3 v, g;
+        for (g.z = 0; g.z < brickGrid_.dims.z; ++g.z)
+            for (g.y = 0; g.y < brickGrid_.dims.y; ++g.y)
+                for (g.x = 0; g.x < brickGrid_.dims.x; ++g.x) {
+                    for (int r = 0; r < 3; ++r)
+                        v[stackAxes[r]] = g[r];
+                    brickGrid_.minMax[(static_cast<std::size_t>(g.z) * brickGrid_.dims.y + g.y) * brickGrid_.dims.x + g.x] =
+                        volumeBricks_.minMax[(static_cast<std::size_t>(v.z) * n.y + v.y) * n.x + v.x];
+                }
+        setEmptySpace();
+    }
 }
 
-// The fused path's bricks: slice3d's, over the drawn stack's grid (b, c, axis), which is the volume with its
-// axes renamed; empty where tau is 0 over the brick's values (direct volume rendering) or where they all
-// lie below the iso-value by more than float rounding in the trilinear interpolation could make up.
-void Stack2dRenderer::setUpFused(const Volume& volume, const TransferFunction& tf)
+bool Stack2dRenderer::setCamera(const Scene& scene)
 {
-    const StackShape s = stackShape(axis_);
-    Volume stackGrid;
-    stackGrid.dims = glm::ivec3(dims_[s.b], dims_[s.c], dims_[axis_]);
-    stackGrid.values = stackTexels(volume.values.data(), dims_, 1, axis_);
-    brickGrid_ = buildBrickGrid(stackGrid);
-    std::vector<cl_uchar> empty;
-    if (iso_) {
-        const double margin = 1e-5 * std::max({std::abs(iso_->dataMin), std::abs(iso_->dataMax), std::abs(iso_->value)});
-        empty.resize(brickGrid_.minMax.size());
-        for (std::size_t b = 0; b < empty.size(); ++b)
-            empty[b] = static_cast<double>(brickGrid_.minMax[b].y) + margin < iso_->value ? 1 : 0;
-    } else {
-        empty = emptyBricks(brickGrid_, tf);
-    }
-    emptyBrickCount_ = static_cast<std::uint64_t>(std::count(empty.begin(), empty.end(), cl_uchar(1)));
-    space_ = device_.upload("stack2d empty-space radii", emptySpaceRadii(brickGrid_.dims, empty));
-    residentBytes_ += empty.size();
-    if (!map_())  // the kernel takes a reflectance map argument in every mode
+    if (scene.image.width != image_.width || scene.image.height != image_.height)
+        return false;  // the frame buffer and the per-pixel counts would change
+    image_ = scene.image;
+    setView(scene);
+    return true;
+}
+
+// The fused path's kernel and buffers, and the bricks (slice3d's) of the volume, which setView renames into
+// the drawn stack's.
+void Stack2dRenderer::setUpFused(const Volume& volume)
+{
+    volumeBricks_ = buildBrickGrid(volume);
+    space_ = device_.buffer("stack2d empty-space radii", volumeBricks_.minMax.size(), CL_MEM_READ_ONLY);
+    residentBytes_ += volumeBricks_.minMax.size();
+    if (!lighting_.shaded())  // the kernel takes a reflectance map argument in every mode
         noMap_ = device_.upload("stack2d no reflectance map", std::vector<glm::vec4>(1));
     // Ray packets (kernels/stack2d.cl stack2d_fused_packet, the same bits): plain direct volume rendering
     // without a clip texture; shading, iso-surfaces and clip textures keep one pixel per work-item.
@@ -294,6 +335,25 @@ void Stack2dRenderer::setUpFused(const Volume& volume, const TransferFunction& t
     const std::size_t pixels = framebuffer_->pixelCount();
     fusedSamples_ = device_.buffer("stack2d fused samples per pixel", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
     fusedSkipped_ = device_.buffer("stack2d fused skipped samples per pixel", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
+}
+
+// The fused path's empty bricks of the drawn stack, and their radii on the device: empty where tau is 0 over the
+// brick's values (direct volume rendering) or where they all lie below the iso-value by more than float rounding
+// in the trilinear interpolation could make up.
+void Stack2dRenderer::setEmptySpace()
+{
+    std::vector<cl_uchar> empty;
+    if (iso_) {
+        const double margin = 1e-5 * std::max({std::abs(iso_->dataMin), std::abs(iso_->dataMax), std::abs(iso_->value)});
+        empty.resize(brickGrid_.minMax.size());
+        for (std::size_t b = 0; b < empty.size(); ++b)
+            empty[b] = static_cast<double>(brickGrid_.minMax[b].y) + margin < iso_->value ? 1 : 0;
+    } else {
+        empty = emptyBricks(brickGrid_, tfHost_);
+    }
+    emptyBrickCount_ = static_cast<std::uint64_t>(std::count(empty.begin(), empty.end(), cl_uchar(1)));
+    const std::vector<cl_uchar> radii = emptySpaceRadii(brickGrid_.dims, empty);
+    device_.queue().enqueueWriteBuffer(space_, CL_TRUE, 0, radii.size(), radii.data());
 }
 
 // The uniforms' clip_row: the rows of world -> clip-texture coordinates (the several-slices path maps
@@ -321,6 +381,7 @@ void Stack2dRenderer::setClipPlacement(const glm::dvec3& offset, const glm::dmat
 
 void Stack2dRenderer::setTransferFunction(const TransferFunction& tf)
 {
+    tfHost_ = tf;
     tf_.replace(device_, "stack2d transfer function", tf, residentBytes_);
     fragmentProgram_.buffers[1] = tf_.buffer();
     if (fragmentProgram_.uniforms.empty())  // during construction, which sets them itself
@@ -331,13 +392,8 @@ void Stack2dRenderer::setTransferFunction(const TransferFunction& tf)
         uniforms_.surface = toCl4(iso_->color, uniforms_.surface.s[3]);
     }
     fragmentProgram_.uniforms = fragmentUniforms(uniforms_);
-    if (options_.path == Stack2dOptions::Path::Fused && !iso_) {
-        // Which bricks are empty depends on the transfer function: classify the kept min-max again.
-        const std::vector<cl_uchar> empty = emptyBricks(brickGrid_, tf);
-        const std::vector<cl_uchar> radii = emptySpaceRadii(brickGrid_.dims, empty);
-        emptyBrickCount_ = static_cast<std::uint64_t>(std::count(empty.begin(), empty.end(), cl_uchar(1)));
-        device_.queue().enqueueWriteBuffer(space_, CL_TRUE, 0, radii.size(), radii.data());
-    }
+    if (options_.path == Stack2dOptions::Path::Fused && !iso_)
+        setEmptySpace();  // which bricks are empty depends on the transfer function
 }
 
 Image4f Stack2dRenderer::render(FrameStats& stats)
