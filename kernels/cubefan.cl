@@ -207,24 +207,6 @@ kernel void cubefan_fused(global float4* out, global uint* steps, global uint* s
  * by lane, so the pixels are the same bits. A lane that has left the box or become opaque keeps its state
  * while the others go on; the packet ends when none is left. The grid's entries are indexed in 32 bits (the
  * host runs cubefan_fused where they do not fit). */
-static int8 cubefan_gather_level(global const uchar* level, const uint8 at)
-{
-    int8 v;
-#define CUBEFAN_GATHER(L) v.s##L = level[at.s##L];
-    CLVR_EACH_LANE(CUBEFAN_GATHER)
-#undef CUBEFAN_GATHER
-    return v;
-}
-
-static float8 cubefan_gather_value(global const float* value, const uint8 at)
-{
-    float8 v;
-#define CUBEFAN_GATHER(L) v.s##L = value[at.s##L];
-    CLVR_EACH_LANE(CUBEFAN_GATHER)
-#undef CUBEFAN_GATHER
-    return v;
-}
-
 /* cubefan_next lane by lane (exit: the lanes leaving by this axis' face; positive: the lanes whose ray goes up it). */
 static int8 cubefan_next8(const int8 exit, const int8 v, const int8 lo, const int8 hi, const int8 positive,
                           const float8 e, const float8 d, const float8 t)
@@ -290,7 +272,8 @@ kernel void cubefan_fused_packet(global float4* out, global uint* steps, global 
         /* cubefan_at lane by lane; the lanes that have stopped read entry 0 */
         const uint8 brick = (convert_uint8(vz >> 2) * bricks_y + convert_uint8(vy >> 2)) * bricks_x + convert_uint8(vx >> 2);
         const uint8 at = select((uint8)(0u), (brick << 6) | convert_uint8(((vz & 3) << 4) | ((vy & 3) << 2) | (vx & 3)), live);
-        const int8 code = cubefan_gather_level(level, at);
+        int8 code;
+        CLVR_GATHER8(code, level, at);
         const int8 l = code & 0x7f;
         const int8 side = (int8)(1) << l;
         int8 lox = (vx >> l) << l, loy = (vy >> l) << l, loz = (vz >> l) << l;
@@ -299,9 +282,8 @@ kernel void cubefan_fused_packet(global float4* out, global uint* steps, global 
         if (any(transparent & live)) {
             /* the cube of empty bricks around a transparent cube, where it is wider than the cube */
             int8 r;
-#define CUBEFAN_SPACE(L) r.s##L = (int)space[at.s##L >> 6] - 1;
-            CLVR_EACH_LANE(CUBEFAN_SPACE)
-#undef CUBEFAN_SPACE
+            CLVR_GATHER8(r, space, at >> 6);
+            r -= 1;
             const int8 wide = transparent & (r >= 0) & (8 * r + 4 > side);
             lox = select(lox, max(((vx >> 2) - r) << 2, 0), wide);
             loy = select(loy, max(((vy >> 2) - r) << 2, 0), wide);
@@ -323,7 +305,9 @@ kernel void cubefan_fused_packet(global float4* out, global uint* steps, global 
         crossed -= opaque;
         if (any(opaque)) {
             float8 cr, cg, cb, tau;
-            clvr_tf_eval8(tf, p.tf_count, cubefan_gather_value(value, at), &cr, &cg, &cb, &tau);
+            float8 v;
+            CLVR_GATHER8(v, value, at);
+            clvr_tf_eval8(tf, p.tf_count, v, &cr, &cg, &cb, &tau);
             const float8 alpha = 1.0f - clvr_exp2_8(tau * ((t - t_exit) * M_LOG2E_F));
             const float8 ta = transmittance * alpha;
             c_r = select(c_r, c_r + ta * cr, opaque);

@@ -15,6 +15,13 @@
 #define CLVR_EACH_LANE(M) M(0) M(1) M(2) M(3) M(4) M(5) M(6) M(7)
 #define CLVR_LANE_INDEX ((int8)(0, 1, 2, 3, 4, 5, 6, 7))
 
+/* out.sL = array[index.sL] in every lane L: a gather, one load per lane (OpenCL C has none); out's element type
+ * converts each loaded element (a uchar into an int lane, say). */
+#define CLVR_GATHER8(out, array, index)                                                                   \
+    ((out).s0 = (array)[(index).s0], (out).s1 = (array)[(index).s1], (out).s2 = (array)[(index).s2],      \
+     (out).s3 = (array)[(index).s3], (out).s4 = (array)[(index).s4], (out).s5 = (array)[(index).s5],      \
+     (out).s6 = (array)[(index).s6], (out).s7 = (array)[(index).s7])
+
 /* The smallest (largest) of 8 lanes. */
 int clvr_min8(const int8 v)
 {
@@ -42,9 +49,7 @@ int8 clvr_space8(global const uchar* space, const int4 bdims, const int8 bx, con
 {
     const uint8 i = (convert_uint8(bz) * (uint)bdims.y + convert_uint8(by)) * (uint)bdims.x + convert_uint8(bx);
     int8 s;
-#define CLVR_SPACE(L) s.s##L = space[i.s##L];
-    CLVR_EACH_LANE(CLVR_SPACE)
-#undef CLVR_SPACE
+    CLVR_GATHER8(s, space, i);
     return s;
 }
 
