@@ -348,7 +348,8 @@ public:
     TetsliceFusedRenderer(Device& device, const Scene& scene, const TetMesh& mesh)
         : options_(parseTetsliceOptions(scene.options)), lo_(mesh.boundsMin()), hi_(mesh.boundsMax())
     {
-        walk_ = makeHarcRenderer(device, scene, mesh, buildTopology(mesh), view(scene));
+        plan_ = planFor(scene);
+        walk_ = makeHarcRenderer(device, scene, mesh, buildTopology(mesh), walkOptions(plan_));
     }
     Image4f render(FrameStats& stats) override
     {
@@ -363,28 +364,31 @@ public:
     void setTransferFunction(const TransferFunction& tf) override { walk_->setTransferFunction(tf); }
     bool setCamera(const Scene& scene) override
     {
-        const SlicePlan previous = plan_;
-        if (harcSetView(*walk_, scene, view(scene)))
-            return true;
-        plan_ = previous;  // refused: the walk keeps its view
-        return false;
+        const SlicePlan plan = planFor(scene);
+        if (!harcSetView(*walk_, scene, walkOptions(plan)))
+            return false;
+        plan_ = plan;
+        return true;
     }
 
 private:
-    // The walk's options for the scene's view: the slices the raster path plans (its camera frame and mesh box,
-    // so the same eye depths); plan_ becomes that plan.
-    HarcOptions view(const Scene& scene)
+    // The slices the raster path plans for the scene's view (its camera frame and mesh box: the same eye depths).
+    SlicePlan planFor(const Scene& scene) const
     {
         const glm::dvec3 shift = 0.5 * (lo_ + hi_);
         Camera camera = frameCamera(scene, lo_, hi_);
         camera.position -= shift;
         camera.focalPoint -= shift;
-        plan_ = planSlices(camera, lo_ - shift, hi_ - shift, options_.slices, options_.sliceSpacing);
+        return planSlices(camera, lo_ - shift, hi_ - shift, options_.slices, options_.sliceSpacing);
+    }
+    // The walk sampling the cells' field at those slices.
+    static HarcOptions walkOptions(const SlicePlan& plan)
+    {
         HarcOptions harc;
         harc.integration = HarcOptions::Integration::Slices;
-        harc.sliceDepth0 = plan_.count ? plan_.depth(0) : 0.0;
-        harc.sliceSpacing = plan_.deltaS > 0.0 ? plan_.deltaS : 1.0;
-        harc.sliceCount = plan_.count;
+        harc.sliceDepth0 = plan.count ? plan.depth(0) : 0.0;
+        harc.sliceSpacing = plan.deltaS > 0.0 ? plan.deltaS : 1.0;
+        harc.sliceCount = plan.count;
         return harc;
     }
 
