@@ -12,6 +12,7 @@
 #include "ray.h"
 #include "segment_integral.h"
 #include "transfer_function.h"
+#include "packet.h"
 
 /* Per tetrahedron, 5 float4 = 80 bytes (Table 1 of seeds/001 uses 96), host/render/tet/harc.h:
  *   [0..2] barycentric planes (h_i, k_i), i = 0, 1, 2: b_i(x) = dot(h_i, x) + k_i is 1 at vertex i and
@@ -299,4 +300,316 @@ kernel void harc_render(global float4* out, global uint* stats, global const flo
     stats[3 * p + 0] = steps;
     stats[3 * p + 1] = bounded;
     stats[3 * p + 2] = integration == HARC_INTEGRATION_ISO ? as_uint(iso_lambda) : pieces;
+}
+
+/* ---- harc_render_packet: 8 pixels of a row per work-item (partial pre-integration, no part box) ----------
+ * Each lane walks its own ray through its own cells (its own entry list, cell, entry face, segment and pieces)
+ * with harc_render's operations lane by lane (kernels/packet.h's rule), so the pixels are the same bits: a lane
+ * that needs its next entry takes it in scalars; a cell step, its exit face and its segment run on all lanes at
+ * once, masked; the packet ends when no lane is left. The helpers below are segment_integral.h's lane by lane. */
+
+/* dot(a, b) of float3s lane by lane, the same expression (and contraction) as the builtin's. */
+float8 harc_dot8(const float8 ax, const float8 ay, const float8 az, const float8 bx, const float8 by, const float8 bz)
+{
+    const float8 x = ax * bx, y = ay * by, z = az * bz;
+    return x + y + z;
+}
+
+/* harc_psi lane by lane (lanes outside m read the table's first texels). */
+float8 harc_psi8(global const float* psi, const int n, const float8 tau_l_front, const float8 tau_l_back, const int8 m)
+{
+    const float8 f = fmin(tau_l_front, 1e30f), b = fmin(tau_l_back, 1e30f);
+    const float n1 = (float)(n - 1);
+    const float8 x = f / (1.0f + f) * n1, y = b / (1.0f + b) * n1;
+    const int8 i = select((int8)(0), min(convert_int8(x), n - 2), m), j = select((int8)(0), min(convert_int8(y), n - 2), m);
+    const float8 fx = x - convert_float8(i), fy = y - convert_float8(j);
+    const int8 at = j * n + i;
+    float8 r00, r01, r10, r11;
+#define HARC_PSI(L)                                                  \
+    {                                                                \
+        const float2 u = vload2(0, psi + at.s##L);                   \
+        const float2 v = vload2(0, psi + at.s##L + n);               \
+        r00.s##L = u.x, r01.s##L = u.y, r10.s##L = v.x, r11.s##L = v.y; \
+    }
+    CLVR_EACH_LANE(HARC_PSI)
+#undef HARC_PSI
+    const float8 a = r00 + fx * (r01 - r00);
+    const float8 c = r10 + fx * (r11 - r10);
+    return a + fy * (c - a);
+}
+
+/* harc_piece lane by lane, for the lanes in m. */
+void harc_piece8(global const float* psi, const int psi_n, const float8 cf_r, const float8 cf_g, const float8 cf_b,
+                 const float8 cf_w, const float8 cb_r, const float8 cb_g, const float8 cb_b, const float8 cb_w,
+                 const float8 l, int8 m, float8* c_r, float8* c_g, float8* c_b, float8* transmittance)
+{
+    const float8 tf = cf_w * l, tb = cb_w * l;
+    m &= ~(isequal(tf, 0.0f) & isequal(tb, 0.0f)); /* tau 0 all along the piece: nothing to add */
+    if (!any(m))
+        return;
+    const float8 zeta = clvr_exp2_8(-0.5f * M_LOG2E_F * (tf + tb));
+    const float8 p = harc_psi8(psi, psi_n, tf, tb, m);
+    const float8 r = cb_r * (p - zeta) + cf_r * (1.0f - p);
+    const float8 g = cb_g * (p - zeta) + cf_g * (1.0f - p);
+    const float8 b = cb_b * (p - zeta) + cf_b * (1.0f - p);
+    *c_r = select(*c_r, *c_r + *transmittance * r, m);
+    *c_g = select(*c_g, *c_g + *transmittance * g, m);
+    *c_b = select(*c_b, *c_b + *transmittance * b, m);
+    *transmittance = select(*transmittance, *transmittance * zeta, m);
+}
+
+/* vload4(i, v) of each lane's i into four vectors. */
+void harc_gather4(global const float* v, const int8 i, float8* x, float8* y, float8* z, float8* w)
+{
+#define HARC_GATHER4(L)                                              \
+    {                                                                \
+        const float4 q = vload4(i.s##L, v);                          \
+        (*x).s##L = q.x, (*y).s##L = q.y, (*z).s##L = q.z, (*w).s##L = q.w; \
+    }
+    CLVR_EACH_LANE(HARC_GATHER4)
+#undef HARC_GATHER4
+}
+
+/* harc_tf_at lane by lane. */
+void harc_tf_at8(global const float* tf, const int n, const int8 k, const float8 x, float8* r, float8* g, float8* b,
+                 float8* w)
+{
+    global const float* value = tf + ((n + 3) & ~3);
+    global const float* slope = value + 4 * n;
+    const int8 i = clamp(k - 1, 0, n - 1);
+    float8 vr, vg, vb, vw, sr, sg, sb, sw, s;
+    harc_gather4(value, i, &vr, &vg, &vb, &vw);
+    harc_gather4(slope, i, &sr, &sg, &sb, &sw);
+    CLVR_GATHER8(s, tf, i);
+    const float8 dx = x - s;
+    const int8 first = k == 0, last = k == n;
+    *r = select(select(vr + dx * sr, (float8)(value[0]), first), (float8)(value[4 * (n - 1)]), last);
+    *g = select(select(vg + dx * sg, (float8)(value[1]), first), (float8)(value[4 * (n - 1) + 1]), last);
+    *b = select(select(vb + dx * sb, (float8)(value[2]), first), (float8)(value[4 * (n - 1) + 2]), last);
+    *w = select(select(vw + dx * sw, (float8)(value[3]), first), (float8)(value[4 * (n - 1) + 3]), last);
+}
+
+/* One end of each lane's segment (HarcTfPoint lane by lane). */
+typedef struct {
+    float8 s, r, g, b, w;
+    int8 k;
+} HarcTfPoint8;
+
+/* harc_segment_from lane by lane for the lanes in m: each lane's pieces in its own order; *back (lanes in m) the
+ * segment's back end. Returns the pieces per lane. */
+int8 harc_segment_from8(global const float* tf, const int n, global const float* psi, const int psi_n,
+                        const HarcTfPoint8* front, const float8 s_b, const float8 l, const int8 m, float8* c_r,
+                        float8* c_g, float8* c_b, float8* transmittance, HarcTfPoint8* back)
+{
+    const float8 s_f = front->s;
+    const int8 flat = m & ~isnotequal(s_b, s_f); /* s constant along the ray: one piece with constant C and tau */
+    const int8 up = m & ~flat & isgreater(s_b, s_f), down = m & ~flat & ~up;
+    harc_piece8(psi, psi_n, front->r, front->g, front->b, front->w, front->r, front->g, front->b, front->w, l, flat,
+                c_r, c_g, c_b, transmittance);
+    const float8 inv_ds = 1.0f / (s_b - s_f);
+    float8 f_r = front->r, f_g = front->g, f_b = front->b, f_w = front->w, lambda_front = 0.0f;
+    int8 pieces = flat & 1;
+    /* up: from the first control point above s_f; down: below the points equal to s_f */
+    int8 k = select(front->k, front->k - 1, down);
+    for (;;) {
+        float8 tk;
+        CLVR_GATHER8(tk, tf, clamp(k, 0, n - 1));
+        const int8 more = down & (k >= 0) & isgreaterequal(tk, s_f);
+        if (!any(more))
+            break;
+        k -= more & 1;
+    }
+    global const float* value = tf + ((n + 3) & ~3);
+    for (;;) {
+        float8 tk;
+        CLVR_GATHER8(tk, tf, clamp(k, 0, n - 1));
+        const int8 next = (up & (k < n) & isless(tk, s_b)) | (down & (k >= 0) & isgreater(tk, s_b));
+        if (!any(next))
+            break;
+        const float8 lambda = l * ((tk - s_f) * inv_ds);
+        float8 i_r, i_g, i_b, i_w;
+        harc_gather4(value, clamp(k, 0, n - 1), &i_r, &i_g, &i_b, &i_w);
+        harc_piece8(psi, psi_n, f_r, f_g, f_b, f_w, i_r, i_g, i_b, i_w, lambda - lambda_front, next, c_r, c_g, c_b,
+                    transmittance);
+        f_r = select(f_r, i_r, next), f_g = select(f_g, i_g, next), f_b = select(f_b, i_b, next);
+        f_w = select(f_w, i_w, next), lambda_front = select(lambda_front, lambda, next);
+        pieces -= next;
+        k += select((int8)(0), select((int8)(-1), (int8)(1), up), next);
+    }
+    float8 tk;
+    CLVR_GATHER8(tk, tf, clamp(k, 0, n - 1));
+    const int8 k_b = select(k + 1, select(k, k + 1, (k < n) & islessequal(tk, s_b)), up);
+    const int8 walked = up | down;
+    float8 b_r, b_g, b_b, b_w;
+    harc_tf_at8(tf, n, k_b, s_b, &b_r, &b_g, &b_b, &b_w);
+    harc_piece8(psi, psi_n, f_r, f_g, f_b, f_w, b_r, b_g, b_b, b_w, l - lambda_front, walked, c_r, c_g, c_b,
+                transmittance);
+    pieces -= walked;
+    back->s = select(back->s, select(front->s, s_b, walked), m);
+    back->k = select(back->k, select(front->k, k_b, walked), m);
+    back->r = select(back->r, select(front->r, b_r, walked), m);
+    back->g = select(back->g, select(front->g, b_g, walked), m);
+    back->b = select(back->b, select(front->b, b_b, walked), m);
+    back->w = select(back->w, select(front->w, b_w, walked), m);
+    return pieces;
+}
+
+kernel void harc_render_packet(global float4* out, global uint* stats, global const float4* tets,
+                               global const uint* offsets, global const int2* entries, global const float* tf,
+                               global const float* psi, const ClHarcParams params)
+{
+    const int x0 = (int)get_global_id(0) * CLVR_LANES, y = (int)get_global_id(1);
+    if (x0 >= params.width || y >= params.height)
+        return;
+    const int tf_count = params.tf_count, psi_n = params.psi_n;
+    const uint max_steps = params.max_steps;
+    const float ert_alpha = params.ert_alpha;
+    const float2 size = (float2)((float)params.width, (float)params.height);
+    /* each lane's ray and entry list, as harc_render sets them up */
+    float8 e_x, e_y, e_z, d_x, d_y, d_z;
+    int8 kk = 0, kend = 0;
+    int8 live = x0 + CLVR_LANE_INDEX < params.width;
+#define HARC_SETUP(L)                                                                                        \
+    {                                                                                                        \
+        float3 e, d;                                                                                         \
+        clvr_ray_unit(clvr_ray_window_offset(clvr_ray_pixel_centre(min(x0 + L, params.width - 1), y), size,   \
+                                             params.camera),                                                 \
+                      params.camera, &e, &d);                                                                \
+        e_x.s##L = e.x, e_y.s##L = e.y, e_z.s##L = e.z, d_x.s##L = d.x, d_y.s##L = d.y, d_z.s##L = d.z;       \
+        const int p = y * params.width + min(x0 + L, params.width - 1);                                       \
+        kk.s##L = (int)offsets[p], kend.s##L = (int)offsets[p + 1];                                          \
+    }
+    CLVR_EACH_LANE(HARC_SETUP)
+#undef HARC_SETUP
+    float8 c_r = 0.0f, c_g = 0.0f, c_b = 0.0f, transmittance = 1.0f;
+    uint8 steps = 0;
+    int8 bounded = 0, pieces = 0;
+    float8 lambda_done = -INFINITY, lambda = 0.0f;
+    int8 cell = 0, entry_face = -1, carry = 0, need = live;
+    HarcTfPoint8 carried = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0};
+    while (any(live)) {
+        /* Lanes that left the mesh (or start) take their next crossing ahead of where they left it; crossings the
+         * walk has passed (and duplicates on shared edges) lie before lambda_done. None left: the lane is done. */
+        if (any(need)) {
+#define HARC_ENTRY(L)                                                                                        \
+            if (need.s##L) {                                                                                 \
+                const float done = lambda_done.s##L;                                                         \
+                int k = kk.s##L, found = 0;                                                                  \
+                for (; k < kend.s##L; ++k) {                                                                 \
+                    const int2 entry = entries[k];                                                           \
+                    const float at = as_float(entry.x);                                                      \
+                    if (at < done - 1e-5f * (1.0f + fabs(done)))                                             \
+                        continue;                                                                            \
+                    lambda.s##L = fmax(at, done);                                                            \
+                    cell.s##L = entry.y >= 0 ? entry.y >> 2 : -1 - entry.y;                                  \
+                    entry_face.s##L = entry.y >= 0 ? entry.y & 3 : -1;                                       \
+                    found = 1;                                                                               \
+                    ++k;                                                                                     \
+                    break;                                                                                   \
+                }                                                                                            \
+                kk.s##L = k;                                                                                 \
+                need.s##L = 0;                                                                               \
+                carry.s##L = 0;                                                                              \
+                if (!found)                                                                                  \
+                    live.s##L = 0;                                                                           \
+            }
+            CLVR_EACH_LANE(HARC_ENTRY)
+#undef HARC_ENTRY
+        }
+        int8 act = live;
+        const int8 over = act & as_int8(steps >= max_steps);
+        bounded |= over & 1;
+        live &= ~over;
+        act &= ~over;
+        if (!any(act))
+            continue;
+        steps += as_uint8(act & 1);
+        /* the lanes' cells */
+        float8 h0x, h0y, h0z, h0w, h1x, h1y, h1z, h1w, h2x, h2y, h2z, h2w, gx, gy, gz, gw;
+        int8 a0, a1, a2, a3;
+        const int8 t = select((int8)(0), cell, act);
+#define HARC_CELL(L)                                                                                         \
+        {                                                                                                    \
+            global const float4* q = tets + (size_t)t.s##L * HARC_TET_FLOAT4S;                               \
+            const float4 p0 = q[0], p1 = q[1], p2 = q[2], grad = q[3];                                       \
+            const int4 adj = as_int4(q[4]);                                                                  \
+            h0x.s##L = p0.x, h0y.s##L = p0.y, h0z.s##L = p0.z, h0w.s##L = p0.w;                              \
+            h1x.s##L = p1.x, h1y.s##L = p1.y, h1z.s##L = p1.z, h1w.s##L = p1.w;                              \
+            h2x.s##L = p2.x, h2y.s##L = p2.y, h2z.s##L = p2.z, h2w.s##L = p2.w;                              \
+            gx.s##L = grad.x, gy.s##L = grad.y, gz.s##L = grad.z, gw.s##L = grad.w;                          \
+            a0.s##L = adj.x, a1.s##L = adj.y, a2.s##L = adj.z, a3.s##L = adj.w;                              \
+        }
+        CLVR_EACH_LANE(HARC_CELL)
+#undef HARC_CELL
+        const float8 h3x = -(h0x + h1x + h2x), h3y = -(h0y + h1y + h2y), h3z = -(h0z + h1z + h2z);
+        const float8 h3w = 1.0f - (h0w + h1w + h2w);
+        const float8 pos_x = e_x + lambda * d_x, pos_y = e_y + lambda * d_y, pos_z = e_z + lambda * d_z;
+        /* the exit face, as harc_render chooses it */
+        float8 best_num = 0.0f, best_den = 0.0f;
+        int8 exit_face = -1;
+#define HARC_FACE(I, HX, HY, HZ, HW)                                                                         \
+        {                                                                                                    \
+            const float8 den = -harc_dot8(HX, HY, HZ, d_x, d_y, d_z);                                        \
+            const int8 candidate = (entry_face != I) & isgreater(den, 0.0f);                                 \
+            const float8 num = fmax(harc_dot8(HX, HY, HZ, pos_x, pos_y, pos_z) + HW, 0.0f);                  \
+            const int8 better = candidate & ((exit_face < 0) | isless(num * best_den, best_num * den));      \
+            best_num = select(best_num, num, better);                                                        \
+            best_den = select(best_den, den, better);                                                        \
+            exit_face = select(exit_face, (int8)(I), better);                                                \
+        }
+        HARC_FACE(0, h0x, h0y, h0z, h0w)
+        HARC_FACE(1, h1x, h1y, h1z, h1w)
+        HARC_FACE(2, h2x, h2y, h2z, h2w)
+        HARC_FACE(3, h3x, h3y, h3z, h3w)
+#undef HARC_FACE
+        const int8 grazing = act & (exit_face < 0); /* a degenerate cell: leave the mesh here */
+        lambda_done = select(lambda_done, lambda, grazing);
+        need |= grazing;
+        act &= ~grazing;
+        const float8 step = best_num / best_den;
+        const float8 lambda_exit = lambda + step;
+        const float8 s_b = harc_dot8(gx, gy, gz, e_x + lambda_exit * d_x, e_y + lambda_exit * d_y,
+                                     e_z + lambda_exit * d_z) + gw;
+        /* the segment's front: the last segment's back end where the walk came through a face, else looked up */
+        HarcTfPoint8 front = carried;
+        const int8 lookup = act & ~carry;
+        if (any(lookup)) {
+            const float8 s_f = harc_dot8(gx, gy, gz, pos_x, pos_y, pos_z) + gw;
+#define HARC_FRONT(L)                                                                                        \
+            if (lookup.s##L) {                                                                               \
+                const HarcTfPoint q = harc_tf_point(tf, tf_count, s_f.s##L);                                 \
+                front.s.s##L = q.s, front.k.s##L = q.k;                                                      \
+                front.r.s##L = q.c.x, front.g.s##L = q.c.y, front.b.s##L = q.c.z, front.w.s##L = q.c.w;      \
+            }
+            CLVR_EACH_LANE(HARC_FRONT)
+#undef HARC_FRONT
+        }
+        pieces += harc_segment_from8(tf, tf_count, psi, psi_n, &front, s_b, step, act, &c_r, &c_g, &c_b,
+                                     &transmittance, &carried);
+        carry |= act;
+        /* early ray termination (off: ert_alpha = 2) */
+        const int8 finished = act & (isgreaterequal(1.0f - transmittance, ert_alpha) | isgreaterequal(lambda_exit, INFINITY));
+        live &= ~finished;
+        act &= ~finished;
+        const int8 next = select(select(select(a3, a2, exit_face == 2), a1, exit_face == 1), a0, exit_face == 0);
+        lambda = select(lambda, lambda_exit, act);
+        const int8 left = act & (next < 0);
+        lambda_done = select(lambda_done, lambda_exit, left);
+        need |= left;
+        const int8 on = act & ~left;
+        cell = select(cell, next >> 2, on);
+        entry_face = select(entry_face, next & 3, on);
+    }
+    const size_t row = (size_t)y * (size_t)params.width;
+#define HARC_STORE(L)                                                                                        \
+    if (x0 + L < params.width) {                                                                             \
+        const size_t p = row + (size_t)(x0 + L);                                                             \
+        out[p] = (float4)((float3)(c_r.s##L, c_g.s##L, c_b.s##L) + transmittance.s##L * params.background.xyz, \
+                          1.0f - transmittance.s##L);                                                        \
+        stats[3 * p + 0] = steps.s##L;                                                                       \
+        stats[3 * p + 1] = (uint)bounded.s##L;                                                               \
+        stats[3 * p + 2] = (uint)pieces.s##L;                                                                \
+    }
+    CLVR_EACH_LANE(HARC_STORE)
+#undef HARC_STORE
 }

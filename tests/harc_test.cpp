@@ -585,6 +585,67 @@ TEST(Harc, EarlyTerminationStaysWithinItsThreshold)
     EXPECT_TRUE(test::imagesNear(b, ad, {.maxAbs = 1e-2, .meanAbs = 5e-3}));
 }
 
+// Ray packets: harc_render_packet walks 8 pixels' rays as vector lanes, each through its own cells, entry list
+// and pieces. The same bits as one pixel per work-item and the same steps, pieces and step-bound rays: a convex
+// grid from outside, a perspective eye inside a non-convex mesh (its rays start in the eye's cell), a parallel
+// view, two boxes with a gap (rays leave and re-enter), a transfer function of 33 control points (several
+// pieces per cell, up and down), early termination, a step bound, and widths that leave lanes out of the image.
+TEST(Harc, PacketsAreBitIdenticalToOnePixelPerWorkItem)
+{
+    const std::vector<Box> lShape = {{{0.0, 0.0, 0.0}, {2.0, 1.0, 1.0}, 4}, {{0.0, 1.0, 0.0}, {1.0, 2.0, 1.0}, 3}};
+    TetMesh inside = boxMesh(lShape, {0.3, 0.35, -0.4}, 0.4);
+    checkMesh(inside);
+    const TetMesh grid = boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, 3}}, {0.6, 0.25, -0.4}, 0.35);
+    const TetMesh gap = boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 0.4}, 3}, {{0.0, 0.0, 0.7}, {1.0, 1.0, 1.1}, 3}}, {0.3, 0.5, 0.2}, 0.1);
+    std::vector<ControlPoint> fine;  // 33 points, tau up and down
+    for (int k = 0; k <= 32; ++k) {
+        const double s = k / 32.0;
+        fine.push_back({s, {s, 0.5 + 0.4 * std::sin(9.0 * s), 1.0 - s}, 2.0 + 1.5 * std::sin(13.0 * s)});
+    }
+    Camera parallel = perspective({3.5, -1.5, 2.5}, {1.0, 1.0, 0.5});
+    parallel.parallel = true;
+    parallel.parallelScale = 1.4;
+    struct Case {
+        const char* name;
+        const TetMesh* mesh;
+        Camera camera;
+        TransferFunction tf;
+        json options;
+    };
+    const Case cases[] = {
+        {"grid, outside", &grid, perspective({1.9, 1.4, 2.6}), rampTf(), json::object()},
+        {"grid, 33 control points", &grid, perspective({1.9, 1.4, 2.6}), TransferFunction(fine), json::object()},
+        {"eye inside the L", &inside, perspective({0.55, 0.45, 0.6}, {1.6, 1.3, 0.3}, 95.0), rampTf(), json::object()},
+        {"L, parallel", &inside, parallel, TransferFunction(fine), json::object()},
+        {"gap", &gap, perspective({0.9, 0.7, 3.2}, {0.5, 0.5, 0.5}, 40.0), rampTf(), json::object()},
+        {"early termination", &grid, perspective({1.9, 1.4, 2.6}),
+         TransferFunction({{0.0, {1.0, 0.5, 0.2}, 20.0}, {1.0, {0.2, 0.5, 1.0}, 20.0}}), json{{"early_termination", 0.9}}},
+        {"step bound", &grid, perspective({1.9, 1.4, 2.6}), rampTf(), json{{"max_steps", 3}}},
+    };
+    int compared = 0;
+    for (const Case& c : cases)
+        for (const int width : {61, 5}) {
+            json options = c.options;
+            options["packets"] = true;
+            Scene packets = makeScene(c.camera, c.tf, width, options);
+            packets.image.height = 37;
+            Scene pixels = packets;
+            pixels.options["packets"] = false;
+            FrameStats ps, qs;
+            const Image4f p = renderHarc(packets, *c.mesh, &ps);
+            const Image4f q = renderHarc(pixels, *c.mesh, &qs);
+            const std::string label = std::string(c.name) + ", width " + std::to_string(width);
+            EXPECT_TRUE(test::sameBits(p, q)) << label;
+            EXPECT_TRUE(ps.extra["packets"].get<bool>()) << label;
+            EXPECT_FALSE(qs.extra["packets"].get<bool>()) << label;
+            for (const char* key : {"steps", "pieces", "rays_step_bound"})
+                EXPECT_EQ(ps.extra[key], qs.extra[key]) << label << " " << key;
+            EXPECT_GT(qs.extra["steps"].get<std::uint64_t>(), 0u) << label;
+            ++compared;
+        }
+    EXPECT_EQ(compared, 7 * 2);
+}
+
 }  // namespace
 }  // namespace clvr
 

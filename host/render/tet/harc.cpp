@@ -76,6 +76,7 @@ private:
     std::vector<float> isoHitLambda_;    // Integration::Iso: the last frame's hit per pixel (+inf: none)
     glm::dvec3 isoColor_{1.0};           // Integration::Iso: the transfer function's color at the iso-value
     cl::Kernel kernel_;
+    bool packet_ = false;  // kernel_ is harc_render_packet
     std::unique_ptr<HarcRasterEntries> rasterEntries_;  // options_.entry == Raster
     std::uint64_t residentBytes_ = 0;
     MeshCounts counts_;
@@ -146,7 +147,10 @@ HarcRenderer::HarcRenderer(Device& device, const Scene& scene, const TetMesh& me
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
     out_ = device_.buffer("harc image", pixels * sizeof(cl_float4), CL_MEM_WRITE_ONLY);
     stats_ = device_.buffer("harc ray counts", pixels * 3 * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
-    kernel_ = device_.kernel("harc.cl", "harc_render");
+    // Ray packets (docs/harc.md): partial pre-integration of a whole mesh, 8 pixels' walks per work-item.
+    packet_ = packetsOnDevice(options_.packets, device_.listing().type) &&
+              options_.integration == HarcOptions::Integration::Partial && !part_;
+    kernel_ = device_.kernel("harc.cl", packet_ ? "harc_render_packet" : "harc_render");
     if (options_.entry == HarcOptions::Entry::Raster)
         rasterEntries_ = std::make_unique<HarcRasterEntries>(device_, mesh, topology, shift_, tets_, image_.width,
                                                              image_.height, options_.maxLayers);
@@ -255,10 +259,12 @@ Image4f HarcRenderer::render(FrameStats& stats)
     kernel_.setArg(a++, entryBuffer);
     kernel_.setArg(a++, tf_.buffer());
     kernel_.setArg(a++, psi_);
-    kernel_.setArg(a++, full_);
-    kernel_.setArg(a++, isoNormals_);
+    if (!packet_) {
+        kernel_.setArg(a++, full_);
+        kernel_.setArg(a++, isoNormals_);
+    }
     kernel_.setArg(a++, params);
-    device_.launch(kHarcWalkPass, kernel_, image_.width, image_.height);
+    device_.launch(kHarcWalkPass, kernel_, rowWorkItems(image_.width, packet_), image_.height);
 
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
     Image4f image = readImage(device_, out_, image_.width, image_.height);
@@ -313,6 +319,7 @@ Image4f HarcRenderer::render(FrameStats& stats)
         break;
     }
     stats.extra["early_termination"] = options_.earlyTermination;
+    stats.extra["packets"] = packet_;
     stats.extra["entry"] = rasterEntries_ ? "raster" : "host";
     stats.extra["eye_tet"] = eyeTet;
     stats.extra["entry_ms"] = entryMs;
@@ -372,6 +379,7 @@ TechniqueInfo harcTechnique()
         {"full_table", nullptr, "[64, 64], with integration full only", "[NS, NL]: the full table's samples of s_f, s_b and of l"},
         {"max_steps", nullptr, "4 cbrt(tets) + 10000", "traversal steps per ray before it is stopped and counted"},
         earlyTerminationInfo(1.0),
+        packetsInfo(),
         {"entry", "host", "", "entry faces per pixel: \"host\" (exact ray/face tests) or \"raster\" (depth peeling)"},
         {"max_layers", 64, "", "raster entry: depth-peeling layers per frame, 1..255"},
     };
@@ -427,6 +435,8 @@ HarcOptions parseHarcOptions(const nlohmann::json& options)
             if (!value.is_number_integer() || value.get<long long>() < 1 || value.get<long long>() > 0xffffffffll)
                 badOption(key, "must be an integer in [1, 4294967295], got " + value.dump());
             o.maxSteps = value.get<std::uint64_t>();
+        } else if (key == "packets") {
+            o.packets = packetsOption(key, value);
         } else if (key == "early_termination") {
             o.earlyTermination = earlyTerminationOption(value);
         } else {
