@@ -454,6 +454,42 @@ int8 harc_segment_from8(global const float* tf, const int n, global const float*
     return pieces;
 }
 
+/* harc_slices lane by lane, for the lanes in m (df > 0): each lane's slices in [seg_f, seg_b) in order. Returns the
+ * slices taken per lane. */
+int8 harc_slices8(global const float* tf, const int tf_count, const float4 slices, const float8 df, const float8 e_x,
+                  const float8 e_y, const float8 e_z, const float8 d_x, const float8 d_y, const float8 d_z,
+                  const float8 gx, const float8 gy, const float8 gz, const float8 gw, const float8 seg_f,
+                  const float8 seg_b, const int8 m, float8* c_r, float8* c_g, float8* c_b, float8* transmittance)
+{
+    const float z0 = slices.x, ds = slices.y;
+    const int count = (int)slices.z;
+    const float8 neg_log2e = -(ds / df) * M_LOG2E_F;
+    int8 k = max(convert_int8(ceil((seg_f * df - z0) / ds)) - 1, 0); /* one before the first, for rounding */
+    int8 taken = 0;
+    for (;;) {
+        const float8 lambda_k = (z0 + convert_float8(k) * ds) / df;
+        const int8 in = m & (k < count) & isless(lambda_k, seg_b);
+        if (!any(in))
+            break;
+        const int8 take = in & ~isless(lambda_k, seg_f);
+        if (any(take)) {
+            float8 r, g, b, tau;
+            clvr_tf_eval8(tf, tf_count,
+                          harc_dot8(gx, gy, gz, e_x + lambda_k * d_x, e_y + lambda_k * d_y, e_z + lambda_k * d_z) + gw,
+                          &r, &g, &b, &tau);
+            const float8 alpha = 1.0f - clvr_exp2_8(tau * neg_log2e);
+            const float8 ta = *transmittance * alpha;
+            *c_r = select(*c_r, *c_r + ta * r, take);
+            *c_g = select(*c_g, *c_g + ta * g, take);
+            *c_b = select(*c_b, *c_b + ta * b, take);
+            *transmittance = select(*transmittance, *transmittance * (1.0f - alpha), take);
+            taken -= take;
+        }
+        k -= in;
+    }
+    return taken;
+}
+
 kernel void harc_render_packet(global float4* out, global uint* stats, global const float4* tets,
                                global const uint* offsets, global const int2* entries, global const float* tf,
                                global const float* psi, const ClHarcParams params)
@@ -461,7 +497,7 @@ kernel void harc_render_packet(global float4* out, global uint* stats, global co
     const int x0 = (int)get_global_id(0) * CLVR_LANES, y = (int)get_global_id(1);
     if (x0 >= params.width || y >= params.height)
         return;
-    const int tf_count = params.tf_count, psi_n = params.psi_n;
+    const int tf_count = params.tf_count, psi_n = params.psi_n, integration = params.integration;
     const uint max_steps = params.max_steps;
     const float ert_alpha = params.ert_alpha;
     const float2 size = (float2)((float)params.width, (float)params.height);
@@ -481,6 +517,9 @@ kernel void harc_render_packet(global float4* out, global uint* stats, global co
     }
     CLVR_EACH_LANE(HARC_SETUP)
 #undef HARC_SETUP
+    /* HARC_INTEGRATION_SLICES: the eye depth per unit λ of each lane's ray */
+    const float8 df = harc_dot8(d_x, d_y, d_z, (float8)(params.camera.forward.x), (float8)(params.camera.forward.y),
+                                (float8)(params.camera.forward.z));
     float8 c_r = 0.0f, c_g = 0.0f, c_b = 0.0f, transmittance = 1.0f;
     uint8 steps = 0;
     int8 bounded = 0, pieces = 0;
@@ -570,23 +609,28 @@ kernel void harc_render_packet(global float4* out, global uint* stats, global co
         const float8 lambda_exit = lambda + step;
         const float8 s_b = harc_dot8(gx, gy, gz, e_x + lambda_exit * d_x, e_y + lambda_exit * d_y,
                                      e_z + lambda_exit * d_z) + gw;
-        /* the segment's front: the last segment's back end where the walk came through a face, else looked up */
-        HarcTfPoint8 front = carried;
-        const int8 lookup = act & ~carry;
-        if (any(lookup)) {
-            const float8 s_f = harc_dot8(gx, gy, gz, pos_x, pos_y, pos_z) + gw;
-#define HARC_FRONT(L)                                                                                        \
-            if (lookup.s##L) {                                                                               \
-                const HarcTfPoint q = harc_tf_point(tf, tf_count, s_f.s##L);                                 \
-                front.s.s##L = q.s, front.k.s##L = q.k;                                                      \
-                front.r.s##L = q.c.x, front.g.s##L = q.c.y, front.b.s##L = q.c.z, front.w.s##L = q.c.w;      \
-            }
-            CLVR_EACH_LANE(HARC_FRONT)
+        if (integration == HARC_INTEGRATION_SLICES) {
+            pieces += harc_slices8(tf, tf_count, params.slices, df, e_x, e_y, e_z, d_x, d_y, d_z, gx, gy, gz, gw,
+                                   lambda, lambda_exit, act & isgreater(df, 0.0f), &c_r, &c_g, &c_b, &transmittance);
+        } else {
+            /* the segment's front: the last segment's back end where the walk came through a face, else looked up */
+            HarcTfPoint8 front = carried;
+            const int8 lookup = act & ~carry;
+            if (any(lookup)) {
+                const float8 s_f = harc_dot8(gx, gy, gz, pos_x, pos_y, pos_z) + gw;
+#define HARC_FRONT(L)                                                                                                \
+                if (lookup.s##L) {                                                                                   \
+                    const HarcTfPoint q = harc_tf_point(tf, tf_count, s_f.s##L);                                     \
+                    front.s.s##L = q.s, front.k.s##L = q.k;                                                          \
+                    front.r.s##L = q.c.x, front.g.s##L = q.c.y, front.b.s##L = q.c.z, front.w.s##L = q.c.w;          \
+                }
+                CLVR_EACH_LANE(HARC_FRONT)
 #undef HARC_FRONT
+            }
+            pieces += harc_segment_from8(tf, tf_count, psi, psi_n, &front, s_b, step, act, &c_r, &c_g, &c_b,
+                                         &transmittance, &carried);
+            carry |= act;
         }
-        pieces += harc_segment_from8(tf, tf_count, psi, psi_n, &front, s_b, step, act, &c_r, &c_g, &c_b,
-                                     &transmittance, &carried);
-        carry |= act;
         /* early ray termination (off: ert_alpha = 2) */
         const int8 finished = act & (isgreaterequal(1.0f - transmittance, ert_alpha) | isgreaterequal(lambda_exit, INFINITY));
         live &= ~finished;

@@ -305,5 +305,46 @@ TEST(Tetslice, SetCameraEqualsANewRenderer)
         }
 }
 
+// Ray packets on the fused path (harc's walk sampling the slices, 8 pixels per work-item): the same bits and the
+// same steps and samples as one pixel per work-item — a grid from outside, parallel, two boxes with a gap (rays
+// leave and re-enter), slices by count and by spacing, widths that leave lanes out of the image.
+TEST(Tetslice, PacketsAreBitIdenticalToOnePixelPerWorkItem)
+{
+    const TetMesh grid = test::boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, 3}}, {0.6, 0.25, -0.4}, 0.35);
+    const TetMesh gap = test::boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 0.4}, 3}, {{0.0, 0.0, 0.7}, {1.0, 1.0, 1.1}, 3}},
+                                      {0.3, 0.5, 0.2}, 0.1);
+    Camera parallel = perspective({2.2, -0.9, 1.1}, {0.5, 0.5, 0.5});
+    parallel.parallel = true;
+    parallel.parallelScale = 0.9;
+    struct Case {
+        const char* name;
+        const TetMesh* mesh;
+        Camera camera;
+        json options;
+    };
+    const Case cases[] = {{"grid", &grid, perspective({1.9, 1.4, 2.6}, {0.5, 0.5, 0.5}, 35.0), {{"slices", 40}}},
+                          {"grid, parallel, by spacing", &grid, parallel, {{"slice_spacing", 0.03}}},
+                          {"gap", &gap, perspective({0.9, 0.7, 3.2}, {0.5, 0.5, 0.5}, 40.0), {{"slices", 64}}}};
+    for (const Case& c : cases)
+        for (const int width : {61, 5}) {
+            json options = c.options;
+            options["packets"] = true;
+            Scene packets = makeScene(c.camera, rampTf(), width, options);
+            packets.image.height = 33;
+            Scene pixels = packets;
+            pixels.options["packets"] = false;
+            FrameStats ps, qs;
+            const Image4f p = renderTetslice(packets, *c.mesh, &ps);
+            const Image4f q = renderTetslice(pixels, *c.mesh, &qs);
+            const std::string label = std::string(c.name) + ", width " + std::to_string(width);
+            EXPECT_TRUE(test::sameBits(p, q)) << label;
+            EXPECT_TRUE(ps.extra["packets"].get<bool>()) << label;
+            EXPECT_FALSE(qs.extra["packets"].get<bool>()) << label;
+            EXPECT_EQ(ps.samples, qs.samples) << label;
+            EXPECT_EQ(ps.extra["steps"], qs.extra["steps"]) << label;
+            EXPECT_GT(qs.samples, 0u) << label;
+        }
+}
+
 }  // namespace
 }  // namespace clvr

@@ -147,9 +147,11 @@ HarcRenderer::HarcRenderer(Device& device, const Scene& scene, const TetMesh& me
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
     out_ = device_.buffer("harc image", pixels * sizeof(cl_float4), CL_MEM_WRITE_ONLY);
     stats_ = device_.buffer("harc ray counts", pixels * 3 * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
-    // Ray packets (docs/harc.md): partial pre-integration of a whole mesh, 8 pixels' walks per work-item.
-    packet_ = packetsOnDevice(options_.packets, device_.listing().type) &&
-              options_.integration == HarcOptions::Integration::Partial && !part_;
+    // Ray packets (docs/harc.md): partial pre-integration or tetslice's slices of a whole mesh, 8 pixels' walks
+    // per work-item.
+    packet_ = packetsOnDevice(options_.packets, device_.listing().type) && !part_ &&
+              (options_.integration == HarcOptions::Integration::Partial ||
+               options_.integration == HarcOptions::Integration::Slices);
     kernel_ = device_.kernel("harc.cl", packet_ ? "harc_render_packet" : "harc_render");
     if (options_.entry == HarcOptions::Entry::Raster)
         rasterEntries_ = std::make_unique<HarcRasterEntries>(device_, mesh, topology, shift_, tets_, image_.width,

@@ -315,7 +315,8 @@ TechniqueInfo tetsliceTechnique()
     t.description = "direct slicing of tetrahedral grids through cell faces, seeds/000 §4.2 (docs/tetslice.md)";
     t.options = {slicesInfo(), sliceSpacingInfo(),
                  {"path", "fused", "", "\"fused\" (each ray walks the cells and samples the slices in them) or "
-                                       "\"raster\" (the face draws per slice through the raster stage)"}};
+                                       "\"raster\" (the face draws per slice through the raster stage)"},
+                 packetsInfo()};
     t.makeForMesh = makeTetsliceRenderer;
     return t;
 }
@@ -333,6 +334,8 @@ TetsliceOptions parseTetsliceOptions(const nlohmann::json& options)
         else if (key == "path")
             o.path = choiceOption(key, value, {"fused", "raster"}) == 0 ? TetsliceOptions::Path::Fused
                                                                        : TetsliceOptions::Path::Raster;
+        else if (key == "packets")
+            o.packets = packetsOption(key, value);
         else
             unparsedOption(info, key);
     });
@@ -349,13 +352,13 @@ public:
         : options_(parseTetsliceOptions(scene.options)), lo_(mesh.boundsMin()), hi_(mesh.boundsMax())
     {
         plan_ = planFor(scene);
-        walk_ = makeHarcRenderer(device, scene, mesh, buildTopology(mesh), walkOptions(plan_));
+        walk_ = makeHarcRenderer(device, scene, mesh, buildTopology(mesh), walkOptions(plan_, options_.packets));
     }
     Image4f render(FrameStats& stats) override
     {
         Image4f image = walk_->render(stats);
         stats.samples = stats.extra["pieces"].get<std::uint64_t>();  // slices taken inside cells
-        stats.extra["path"] = "fused";
+        stats.extra["path"] = "fused";  // and "packets" from the walk
         stats.extra["slices"] = plan_.count;
         stats.extra["slice_spacing"] = plan_.deltaS;
         return image;
@@ -365,7 +368,7 @@ public:
     bool setCamera(const Scene& scene) override
     {
         const SlicePlan plan = planFor(scene);
-        if (!harcSetView(*walk_, scene, walkOptions(plan)))
+        if (!harcSetView(*walk_, scene, walkOptions(plan, options_.packets)))
             return false;
         plan_ = plan;
         return true;
@@ -382,9 +385,10 @@ private:
         return planSlices(camera, lo_ - shift, hi_ - shift, options_.slices, options_.sliceSpacing);
     }
     // The walk sampling the cells' field at those slices.
-    static HarcOptions walkOptions(const SlicePlan& plan)
+    static HarcOptions walkOptions(const SlicePlan& plan, const std::optional<bool>& packets)
     {
         HarcOptions harc;
+        harc.packets = packets;
         harc.integration = HarcOptions::Integration::Slices;
         harc.sliceDepth0 = plan.count ? plan.depth(0) : 0.0;
         harc.sliceSpacing = plan.deltaS > 0.0 ? plan.deltaS : 1.0;

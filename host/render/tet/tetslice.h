@@ -18,6 +18,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 namespace clvr {
@@ -30,12 +31,15 @@ struct TetsliceOptions {
     // each cell's linear field at the slices inside it — the scalar the face draws interpolate.
     enum class Path { Fused, Raster };
     Path path = Path::Fused;
+    // Fused path: 8 neighbouring pixels' walks per work-item as vector lanes (harc's packets; the same bits).
+    // Unset: on CPU devices only (packetsOnDevice, host/render/options_util.h).
+    std::optional<bool> packets;
 };
 
 // Its registry entry (host/render/renderer.h).
 TechniqueInfo tetsliceTechnique();
 
-// Reads the scene's "options" for tetslice: "slices", "slice_spacing" (as slice3d's), "path". InputError naming
+// Reads the scene's "options" for tetslice: "slices", "slice_spacing" (as slice3d's), "path", "packets". InputError naming
 // the key for unknown keys, wrong types and values out of range.
 TetsliceOptions parseTetsliceOptions(const nlohmann::json& options);
 
