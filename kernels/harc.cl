@@ -308,11 +308,20 @@ kernel void harc_render(global float4* out, global uint* stats, global const flo
  * that needs its next entry takes it in scalars; a cell step, its exit face and its segment run on all lanes at
  * once, masked; the packet ends when no lane is left. The helpers below are segment_integral.h's lane by lane. */
 
-/* dot(a, b) of float3s lane by lane, the same expression (and contraction) as the builtin's. */
+/* dot(a, b) of float3s lane by lane, rounded as PoCL's builtin rounds it: the products, then a pairwise sum
+ * ((x + y) + z, the float4 reduction with w = 0), nothing fused (a fused form moves the last bits). */
 float8 harc_dot8(const float8 ax, const float8 ay, const float8 az, const float8 bx, const float8 by, const float8 bz)
 {
     const float8 x = ax * bx, y = ay * by, z = az * bz;
     return x + y + z;
+}
+
+/* dot(a, b) of float4s lane by lane, as PoCL's builtin rounds it: (x + y) + (z + w) of the products. */
+float8 harc_dot8_4(const float8 ax, const float8 ay, const float8 az, const float8 aw, const float8 bx, const float8 by,
+                   const float8 bz, const float8 bw)
+{
+    const float8 x = ax * bx, y = ay * by, z = az * bz, w = aw * bw;
+    return (x + y) + (z + w);
 }
 
 /* harc_psi lane by lane (lanes outside m read the table's first texels). */
@@ -490,9 +499,56 @@ int8 harc_slices8(global const float* tf, const int tf_count, const float4 slice
     return taken;
 }
 
+/* harc_iso_hit lane by lane, for the lanes in m: the lanes whose cell holds a crossing (returned), their shade in
+ * (c_r, c_g, c_b) and their q. */
+int8 harc_iso_hit8(const ClHarcParams* params, global const float4* normals, const int8 cell, const float8 h[4][4],
+                   const float8 e_x, const float8 e_y, const float8 e_z, const float8 d_x, const float8 d_y,
+                   const float8 d_z, const float8 seg_f, const float8 seg_b, const float8 s_f, const float8 s_b,
+                   const int8 m, float8* c_r, float8* c_g, float8* c_b, float8* q)
+{
+    const float iso = params->iso.x;
+    const int8 hit = m & ((islessequal(s_f, iso) & isgreater(s_b, iso)) | (isgreaterequal(s_f, iso) & isless(s_b, iso)));
+    if (!any(hit))
+        return hit;
+    *q = select(*q, (iso - s_f) / (s_b - s_f), hit);
+    const int flags = (int)params->iso.w;
+    const float3 base = params->iso_color.xyz;
+    if (!(flags & HARC_ISO_SHADED)) {
+        const float3 c = clamp(base, 0.0f, 1.0f);
+        *c_r = select(*c_r, (float8)(c.x), hit), *c_g = select(*c_g, (float8)(c.y), hit);
+        *c_b = select(*c_b, (float8)(c.z), hit);
+        return hit;
+    }
+    const float8 w = (flags & HARC_ISO_EQUAL_WEIGHTS) ? (float8)(0.5f) : *q;
+    const float8 pf_x = e_x + seg_f * d_x, pf_y = e_y + seg_f * d_y, pf_z = e_z + seg_f * d_z;
+    const float8 pb_x = e_x + seg_b * d_x, pb_y = e_y + seg_b * d_y, pb_z = e_z + seg_b * d_z;
+    float8 b[4];
+    for (int i = 0; i < 4; ++i) {
+        const float8 bf = harc_dot8(h[i][0], h[i][1], h[i][2], pf_x, pf_y, pf_z) + h[i][3];
+        const float8 bb = harc_dot8(h[i][0], h[i][1], h[i][2], pb_x, pb_y, pb_z) + h[i][3];
+        b[i] = (1.0f - w) * bf + w * bb;
+    }
+    float8 n[3];
+    for (int axis = 0; axis < 3; ++axis) {
+        float8 nx, ny, nz, nw;
+        const int8 at = select((int8)(0), cell * 3 + axis, hit);
+#define HARC_NORMAL(L)                                                                                               {                                                                                                                const float4 v = normals[at.s##L];                                                                           nx.s##L = v.x, ny.s##L = v.y, nz.s##L = v.z, nw.s##L = v.w;                                              }
+        CLVR_EACH_LANE(HARC_NORMAL)
+#undef HARC_NORMAL
+        n[axis] = harc_dot8_4(nx, ny, nz, nw, b[0], b[1], b[2], b[3]);
+    }
+    const float3 light = params->iso_light.xyz;
+    const float8 shade = params->iso.y + params->iso.z * harc_dot8((float8)(light.x), (float8)(light.y),
+                                                                    (float8)(light.z), n[0], n[1], n[2]);
+    *c_r = select(*c_r, clamp(base.x * shade, 0.0f, 1.0f), hit);
+    *c_g = select(*c_g, clamp(base.y * shade, 0.0f, 1.0f), hit);
+    *c_b = select(*c_b, clamp(base.z * shade, 0.0f, 1.0f), hit);
+    return hit;
+}
+
 kernel void harc_render_packet(global float4* out, global uint* stats, global const float4* tets,
                                global const uint* offsets, global const int2* entries, global const float* tf,
-                               global const float* psi, const ClHarcParams params)
+                               global const float* psi, global const float4* iso_normals, const ClHarcParams params)
 {
     const int x0 = (int)get_global_id(0) * CLVR_LANES, y = (int)get_global_id(1);
     if (x0 >= params.width || y >= params.height)
@@ -525,6 +581,7 @@ kernel void harc_render_packet(global float4* out, global uint* stats, global co
     int8 bounded = 0, pieces = 0;
     float8 lambda_done = -INFINITY, lambda = 0.0f;
     int8 cell = 0, entry_face = -1, carry = 0, need = live;
+    float8 iso_lambda = INFINITY; /* HARC_INTEGRATION_ISO: the hit */
     HarcTfPoint8 carried = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0};
     while (any(live)) {
         /* Lanes that left the mesh (or start) take their next crossing ahead of where they left it; crossings the
@@ -609,7 +666,17 @@ kernel void harc_render_packet(global float4* out, global uint* stats, global co
         const float8 lambda_exit = lambda + step;
         const float8 s_b = harc_dot8(gx, gy, gz, e_x + lambda_exit * d_x, e_y + lambda_exit * d_y,
                                      e_z + lambda_exit * d_z) + gw;
-        if (integration == HARC_INTEGRATION_SLICES) {
+        if (integration == HARC_INTEGRATION_ISO) {
+            const float8 h[4][4] = {{h0x, h0y, h0z, h0w}, {h1x, h1y, h1z, h1w}, {h2x, h2y, h2z, h2w}, {h3x, h3y, h3z, h3w}};
+            const float8 s_f = harc_dot8(gx, gy, gz, pos_x, pos_y, pos_z) + gw;
+            float8 q = 0.0f;
+            const int8 hit = harc_iso_hit8(&params, iso_normals, t, h, e_x, e_y, e_z, d_x, d_y, d_z, lambda, lambda_exit,
+                                           s_f, s_b, act, &c_r, &c_g, &c_b, &q);
+            iso_lambda = select(iso_lambda, lambda + q * (lambda_exit - lambda), hit);
+            transmittance = select(transmittance, (float8)(0.0f), hit);
+            live &= ~hit; /* the first crossing ends the ray */
+            act &= ~hit;
+        } else if (integration == HARC_INTEGRATION_SLICES) {
             pieces += harc_slices8(tf, tf_count, params.slices, df, e_x, e_y, e_z, d_x, d_y, d_z, gx, gy, gz, gw,
                                    lambda, lambda_exit, act & isgreater(df, 0.0f), &c_r, &c_g, &c_b, &transmittance);
         } else {
@@ -652,7 +719,7 @@ kernel void harc_render_packet(global float4* out, global uint* stats, global co
                           1.0f - transmittance.s##L);                                                        \
         stats[3 * p + 0] = steps.s##L;                                                                       \
         stats[3 * p + 1] = (uint)bounded.s##L;                                                               \
-        stats[3 * p + 2] = (uint)pieces.s##L;                                                                \
+        stats[3 * p + 2] = integration == HARC_INTEGRATION_ISO ? as_uint(iso_lambda.s##L) : (uint)pieces.s##L; \
     }
     CLVR_EACH_LANE(HARC_STORE)
 #undef HARC_STORE

@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <string>
@@ -453,6 +454,54 @@ TEST(Tetiso, SetCameraEqualsANewRenderer)
         test::expectSetCameraEqualsNewRenderer(
             isoScene(cameras[0], 27, 0.6, json::object(), path),
             [&](const Scene& s) { return makeTetisoRenderer(test::device(), s, mesh); }, cameras, path);
+}
+
+// Ray packets on the fused path (harc's walk to the first crossing, 8 pixels per work-item): the same bits, hit
+// depths and counts as one pixel per work-item — the cone sphere from two sides, interpolated and equal weights,
+// unshaded, the surface behind a gap, widths that leave lanes out of the image.
+TEST(TetisoFused, PacketsAreBitIdenticalToOnePixelPerWorkItem)
+{
+    const TetMesh cone = coneMesh(6, kConeCenter);
+    const TetMesh gap = test::boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 0.4}, 3}, {{0.0, 0.0, 0.7}, {1.0, 1.0, 1.1}, 3}},
+                                      {0.3, 0.5, 1.0}, 0.1);
+    struct Case {
+        const char* name;
+        const TetMesh* mesh;
+        Camera camera;
+        json options;
+        IsoSpec::Shading shading;
+    };
+    const Case cases[] = {
+        {"cone sphere", &cone, perspective({1.7, 1.3, 2.4}, {0.5, 0.5, 0.5}, 30.0), json::object(), IsoSpec::Shading::Gradient},
+        {"equal weights", &cone, perspective({-1.1, 0.2, 2.0}, {0.5, 0.5, 0.5}, 30.0), {{"weights", "equal"}},
+         IsoSpec::Shading::Gradient},
+        {"unshaded", &cone, perspective({1.7, 1.3, 2.4}, {0.5, 0.5, 0.5}, 30.0), json::object(), IsoSpec::Shading::None},
+        {"behind a gap", &gap, perspective({0.9, 0.7, 3.2}, {0.5, 0.5, 0.5}, 40.0), json::object(), IsoSpec::Shading::Gradient},
+    };
+    for (const Case& c : cases)
+        for (const int width : {61, 5}) {
+            json options = c.options;
+            options["packets"] = true;
+            Scene packets = isoScene(c.camera, width, 0.6, options, "fused");
+            packets.image.height = 35;
+            packets.iso->shading = c.shading;
+            Scene pixels = packets;
+            pixels.options["packets"] = false;
+            auto p = makeTetisoRenderer(test::device(), packets, *c.mesh);
+            auto q = makeTetisoRenderer(test::device(), pixels, *c.mesh);
+            FrameStats ps, qs;
+            const Image4f a = p->render(ps), b = q->render(qs);
+            const std::string label = std::string(c.name) + ", width " + std::to_string(width);
+            EXPECT_TRUE(test::sameBits(a, b)) << label;
+            EXPECT_TRUE(ps.extra["packets"].get<bool>()) << label;
+            EXPECT_FALSE(qs.extra["packets"].get<bool>()) << label;
+            EXPECT_EQ(ps.extra["steps"], qs.extra["steps"]) << label;
+            EXPECT_EQ(ps.extra["pixels_hit"], qs.extra["pixels_hit"]) << label;
+            EXPECT_GT(qs.extra["pixels_hit"].get<std::uint64_t>(), 0u) << label;
+            const std::vector<double> za = p->hitDepth(), zb = q->hitDepth();
+            ASSERT_EQ(za.size(), zb.size());
+            EXPECT_EQ(std::memcmp(za.data(), zb.data(), za.size() * sizeof(double)), 0) << label;
+        }
 }
 
 }  // namespace

@@ -449,6 +449,7 @@ public:
         harc.iso.diffuse = iso_.diffuse;
         harc.iso.shaded = iso_.shading != IsoSpec::Shading::None;
         harc.iso.equalWeights = options.weights == TetisoOptions::Weights::Equal;
+        harc.packets = options.packets;
         weights_ = options.weights == TetisoOptions::Weights::Equal ? "equal" : "interpolated";
         walk_ = makeHarcRenderer(device, scene, mesh, buildTopology(mesh), harc);
     }
@@ -493,6 +494,7 @@ TechniqueInfo tetisoTechnique()
         {"intervals", 64, "", "interval bit-streams over the value range, 1..4096 (which cells an iso-value draws; raster path)"},
         {"path", "fused", "", "\"fused\" (harc's cell walk stops at each ray's first crossing) or \"raster\" (the face "
                               "draws and per-pixel passes of seeds/000 §4.1)"},
+        packetsInfo(),
     };
     t.makeForMesh = [](Device& device, const Scene& scene, const TetMesh& mesh) -> std::unique_ptr<Renderer> {
         return makeTetisoRenderer(device, scene, mesh);
@@ -518,6 +520,8 @@ TetisoOptions parseTetisoOptions(const nlohmann::json& options)
         } else if (key == "path") {
             o.path = choiceOption(key, value, {"fused", "raster"}) == 0 ? TetisoOptions::Path::Fused
                                                                        : TetisoOptions::Path::Raster;
+        } else if (key == "packets") {
+            o.packets = packetsOption(key, value);
         } else {
             unparsedOption(info, key);
         }

@@ -21,6 +21,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 namespace clvr {
@@ -34,6 +35,9 @@ struct TetisoOptions {
     // face draws and per-pixel passes through the raster stage.
     enum class Path { Fused, Raster };
     Path path = Path::Fused;
+    // Fused path: 8 neighbouring pixels' walks per work-item as vector lanes (harc's packets; the same bits).
+    // Unset: on CPU devices only (packetsOnDevice, host/render/options_util.h).
+    std::optional<bool> packets;
 };
 
 // Its registry entry (host/render/renderer.h).
