@@ -399,24 +399,14 @@ TEST(CubefanFused, PacketsAreBitIdenticalToOnePixelPerWorkItem)
     for (const Camera& camera : cameras)
         for (const json& set : sets)
             for (const int width : {61, 5}) {
-                json options = set;
-                options["packets"] = true;
-                Scene packets = makeScene(camera, sparse, width, options);
-                packets.image.height = 23;
-                Scene pixels = packets;
-                pixels.options["packets"] = false;
-                FrameStats ps, qs;
-                const Image4f p = render(packets, blobs, &ps);
-                const Image4f q = render(pixels, blobs, &qs);
-                const std::string label = options.dump() + " width " + std::to_string(width) + " camera " +
-                                          std::to_string(&camera - cameras);
-                EXPECT_TRUE(test::sameBits(p, q)) << label;
-                EXPECT_TRUE(ps.extra["packets"].get<bool>()) << label;
-                EXPECT_FALSE(qs.extra["packets"].get<bool>()) << label;
-                EXPECT_EQ(count(ps, "cubes_crossed"), count(qs, "cubes_crossed")) << label;
-                EXPECT_EQ(count(ps, "cubes_stepped_over"), count(qs, "cubes_stepped_over")) << label;
-                EXPECT_GT(count(qs, "cubes_crossed"), 0u) << label;
-                steppedOver += count(qs, "cubes_stepped_over");
+                Scene scene = makeScene(camera, sparse, width, set);
+                scene.image.height = 23;
+                const FrameStats stats = test::expectPacketsEqualPixels(
+                    scene, [&](const Scene& s, FrameStats& st) { return render(s, blobs, &st); },
+                    {"cubes_crossed", "cubes_stepped_over"},
+                    set.dump() + " width " + std::to_string(width) + " camera " + std::to_string(&camera - cameras));
+                EXPECT_GT(count(stats, "cubes_crossed"), 0u) << set.dump();
+                steppedOver += count(stats, "cubes_stepped_over");
                 ++compared;
             }
     EXPECT_EQ(compared, 4 * 4 * 2);

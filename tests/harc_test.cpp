@@ -625,22 +625,12 @@ TEST(Harc, PacketsAreBitIdenticalToOnePixelPerWorkItem)
     int compared = 0;
     for (const Case& c : cases)
         for (const int width : {61, 5}) {
-            json options = c.options;
-            options["packets"] = true;
-            Scene packets = makeScene(c.camera, c.tf, width, options);
-            packets.image.height = 37;
-            Scene pixels = packets;
-            pixels.options["packets"] = false;
-            FrameStats ps, qs;
-            const Image4f p = renderHarc(packets, *c.mesh, &ps);
-            const Image4f q = renderHarc(pixels, *c.mesh, &qs);
-            const std::string label = std::string(c.name) + ", width " + std::to_string(width);
-            EXPECT_TRUE(test::sameBits(p, q)) << label;
-            EXPECT_TRUE(ps.extra["packets"].get<bool>()) << label;
-            EXPECT_FALSE(qs.extra["packets"].get<bool>()) << label;
-            for (const char* key : {"steps", "pieces", "rays_step_bound"})
-                EXPECT_EQ(ps.extra[key], qs.extra[key]) << label << " " << key;
-            EXPECT_GT(qs.extra["steps"].get<std::uint64_t>(), 0u) << label;
+            Scene scene = makeScene(c.camera, c.tf, width, c.options);
+            scene.image.height = 37;
+            const FrameStats stats = test::expectPacketsEqualPixels(
+                scene, [&](const Scene& s, FrameStats& st) { return renderHarc(s, *c.mesh, &st); },
+                {"steps", "pieces", "rays_step_bound"}, std::string(c.name) + ", width " + std::to_string(width));
+            EXPECT_GT(stats.extra["steps"].get<std::uint64_t>(), 0u) << c.name;
             ++compared;
         }
     EXPECT_EQ(compared, 7 * 2);

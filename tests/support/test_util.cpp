@@ -68,6 +68,24 @@ std::string repoData(const std::string& relative)
     return path;
 }
 
+FrameStats expectPacketsEqualPixels(Scene scene, const std::function<Image4f(const Scene&, FrameStats&)>& render,
+                                    const std::vector<std::string>& keys, const std::string& label)
+{
+    scene.options["packets"] = true;
+    Scene pixels = scene;
+    pixels.options["packets"] = false;
+    FrameStats ps, qs;
+    const Image4f p = render(scene, ps);
+    const Image4f q = render(pixels, qs);
+    EXPECT_TRUE(sameBits(p, q)) << label;
+    EXPECT_TRUE(ps.extra["packets"].get<bool>()) << label;
+    EXPECT_FALSE(qs.extra["packets"].get<bool>()) << label;
+    EXPECT_EQ(ps.samples, qs.samples) << label;
+    for (const std::string& key : keys)
+        EXPECT_EQ(ps.extra[key], qs.extra[key]) << label << ": " << key;
+    return qs;
+}
+
 void expectSetCameraEqualsNewRenderer(Scene scene, const std::function<std::unique_ptr<Renderer>(const Scene&)>& make,
                                       const std::vector<Camera>& cameras, const std::string& label)
 {

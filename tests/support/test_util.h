@@ -50,6 +50,12 @@ struct Tolerance {
 using clvr::ImageError;
 using clvr::imageError;
 
+// Ray packets' promise: `scene` with "packets": true renders the bits of the same scene with "packets": false,
+// with equal stats under `keys` (the samples too), and each frame reports which kernel ran. `render` makes a
+// renderer for the scene and renders one frame into its stats. Returns the one-pixel frame's stats.
+FrameStats expectPacketsEqualPixels(Scene scene, const std::function<Image4f(const Scene&, FrameStats&)>& render,
+                                    const std::vector<std::string>& keys, const std::string& label);
+
 // Renderer::setCamera's promise: a renderer made by `make` for `scene` at cameras[0] (one frame rendered there
 // first, so whatever it leaves behind is exercised) and pointed at each further camera renders the bits a new
 // renderer renders there; a wider image it refuses. `label` names the case in failures.
