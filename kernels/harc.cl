@@ -30,6 +30,21 @@
 #define HARC_INTEGRATION_SLICES 3
 #define HARC_INTEGRATION_ISO 4
 
+/* dot() written out: the products, then their sum pairwise ((x + y) + z; (x + y) + (z + w) for float4s), nothing
+ * fused — how PoCL's builtin rounds it (measured: bit for bit), and what harc_render_packet repeats lane by lane, so
+ * that the two kernels round alike on any OpenCL whose builtin rounds otherwise (Mesa's rusticl does). */
+float harc_dot3(const float3 a, const float3 b)
+{
+    const float x = a.x * b.x, y = a.y * b.y, z = a.z * b.z;
+    return x + y + z;
+}
+
+float harc_dot4(const float4 a, const float4 b)
+{
+    const float x = a.x * b.x, y = a.y * b.y, z = a.z * b.z, w = a.w * b.w;
+    return (x + y) + (z + w);
+}
+
 /* The plain average-of-endpoints segment (the comparison of issue 3 part 6): constant C and τ, the
  * means of their values at s_f and s_b: C (1 - exp(-τ l)). */
 void harc_segment_average(global const float* tf, const int n, const float s_f, const float s_b, const float l,
@@ -64,7 +79,7 @@ uint harc_slices(global const float* tf, const int tf_count, const float4 slices
             break;
         if (lambda_k < seg_f)
             continue;
-        const float4 ct = clvr_tf_eval(tf, tf_count, dot(grad.xyz, e + lambda_k * d) + grad.w);
+        const float4 ct = clvr_tf_eval(tf, tf_count, harc_dot3(grad.xyz, e + lambda_k * d) + grad.w);
         const float alpha = 1.0f - clvr_exp2(ct.w * neg_log2e);
         *color += (*transmittance * alpha) * ct.xyz;
         *transmittance *= 1.0f - alpha;
@@ -96,13 +111,14 @@ int harc_iso_hit(const ClHarcParams* params, global const float4* normals, const
     }
     const float w = (flags & HARC_ISO_EQUAL_WEIGHTS) ? 0.5f : *q;
     const float3 pf = e + seg_f * d, pb = e + seg_b * d;
-    const float4 bf = (float4)(dot(planes[0].xyz, pf) + planes[0].w, dot(planes[1].xyz, pf) + planes[1].w,
-                               dot(planes[2].xyz, pf) + planes[2].w, dot(planes[3].xyz, pf) + planes[3].w);
-    const float4 bb = (float4)(dot(planes[0].xyz, pb) + planes[0].w, dot(planes[1].xyz, pb) + planes[1].w,
-                               dot(planes[2].xyz, pb) + planes[2].w, dot(planes[3].xyz, pb) + planes[3].w);
+    const float4 bf = (float4)(harc_dot3(planes[0].xyz, pf) + planes[0].w, harc_dot3(planes[1].xyz, pf) + planes[1].w,
+                               harc_dot3(planes[2].xyz, pf) + planes[2].w, harc_dot3(planes[3].xyz, pf) + planes[3].w);
+    const float4 bb = (float4)(harc_dot3(planes[0].xyz, pb) + planes[0].w, harc_dot3(planes[1].xyz, pb) + planes[1].w,
+                               harc_dot3(planes[2].xyz, pb) + planes[2].w, harc_dot3(planes[3].xyz, pb) + planes[3].w);
     const float4 b = (1.0f - w) * bf + w * bb;
-    const float3 n = (float3)(dot(normals[0], b), dot(normals[1], b), dot(normals[2], b));
-    *color = clamp(params->iso_color.xyz * (params->iso.y + params->iso.z * dot(params->iso_light.xyz, n)), 0.0f, 1.0f);
+    const float3 n = (float3)(harc_dot4(normals[0], b), harc_dot4(normals[1], b), harc_dot4(normals[2], b));
+    *color = clamp(params->iso_color.xyz * (params->iso.y + params->iso.z * harc_dot3(params->iso_light.xyz, n)), 0.0f,
+                   1.0f);
     return 1;
 }
 
@@ -220,9 +236,9 @@ kernel void harc_render(global float4* out, global uint* stats, global const flo
             int exit_face = -1;
             const float4 planes[4] = {p0, p1, p2, p3};
             for (int i = 0; i < 4; ++i) {
-                const float den = -dot(planes[i].xyz, d);
+                const float den = -harc_dot3(planes[i].xyz, d);
                 if (i != entry_face && den > 0.0f) {
-                    const float num = fmax(dot(planes[i].xyz, pos) + planes[i].w, 0.0f);
+                    const float num = fmax(harc_dot3(planes[i].xyz, pos) + planes[i].w, 0.0f);
                     if (exit_face < 0 || num * best_den < best_num * den) {
                         best_num = num;
                         best_den = den;
@@ -240,16 +256,17 @@ kernel void harc_render(global float4* out, global uint* stats, global const flo
             const float seg_f = fmax(lambda, clip_lo), seg_b = fmin(lambda_exit, clip_hi);
             if (seg_f < seg_b || (seg_f == lambda && seg_b == lambda_exit)) {
                 const float length = seg_f == lambda && seg_b == lambda_exit ? step : seg_b - seg_f;
-                const float s_b = dot(grad.xyz, e + seg_b * d) + grad.w;                       /* Eq. 6 */
+                const float s_b = harc_dot3(grad.xyz, e + seg_b * d) + grad.w;                       /* Eq. 6 */
                 if (integration == HARC_INTEGRATION_PARTIAL) {
                     const HarcTfPoint front = carry && seg_f == lambda
                                                   ? carried
-                                                  : harc_tf_point(tf, tf_count, dot(grad.xyz, e + seg_f * d) + grad.w);
+                                                  : harc_tf_point(tf, tf_count,
+                                                                  harc_dot3(grad.xyz, e + seg_f * d) + grad.w);
                     pieces += (uint)harc_segment_from(tf, tf_count, psi, psi_n, front, s_b, length, &color,
                                                       &transmittance, &carried);
                     carry = seg_b == lambda_exit;
                 } else if (integration == HARC_INTEGRATION_ISO) {
-                    const float s_f = dot(grad.xyz, e + seg_f * d) + grad.w;
+                    const float s_f = harc_dot3(grad.xyz, e + seg_f * d) + grad.w;
                     float q;
                     if (harc_iso_hit(&params, iso_normals + (size_t)t * 3, planes, e, d, seg_f, seg_b, s_f, s_b,
                                      &color, &q)) {
@@ -259,12 +276,12 @@ kernel void harc_render(global float4* out, global uint* stats, global const flo
                         break;
                     }
                 } else if (integration == HARC_INTEGRATION_SLICES) {
-                    const float df = dot(d, params.camera.forward.xyz);
+                    const float df = harc_dot3(d, params.camera.forward.xyz);
                     if (df > 0.0f)
                         pieces += harc_slices(tf, tf_count, params.slices, df, e, d, grad, seg_f, seg_b, &color,
                                               &transmittance);
                 } else {
-                    const float s_f = dot(grad.xyz, e + seg_f * d) + grad.w;
+                    const float s_f = harc_dot3(grad.xyz, e + seg_f * d) + grad.w;
                     if (integration == HARC_INTEGRATION_FULL) {
                         /* The whole segment at once: no split at control points (the table has them inside). */
                         const float4 c = harc_full_lookup(full_table, params.full_ns, params.full_nl,
@@ -308,15 +325,14 @@ kernel void harc_render(global float4* out, global uint* stats, global const flo
  * that needs its next entry takes it in scalars; a cell step, its exit face and its segment run on all lanes at
  * once, masked; the packet ends when no lane is left. The helpers below are segment_integral.h's lane by lane. */
 
-/* dot(a, b) of float3s lane by lane, rounded as PoCL's builtin rounds it: the products, then a pairwise sum
- * ((x + y) + z, the float4 reduction with w = 0), nothing fused (a fused form moves the last bits). */
+/* harc_dot3 lane by lane (a fused form would move the last bits). */
 float8 harc_dot8(const float8 ax, const float8 ay, const float8 az, const float8 bx, const float8 by, const float8 bz)
 {
     const float8 x = ax * bx, y = ay * by, z = az * bz;
     return x + y + z;
 }
 
-/* dot(a, b) of float4s lane by lane, as PoCL's builtin rounds it: (x + y) + (z + w) of the products. */
+/* harc_dot4 lane by lane. */
 float8 harc_dot8_4(const float8 ax, const float8 ay, const float8 az, const float8 aw, const float8 bx, const float8 by,
                    const float8 bz, const float8 bw)
 {
