@@ -564,7 +564,8 @@ int8 harc_iso_hit8(const ClHarcParams* params, global const float4* normals, con
 
 kernel void harc_render_packet(global float4* out, global uint* stats, global const float4* tets,
                                global const uint* offsets, global const int2* entries, global const float* tf,
-                               global const float* psi, global const float4* iso_normals, const ClHarcParams params)
+                               global const float* psi, global const float4* full_table,
+                               global const float4* iso_normals, const ClHarcParams params)
 {
     const int x0 = (int)get_global_id(0) * CLVR_LANES, y = (int)get_global_id(1);
     if (x0 >= params.width || y >= params.height)
@@ -692,6 +693,26 @@ kernel void harc_render_packet(global float4* out, global uint* stats, global co
             transmittance = select(transmittance, (float8)(0.0f), hit);
             live &= ~hit; /* the first crossing ends the ray */
             act &= ~hit;
+        } else if (integration == HARC_INTEGRATION_FULL || integration == HARC_INTEGRATION_AVERAGE) {
+            /* one lookup or one average per segment, lane by lane with harc_render's own functions */
+            const float8 s_f = harc_dot8(gx, gy, gz, pos_x, pos_y, pos_z) + gw;
+#define HARC_WHOLE(L)                                                                                                \
+            if (act.s##L) {                                                                                          \
+                float3 color = (float3)(c_r.s##L, c_g.s##L, c_b.s##L);                                               \
+                float transmittance_l = transmittance.s##L;                                                          \
+                if (integration == HARC_INTEGRATION_FULL) {                                                          \
+                    const float4 c = harc_full_lookup(full_table, params.full_ns, params.full_nl, params.full_params, \
+                                                      s_f.s##L, s_b.s##L, step.s##L);                                \
+                    color += transmittance_l * c.xyz;                                                                \
+                    transmittance_l *= 1.0f - c.w;                                                                   \
+                } else {                                                                                             \
+                    harc_segment_average(tf, tf_count, s_f.s##L, s_b.s##L, step.s##L, &color, &transmittance_l);     \
+                }                                                                                                    \
+                c_r.s##L = color.x, c_g.s##L = color.y, c_b.s##L = color.z, transmittance.s##L = transmittance_l;    \
+            }
+            CLVR_EACH_LANE(HARC_WHOLE)
+#undef HARC_WHOLE
+            pieces -= act;
         } else if (integration == HARC_INTEGRATION_SLICES) {
             pieces += harc_slices8(tf, tf_count, params.slices, df, e_x, e_y, e_z, d_x, d_y, d_z, gx, gy, gz, gw,
                                    lambda, lambda_exit, act & isgreater(df, 0.0f), &c_r, &c_g, &c_b, &transmittance);

@@ -589,7 +589,8 @@ TEST(Harc, EarlyTerminationStaysWithinItsThreshold)
 // and pieces. The same bits as one pixel per work-item and the same steps, pieces and step-bound rays: a convex
 // grid from outside, a perspective eye inside a non-convex mesh (its rays start in the eye's cell), a parallel
 // view, two boxes with a gap (rays leave and re-enter), a transfer function of 33 control points (several
-// pieces per cell, up and down), early termination, a step bound, and widths that leave lanes out of the image.
+// pieces per cell, up and down), early termination, a step bound, full pre-integration and the average, and
+// widths that leave lanes out of the image.
 TEST(Harc, PacketsAreBitIdenticalToOnePixelPerWorkItem)
 {
     const std::vector<Box> lShape = {{{0.0, 0.0, 0.0}, {2.0, 1.0, 1.0}, 4}, {{0.0, 1.0, 0.0}, {1.0, 2.0, 1.0}, 3}};
@@ -621,6 +622,10 @@ TEST(Harc, PacketsAreBitIdenticalToOnePixelPerWorkItem)
         {"early termination", &grid, perspective({1.9, 1.4, 2.6}),
          TransferFunction({{0.0, {1.0, 0.5, 0.2}, 20.0}, {1.0, {0.2, 0.5, 1.0}, 20.0}}), json{{"early_termination", 0.9}}},
         {"step bound", &grid, perspective({1.9, 1.4, 2.6}), rampTf(), json{{"max_steps", 3}}},
+        {"full pre-integration, eye inside", &inside, perspective({0.55, 0.45, 0.6}, {1.6, 1.3, 0.3}, 95.0), rampTf(),
+         json{{"integration", "full"}, {"full_table", {16, 16}}}},
+        {"average, gap", &gap, perspective({0.9, 0.7, 3.2}, {0.5, 0.5, 0.5}, 40.0), TransferFunction(fine),
+         json{{"integration", "average"}}},
     };
     int compared = 0;
     for (const Case& c : cases)
@@ -633,7 +638,7 @@ TEST(Harc, PacketsAreBitIdenticalToOnePixelPerWorkItem)
             EXPECT_GT(stats.extra["steps"].get<std::uint64_t>(), 0u) << c.name;
             ++compared;
         }
-    EXPECT_EQ(compared, 7 * 2);
+    EXPECT_EQ(compared, 9 * 2);
 }
 
 }  // namespace

@@ -147,12 +147,8 @@ HarcRenderer::HarcRenderer(Device& device, const Scene& scene, const TetMesh& me
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
     out_ = device_.buffer("harc image", pixels * sizeof(cl_float4), CL_MEM_WRITE_ONLY);
     stats_ = device_.buffer("harc ray counts", pixels * 3 * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
-    // Ray packets (docs/harc.md): partial pre-integration, tetslice's slices or tetiso's first crossing of a whole
-    // mesh, 8 pixels' walks per work-item.
-    packet_ = packetsOnDevice(options_.packets, device_.listing().type) && !part_ &&
-              (options_.integration == HarcOptions::Integration::Partial ||
-               options_.integration == HarcOptions::Integration::Slices ||
-               options_.integration == HarcOptions::Integration::Iso);
+    // Ray packets (docs/harc.md): a whole mesh (not a sort-last part), 8 pixels' walks per work-item.
+    packet_ = packetsOnDevice(options_.packets, device_.listing().type) && !part_;
     kernel_ = device_.kernel("harc.cl", packet_ ? "harc_render_packet" : "harc_render");
     if (options_.entry == HarcOptions::Entry::Raster)
         rasterEntries_ = std::make_unique<HarcRasterEntries>(device_, mesh, topology, shift_, tets_, image_.width,
@@ -262,8 +258,7 @@ Image4f HarcRenderer::render(FrameStats& stats)
     kernel_.setArg(a++, entryBuffer);
     kernel_.setArg(a++, tf_.buffer());
     kernel_.setArg(a++, psi_);
-    if (!packet_)
-        kernel_.setArg(a++, full_);
+    kernel_.setArg(a++, full_);
     kernel_.setArg(a++, isoNormals_);
     kernel_.setArg(a++, params);
     device_.launch(kHarcWalkPass, kernel_, rowWorkItems(image_.width, packet_), image_.height);
