@@ -581,10 +581,13 @@ HarcEntryLists buildHarcEntryLists(const TetMesh& mesh, const TetTopology& topol
                     maxY = std::max(maxY, py);
                 }
                 if (!clipped) {
-                    x0 = std::max(x0, std::floor(minX) - 1.0);
-                    x1 = std::min(x1, std::ceil(maxX) + 1.0);
-                    y0 = std::max(y0, std::floor(minY) - 1.0);
-                    y1 = std::min(y1, std::ceil(maxY) + 1.0);
+                    // The pixel centres (x, y) in the projected box, widened by far more than the projection's
+                    // rounding and the test's edge margin (1e-7 of a barycentric coordinate) can move a hit.
+                    const double pad = 0.01 + 1e-6 * std::max(maxX - minX, maxY - minY);
+                    x0 = std::max(x0, std::ceil(minX - pad));
+                    x1 = std::min(x1, std::floor(maxX + pad));
+                    y0 = std::max(y0, std::ceil(minY - pad));
+                    y1 = std::min(y1, std::floor(maxY + pad));
                 }
                 const glm::dvec3 e1 = p[1] - p[0], e2 = p[2] - p[0];
                 for (int y = static_cast<int>(y0); y <= static_cast<int>(y1); ++y)
