@@ -38,6 +38,14 @@ glm::dvec3 Camera::forward() const { return glm::normalize(focalPoint - position
 glm::dvec3 Camera::right() const { return glm::normalize(glm::cross(forward(), viewUp)); }
 glm::dvec3 Camera::up() const { return glm::cross(right(), forward()); }
 
+Camera Camera::relativeTo(const glm::dvec3& origin) const
+{
+    Camera c = *this;
+    c.position -= origin;
+    c.focalPoint -= origin;
+    return c;
+}
+
 Ray Camera::ray(double px, double py, int width, int height) const
 {
     return PixelRays(*this, width, height).at(px, py);

@@ -35,6 +35,10 @@ struct Camera {
     glm::dvec3 right() const;
     glm::dvec3 up() const;
 
+    // The same camera in coordinates whose origin is `origin` (position and focal point moved by -origin): the
+    // camera of a renderer that shifts its data there.
+    Camera relativeTo(const glm::dvec3& origin) const;
+
     // The ray through the center of pixel (px, py) of a width x height image (row 0 at the top).
     // PixelRays gives the same rays without recomputing the basis per pixel.
     Ray ray(double px, double py, int width, int height) const;

@@ -24,6 +24,9 @@ struct ImageSpec {
     glm::dvec3 background{0.0};
 };
 
+// Whether two images have the same size (Renderer::setCamera takes a new view only for the size its buffers have).
+inline bool sameImageSize(const ImageSpec& a, const ImageSpec& b) { return a.width == b.width && a.height == b.height; }
+
 // The scene's "iso" (docs/scene-format.md): an iso-surface and how it is shaded.
 struct IsoSpec {
     enum class Shading { Gradient, Gradientless, None };

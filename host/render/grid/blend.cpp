@@ -75,7 +75,7 @@ BlendRenderer::BlendRenderer(Device& device, const Scene& scene, const Volume& v
 
 bool BlendRenderer::setCamera(const Scene& scene)
 {
-    if (scene.image.width != image_.width || scene.image.height != image_.height)
+    if (!sameImageSize(scene.image, image_))
         return false;  // the image-sized buffers would change
     image_ = scene.image;
     camera_ = frameCamera(scene, lo_, hi_);

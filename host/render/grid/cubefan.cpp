@@ -223,7 +223,7 @@ public:
     // selection grid does not depend on the view): a new view is a new camera.
     bool setCamera(const Scene& scene) override
     {
-        if (scene.image.width != image_.width || scene.image.height != image_.height)
+        if (!sameImageSize(scene.image, image_))
             return false;  // the frame buffer and the per-pixel counts would change
         image_ = scene.image;
         camera_ = frameCamera(scene, volumeLo_, volumeHi_);

@@ -46,7 +46,7 @@ public:
     // the headlight (IsoSpec::lightFor) follows it, with gradientless shading's shift along the light.
     bool setCamera(const Scene& scene) override
     {
-        if (scene.image.width != image_.width || scene.image.height != image_.height)
+        if (!sameImageSize(scene.image, image_))
             return false;  // the frame buffer and the per-pixel buffers would change
         image_ = scene.image;
         camera_ = frameCamera(scene, lo_, hi_);

@@ -247,7 +247,7 @@ void Slice3dRenderer::setFragmentView()
 
 bool Slice3dRenderer::setCamera(const Scene& scene)
 {
-    if (scene.image.width != image_.width || scene.image.height != image_.height)
+    if (!sameImageSize(scene.image, image_))
         return false;  // the image-sized buffers and frame buffer would change
     frameView(scene);
     if (options_.path == Slice3dOptions::Path::Raster)

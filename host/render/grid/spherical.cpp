@@ -287,7 +287,7 @@ void SphericalRenderer::frameView(const Scene& scene)
 
 bool SphericalRenderer::setCamera(const Scene& scene)
 {
-    if (scene.image.width != imageSpec_.width || scene.image.height != imageSpec_.height)
+    if (!sameImageSize(scene.image, imageSpec_))
         return false;  // the frame buffers would change
     frameView(scene);
     return true;

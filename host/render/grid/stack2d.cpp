@@ -109,7 +109,6 @@ private:
     int axis_ = 2;
     std::vector<StackSlice> slices_;
     SliceGroups grouped_;  // slices_per_polygon > 1 only
-    int channels_ = 1;     // per texel of the stacks: the value, or (gradient, value)
     cl::Buffer sliceTable_;  // buffer[3]: the slice table (slices_per_polygon > 1), then the clip texels
     std::uint64_t sliceTableBytes_ = 0;
     // Clip texture: the texture and world -> clip-texture coordinates.
@@ -170,7 +169,7 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
     // Unshaded: the values (1 channel). Shaded or iso-surface: (gradient, value) per texel, the paper's
     // RGBA slices with the gradient in RGB, so that one bilinear fetch (and the lerp) interpolates both.
     const bool gradients = lighting_.shaded() || iso_;
-    channels_ = gradients ? 4 : 1;
+    const int channels = gradients ? 4 : 1;
     std::vector<glm::vec4> rgba;
     if (gradients)
         rgba = sobelGradientVolume(volume);
@@ -181,10 +180,10 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
         desc.width = dims_[s.b];
         desc.height = dims_[s.c];
         desc.depth = dims_[a];
-        desc.channels = channels_;
+        desc.channels = channels;
         desc.filter = raster::Filter::Linear;
         desc.wrap = raster::Wrap::ClampToEdge;
-        stacks_.emplace_back(device_, desc, stackTexels(points, dims_, channels_, a));
+        stacks_.emplace_back(device_, desc, stackTexels(points, dims_, channels, a));
         residentBytes_ += stacks_.back().bytes();
     }
     setTransferFunction(scene.transferFunction);
@@ -214,10 +213,7 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
     if (clipTexture_) {
         const glm::ivec3 n = clipTexture_->dims();
         u.clip_tex = cl4(n.x, n.y, n.z, options_.clipTexture->inverse ? 1.0f : 0.0f);
-        for (int r = 0; r < 3; ++r)
-            u.clip_row[r] =
-                cl4(static_cast<float>(clipCoordinates_[0][r]), static_cast<float>(clipCoordinates_[1][r]),
-                    static_cast<float>(clipCoordinates_[2][r]), static_cast<float>(clipCoordinates_[3][r]));
+        setClipCoordinateUniforms();  // u.clip_row
     }
     fragmentProgram_.buffers[1] = tf_.buffer();
     if (options_.path == Stack2dOptions::Path::Fused)
@@ -249,7 +245,7 @@ void Stack2dRenderer::setView(const Scene& scene)
     u.camera = toClCamera(camera_, image_.width, image_.height);
     u.axis = cl4(0.0f, 0.0f, 0.0f, 0.0f);
     u.axis.s[axis_] = 1.0f;
-    u.slice_tex = cl4(dims_[s.b], dims_[s.c], channels_, 0.0f);
+    u.slice_tex = cl4(dims_[s.b], dims_[s.c], stacks_[axis_].desc().channels, 0.0f);
     u.to_eye = toCl4(-camera_.forward());
     if (iso_) {
         const double range = iso_->dataMax > iso_->dataMin ? iso_->dataMax - iso_->dataMin : 1.0;
@@ -311,7 +307,7 @@ void Stack2dRenderer::setView(const Scene& scene)
 
 bool Stack2dRenderer::setCamera(const Scene& scene)
 {
-    if (scene.image.width != image_.width || scene.image.height != image_.height)
+    if (!sameImageSize(scene.image, image_))
         return false;  // the frame buffer and the per-pixel counts would change
     image_ = scene.image;
     setView(scene);

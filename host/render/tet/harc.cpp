@@ -172,7 +172,7 @@ void HarcRenderer::buildFullTable(const TransferFunction& tf)
 
 bool HarcRenderer::setCamera(const Scene& scene)
 {
-    if (scene.image.width != image_.width || scene.image.height != image_.height)
+    if (!sameImageSize(scene.image, image_))
         return false;  // the image-sized buffers (and the raster entry's frame buffers) would change
     image_ = scene.image;
     camera_ = frameCamera(scene, lo_, hi_);

@@ -49,9 +49,9 @@ struct HarcOptions {
     enum class Entry { Raster, Host };
     Entry entry = Entry::Host;
     int maxLayers = 64;  // raster entry: peeling layers per frame (1..255); rays past them are counted
-    // Partial pre-integration of a whole mesh (no sort-last part): 8 neighbouring pixels per work-item, one per
-    // float8 lane (kernels/harc.cl's harc_render_packet; the same bits). Unset: on CPU devices only
-    // (packetsOnDevice, host/render/options_util.h).
+    // A whole mesh (not a sort-last part), every integration: 8 neighbouring pixels per work-item, one per float8
+    // lane (kernels/harc.cl's harc_render_packet; the same bits). Unset: on CPU devices only (packetsOnDevice,
+    // host/render/options_util.h).
     std::optional<bool> packets;
 };
 

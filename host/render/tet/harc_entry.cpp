@@ -71,9 +71,7 @@ HarcEntryLists HarcRasterEntries::build(const Camera& worldCamera, HarcRasterEnt
 
     // The camera relative to the mesh origin; near and far bracket the boundary's bounding sphere
     // (near clamped in front of the eye: faces behind it are clipped, as rays start at λ = 0).
-    Camera camera = worldCamera;
-    camera.position -= shift_;
-    camera.focalPoint -= shift_;
+    const Camera camera = worldCamera.relativeTo(shift_);
     const glm::dvec3 forward = camera.forward();
     const double centerDepth = glm::dot(boundsCenter_ - camera.position, forward);
     const double margin = 1e-3 * boundsRadius_ + 1e-6;

@@ -585,7 +585,7 @@ public:
     // Every frame sorts, projects and draws from camera_: a new view is a new camera.
     bool setCamera(const Scene& scene) override
     {
-        if (scene.image.width != image_.width || scene.image.height != image_.height)
+        if (!sameImageSize(scene.image, image_))
             return false;  // the frame buffer would change
         image_ = scene.image;
         camera_ = frameCamera(scene, meshLo_, meshHi_);

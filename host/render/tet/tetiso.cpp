@@ -174,12 +174,10 @@ public:
     // Every frame draws from camera_ (and lights from it): a new view is a new camera.
     bool setCamera(const Scene& scene) override
     {
-        if (scene.image.width != image_.width || scene.image.height != image_.height)
+        if (!sameImageSize(scene.image, image_))
             return false;  // the frame buffer and the per-pixel buffers would change
         image_ = scene.image;
-        camera_ = frameCamera(scene, meshLo_, meshHi_);
-        camera_.position -= shift_;
-        camera_.focalPoint -= shift_;
+        camera_ = frameCamera(scene, meshLo_, meshHi_).relativeTo(shift_);
         return true;
     }
 
@@ -227,9 +225,7 @@ Tetiso::Tetiso(Device& device, const Scene& scene, const TetMesh& mesh)
     color_ = surfaceColor(scene.transferFunction);
     meshLo_ = mesh.boundsMin();
     meshHi_ = mesh.boundsMax();
-    camera_ = frameCamera(scene, meshLo_, meshHi_);
-    camera_.position -= shift_;
-    camera_.focalPoint -= shift_;
+    camera_ = frameCamera(scene, meshLo_, meshHi_).relativeTo(shift_);
     counts_ = MeshCounts::of(mesh);
 
     // All scalar values scaled to [0, 1] (§4.3; GL clamps the alpha-test reference to [0, 1]).

@@ -114,12 +114,10 @@ public:
     // Every frame plans its slices and draws them from camera_: a new view is a new camera.
     bool setCamera(const Scene& scene) override
     {
-        if (scene.image.width != image_.width || scene.image.height != image_.height)
+        if (!sameImageSize(scene.image, image_))
             return false;  // the frame buffer and the image would change
         image_ = scene.image;
-        camera_ = frameCamera(scene, meshLo_, meshHi_);
-        camera_.position -= shift_;
-        camera_.focalPoint -= shift_;
+        camera_ = frameCamera(scene, meshLo_, meshHi_).relativeTo(shift_);
         return true;
     }
 
@@ -152,9 +150,7 @@ TetsliceRenderer::TetsliceRenderer(Device& device, const Scene& scene, const Tet
     hi_ = hi - shift_;
     meshLo_ = lo;
     meshHi_ = hi;
-    camera_ = frameCamera(scene, lo, hi);
-    camera_.position -= shift_;
-    camera_.focalPoint -= shift_;
+    camera_ = frameCamera(scene, lo, hi).relativeTo(shift_);
     counts_ = MeshCounts::of(mesh);
 
     scalars_.assign(mesh.scalars.begin(), mesh.scalars.end());
@@ -379,10 +375,8 @@ private:
     SlicePlan planFor(const Scene& scene) const
     {
         const glm::dvec3 shift = 0.5 * (lo_ + hi_);
-        Camera camera = frameCamera(scene, lo_, hi_);
-        camera.position -= shift;
-        camera.focalPoint -= shift;
-        return planSlices(camera, lo_ - shift, hi_ - shift, options_.slices, options_.sliceSpacing);
+        return planSlices(frameCamera(scene, lo_, hi_).relativeTo(shift), lo_ - shift, hi_ - shift, options_.slices,
+                          options_.sliceSpacing);
     }
     // The walk sampling the cells' field at those slices.
     static HarcOptions walkOptions(const SlicePlan& plan, const std::optional<bool>& packets)
