@@ -28,6 +28,7 @@ using nlohmann::json;
 using test::Box;
 using test::boxMesh;
 using test::meshCamera;
+using test::parallelView;
 using test::perspective;
 
 // Face adjacency by hand (sorted point triples), as buildTopology defines it.
@@ -433,9 +434,7 @@ TEST(Harc, SetCameraEqualsAFreshRenderer)
     TetMesh mesh = boxMesh(boxes, {0.3, 0.35, -0.4}, 0.4);
     checkMesh(mesh);  // orients the cells, as every loader does
     ASSERT_GE(locatePoint(mesh, glm::dvec3(0.55, 0.45, 0.6)), 0);
-    Camera parallel = perspective({3.5, -1.5, 2.5}, {1.0, 1.0, 0.5});
-    parallel.parallel = true;
-    parallel.parallelScale = 1.4;
+    const Camera parallel = parallelView({3.5, -1.5, 2.5}, {1.0, 1.0, 0.5}, 1.4);
     const Camera cameras[] = {perspective({3.2, 2.6, 2.4}, {1.0, 1.0, 0.5}, 40.0),
                               perspective({0.55, 0.45, 0.6}, {1.6, 1.3, 0.3}, 95.0), parallel,
                               perspective({-1.5, 3.0, 1.8}, {1.0, 1.0, 0.5}, 40.0)};
@@ -603,9 +602,7 @@ TEST(Harc, PacketsAreBitIdenticalToOnePixelPerWorkItem)
         const double s = k / 32.0;
         fine.push_back({s, {s, 0.5 + 0.4 * std::sin(9.0 * s), 1.0 - s}, 2.0 + 1.5 * std::sin(13.0 * s)});
     }
-    Camera parallel = perspective({3.5, -1.5, 2.5}, {1.0, 1.0, 0.5});
-    parallel.parallel = true;
-    parallel.parallelScale = 1.4;
+    const Camera parallel = parallelView({3.5, -1.5, 2.5}, {1.0, 1.0, 0.5}, 1.4);
     struct Case {
         const char* name;
         const TetMesh* mesh;

@@ -30,6 +30,7 @@ namespace {
 using nlohmann::json;
 using test::Box;
 using test::boxMesh;
+using test::parallelView;
 using test::perspective;
 
 Scene makeScene(const Camera& camera, const TransferFunction& tf, int size, json options = json::object())
@@ -476,10 +477,7 @@ TetMesh pinwheel()
 
 Camera fromAbove(glm::dvec3 focal, double scale)
 {
-    Camera camera = perspective(focal + glm::dvec3(0.0, 0.0, 3.0), focal, 35.0);
-    camera.parallel = true;
-    camera.parallelScale = scale;
-    return camera;
+    return parallelView(focal + glm::dvec3(0.0, 0.0, 3.0), focal, scale);
 }
 
 TEST(ProjtetNonConvex, PinwheelOfBarsIsNoCycleOfCells)

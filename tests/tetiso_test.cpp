@@ -82,6 +82,7 @@ TEST(TetisoGradients, ALinearFieldGivesItsGradientAtEveryVertex)
         EXPECT_LT(glm::length(v - g), 1e-12);
 }
 
+using test::parallelView;
 using test::perspective;
 
 // A cone field about `center` on a box grid: s = 1 - |x - center|, its iso-surface at s = iso the sphere
@@ -445,9 +446,7 @@ TEST(TetisoFused, IdenticalBitsTwiceAndTheColorFromTheTransferFunction)
 TEST(Tetiso, SetCameraEqualsANewRenderer)
 {
     const TetMesh mesh = coneMesh(6, kConeCenter);
-    Camera parallel = perspective({2.0, -1.0, 1.0}, {0.5, 0.5, 0.5});
-    parallel.parallel = true;
-    parallel.parallelScale = 0.8;
+    const Camera parallel = parallelView({2.0, -1.0, 1.0}, {0.5, 0.5, 0.5}, 0.8);
     const std::vector<Camera> cameras = {perspective({1.7, 1.3, 2.4}, {0.5, 0.5, 0.5}, 30.0),
                                          perspective({-1.1, 0.2, 2.0}, {0.5, 0.5, 0.5}, 30.0), parallel};
     for (const char* path : {"fused", "raster"})

@@ -79,6 +79,7 @@ TEST(TetsliceActiveCells, EachSliceListsExactlyTheCellsItCuts)
 }
 
 using test::meshCamera;
+using test::parallelView;
 using test::perspective;
 
 Scene makeScene(const Camera& camera, const TransferFunction& tf, int size, json options = json::object())
@@ -290,9 +291,7 @@ TEST(Tetslice, StatsCountReorientedAndDegenerateCells)
 TEST(Tetslice, SetCameraEqualsANewRenderer)
 {
     const TetMesh mesh = test::boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, 3}}, {0.6, 0.25, -0.4}, 0.35);
-    Camera parallel = perspective({2.2, -0.9, 1.1}, {0.5, 0.5, 0.5});
-    parallel.parallel = true;
-    parallel.parallelScale = 0.9;
+    const Camera parallel = parallelView({2.2, -0.9, 1.1}, {0.5, 0.5, 0.5}, 0.9);
     const std::vector<Camera> cameras = {perspective({1.9, 1.4, 2.6}, {0.5, 0.5, 0.5}, 35.0),
                                          perspective({-0.8, 2.5, 0.3}, {0.5, 0.5, 0.5}, 35.0), parallel};
     for (const char* path : {"fused", "raster"})
@@ -313,9 +312,7 @@ TEST(Tetslice, PacketsAreBitIdenticalToOnePixelPerWorkItem)
     const TetMesh grid = test::boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, 3}}, {0.6, 0.25, -0.4}, 0.35);
     const TetMesh gap = test::boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 0.4}, 3}, {{0.0, 0.0, 0.7}, {1.0, 1.0, 1.1}, 3}},
                                       {0.3, 0.5, 0.2}, 0.1);
-    Camera parallel = perspective({2.2, -0.9, 1.1}, {0.5, 0.5, 0.5});
-    parallel.parallel = true;
-    parallel.parallelScale = 0.9;
+    const Camera parallel = parallelView({2.2, -0.9, 1.1}, {0.5, 0.5, 0.5}, 0.9);
     struct Case {
         const char* name;
         const TetMesh* mesh;

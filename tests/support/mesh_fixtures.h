@@ -125,6 +125,15 @@ inline Camera perspective(glm::dvec3 position, glm::dvec3 focal = {0.5, 0.5, 0.5
     return c;
 }
 
+// A parallel camera with +y up, `scale` half the view's height.
+inline Camera parallelView(glm::dvec3 position, glm::dvec3 focal, double scale)
+{
+    Camera c = perspective(position, focal);
+    c.parallel = true;
+    c.parallelScale = scale;
+    return c;
+}
+
 // A size x size scene of `technique` with `camera`, `tf`, `options`, on the background (0.1, 0.2, 0.3).
 inline Scene meshScene(const std::string& technique, const Camera& camera, const TransferFunction& tf, int size,
                        nlohmann::json options = nlohmann::json::object())
