@@ -481,7 +481,7 @@ int8 harc_segment_from8(global const float* tf, const int n, global const float*
 
 /* harc_slices lane by lane, for the lanes in m (df > 0): each lane's slices in [seg_f, seg_b) in order. Returns the
  * slices taken per lane. */
-int8 harc_slices8(global const float* tf, const int tf_count, const float4 slices, const float8 df, const float8 e_x,
+__attribute__((always_inline)) int8 harc_slices8(global const float* tf, const int tf_count, const float4 slices, const float8 df, const float8 e_x,
                   const float8 e_y, const float8 e_z, const float8 d_x, const float8 d_y, const float8 d_z,
                   const float8 gx, const float8 gy, const float8 gz, const float8 gw, const float8 seg_f,
                   const float8 seg_b, const int8 m, float8* c_r, float8* c_g, float8* c_b, float8* transmittance)
