@@ -19,6 +19,7 @@
 #include <cstdio>
 #include <cstring>
 #include <map>
+#include <random>
 #include <string>
 
 namespace clvr {
@@ -129,6 +130,11 @@ Image4f renderHarc(const Scene& scene, const TetMesh& mesh, FrameStats* statsOut
         *statsOut = stats;
     return image;
 }
+
+struct TopologyAndSlots {
+    TetTopology topology;
+    std::vector<std::uint32_t> slot;
+};
 
 void printError(const char* what, const Image4f& actual, const Image4d& expected)
 {
@@ -256,6 +262,133 @@ TEST(HarcLayout, AdjacencyNamesTheNeighborsEntryFace)
         }
     }
     EXPECT_GT(inner, mesh.tets.size());  // the grid has inner faces
+}
+
+// The mesh's cells in a fixed random order (as a mesher may number them), the points kept.
+TetMesh shuffledCells(TetMesh mesh, unsigned seed)
+{
+    std::mt19937 random(seed);
+    std::shuffle(mesh.tets.begin(), mesh.tets.end(), random);
+    return mesh;
+}
+
+// harcCellOrder: a permutation that puts face neighbours near each other on the device, and packHarcTets with
+// it: each cell's planes and gradient at its place, its adjacency naming the neighbours' places.
+TEST(HarcLayout, CellOrderPlacesNeighboursNearAndMapsTheAdjacency)
+{
+    const TetMesh mesh = shuffledCells(boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, 6}}, {0.5, 0.3, 0.2}, 0.1), 7);
+    const TetTopology topology = handTopology(mesh);
+    const std::vector<std::uint32_t> slot = harcCellOrder(mesh, topology);
+    ASSERT_EQ(slot.size(), mesh.tets.size());
+    std::vector<std::uint32_t> sorted = slot;
+    std::sort(sorted.begin(), sorted.end());
+    for (std::size_t i = 0; i < sorted.size(); ++i)
+        ASSERT_EQ(sorted[i], i) << "not a permutation";
+    // The mean distance in memory between face neighbours: the shuffled order's is a third of the cells.
+    double shuffled = 0.0, ordered = 0.0;
+    std::size_t pairs = 0;
+    for (std::size_t t = 0; t < mesh.tets.size(); ++t)
+        for (const std::int32_t n : topology.neighbor[t])
+            if (n >= 0) {
+                shuffled += std::abs(static_cast<double>(t) - n);
+                ordered += std::abs(static_cast<double>(slot[t]) - slot[static_cast<std::size_t>(n)]);
+                ++pairs;
+            }
+    std::printf("mean distance of face neighbours: %.1f cells shuffled, %.1f ordered (%zu cells); log2: %.2f, %.2f\n",
+                shuffled / pairs, ordered / pairs, mesh.tets.size(), harcNeighbourDistance(topology),
+                harcNeighbourDistance(topology, slot));
+    EXPECT_LT(ordered * 8.0, shuffled);
+    EXPECT_LT(harcNeighbourDistance(topology, slot) + 3.0, harcNeighbourDistance(topology));
+    // A mesh numbered in that order already keeps its own.
+    TetMesh numbered = mesh;
+    for (std::size_t t = 0; t < mesh.tets.size(); ++t)
+        numbered.tets[slot[t]] = mesh.tets[t];
+    const std::vector<std::uint32_t> kept = harcCellOrder(numbered, handTopology(numbered));
+    for (std::size_t t = 0; t < kept.size(); ++t)
+        ASSERT_EQ(kept[t], t) << "a mesh in Morton order was reordered";
+
+    const glm::dvec3 shift(0.5);
+    const std::vector<cl_float4> plain = packHarcTets(mesh, topology, shift);
+    const std::vector<cl_float4> placed = packHarcTets(mesh, topology, shift, slot);
+    ASSERT_EQ(placed.size(), plain.size());
+    for (std::size_t t = 0; t < mesh.tets.size(); ++t) {
+        EXPECT_EQ(std::memcmp(&placed[5 * slot[t]], &plain[5 * t], 4 * sizeof(cl_float4)), 0) << "tet " << t;
+        cl_int a[4], b[4];
+        std::memcpy(a, &placed[5 * slot[t] + 4], sizeof a);
+        std::memcpy(b, &plain[5 * t + 4], sizeof b);
+        for (int i = 0; i < 4; ++i)
+            EXPECT_EQ(a[i], b[i] < 0 ? -1 : harcDeviceCode(b[i], slot)) << "tet " << t << " face " << i;
+    }
+    EXPECT_EQ(harcDeviceCode(-1 - 5, slot), -1 - static_cast<std::int32_t>(slot[5]));  // the eye's cell
+    EXPECT_EQ(harcDeviceCode(4 * 9 + 3, slot), static_cast<std::int32_t>(4 * slot[9] + 3));
+}
+
+// The cells' order on the device changes no bit of any integration, packets or not, with the host's entry
+// lists, the raster's and an eye inside the mesh (whose entries name cells by their place).
+TEST(Harc, CellOrderChangesNoBit)
+{
+    const std::vector<Box> lShape = {{{0.0, 0.0, 0.0}, {2.0, 1.0, 1.0}, 4}, {{0.0, 1.0, 0.0}, {1.0, 2.0, 1.0}, 3}};
+    TetMesh inside = boxMesh(lShape, {0.3, 0.35, -0.4}, 0.4);
+    checkMesh(inside);
+    inside = shuffledCells(inside, 3);
+    const TetMesh gap = shuffledCells(
+        boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 0.4}, 3}, {{0.0, 0.0, 0.7}, {1.0, 1.0, 1.1}, 3}}, {0.3, 0.5, 0.2}, 0.1), 5);
+    const TetMesh grid = shuffledCells(boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, 3}}, {0.6, 0.25, -0.4}, 0.35), 11);
+    struct Case {
+        const char* name;
+        const TetMesh* mesh;
+        Camera camera;
+        json options;
+    };
+    const Camera eyeInside = perspective({0.55, 0.45, 0.6}, {1.6, 1.3, 0.3}, 95.0);
+    const Camera overGap = perspective({0.9, 0.7, 3.2}, {0.5, 0.5, 0.5}, 40.0);
+    const Case cases[] = {
+        {"grid, partial", &grid, perspective({1.9, 1.4, 2.6}), json::object()},
+        {"eye inside the L, partial", &inside, eyeInside, json::object()},
+        {"eye inside the L, full", &inside, eyeInside, json{{"integration", "full"}, {"full_table", {16, 16}}}},
+        {"gap, average", &gap, overGap, json{{"integration", "average"}}},
+        {"gap, raster entry", &gap, overGap, json{{"entry", "raster"}}},
+        {"gap, slices", &gap, overGap, json::object()},
+        {"L, iso", &inside, parallelView({3.5, -1.5, 2.5}, {1.0, 1.0, 0.5}, 1.4), json::object()},
+    };
+    int compared = 0;
+    for (const Case& c : cases) {
+        TopologyAndSlots check{handTopology(*c.mesh), {}};
+        check.slot = harcCellOrder(*c.mesh, check.topology);
+        ASSERT_FALSE(std::is_sorted(check.slot.begin(), check.slot.end())) << c.name << ": the order is the mesh's";
+        for (const bool packets : {true, false}) {
+            Scene scene = makeScene(c.camera, rampTf(), 41, c.options);
+            scene.image.height = 29;
+            HarcOptions options = parseHarcOptions(scene.options);
+            options.packets = packets;
+            const std::string name(c.name);
+            if (name.ends_with("slices")) {
+                options.integration = HarcOptions::Integration::Slices;
+                options.sliceDepth0 = 0.5;
+                options.sliceSpacing = 0.05;
+                options.sliceCount = 100;
+            } else if (name.ends_with("iso")) {
+                options.integration = HarcOptions::Integration::Iso;
+                options.iso.value = 0.4;
+                for (const glm::dvec3& point : c.mesh->points)  // a different normal at every point
+                    options.iso.normals.push_back(glm::normalize(point - glm::dvec3(0.7, 0.6, -0.5)));
+            }
+            FrameStats stats[2];
+            Image4f images[2];
+            for (int i = 0; i < 2; ++i) {
+                options.meshCellOrder = i == 1;
+                images[i] = makeHarcRenderer(test::device(), scene, *c.mesh, check.topology, options)->render(stats[i]);
+            }
+            const std::string what = name + (packets ? ", packets" : ", one pixel per work-item");
+            EXPECT_TRUE(test::sameBits(images[0], images[1])) << what;
+            for (const char* key : {"steps", "pieces", "entry_crossings", "eye_tet"})
+                EXPECT_EQ(stats[0].extra[key], stats[1].extra[key]) << what << ": " << key;
+            EXPECT_GT(stats[0].extra["steps"].get<std::uint64_t>(), 0u) << what;
+            EXPECT_GT(stats[0].extra["pieces"].get<std::uint64_t>(), 0u) << what;  // pieces, samples or hits
+            ++compared;
+        }
+    }
+    EXPECT_EQ(compared, 7 * 2);
 }
 
 TEST(Harc, SingleTetConstantMatchesClosedForm)

@@ -21,6 +21,7 @@
 #include <cstring>
 #include <limits>
 #include <mutex>
+#include <numeric>
 #include <string>
 
 namespace clvr {
@@ -66,6 +67,7 @@ private:
     ImageSpec image_;
     TetMesh mesh_;          // copies: the renderer outlives the caller's mesh
     TetTopology topology_;
+    std::vector<std::uint32_t> slot_;  // each tetrahedron's place on the device (harcCellOrder)
     glm::dvec3 shift_{0.0};
     glm::dvec3 lo_{0.0}, hi_{0.0};  // the mesh's bounds, which frame the camera (harcBounds)
     std::optional<MeshPart> part_;  // the box to integrate in, for a part of a larger mesh
@@ -111,7 +113,13 @@ HarcRenderer::HarcRenderer(Device& device, const Scene& scene, const TetMesh& me
     counts_ = MeshCounts::of(mesh);
     maxSteps_ = harcMaxSteps(options_, counts_.rendered);
 
-    const std::vector<cl_float4> tets = packHarcTets(mesh, topology, shift_);
+    if (options_.meshCellOrder) {
+        slot_.resize(mesh.tets.size());
+        std::iota(slot_.begin(), slot_.end(), 0u);
+    } else {
+        slot_ = harcCellOrder(mesh, topology);
+    }
+    const std::vector<cl_float4> tets = packHarcTets(mesh, topology, shift_, slot_);
     tets_ = device_.upload("harc tetrahedra (80 bytes each)", tets);
     tf_.upload(device_, "harc transfer function", scene.transferFunction);
     const PsiTable& psi = psiTable();
@@ -137,7 +145,8 @@ HarcRenderer::HarcRenderer(Device& device, const Scene& scene, const TetMesh& me
         for (std::size_t t = 0; t < mesh.tets.size(); ++t)
             for (int axis = 0; axis < 3; ++axis)
                 for (int v = 0; v < 4; ++v)
-                    normals[3 * t + axis].s[v] = static_cast<float>(options_.iso.normals[mesh.tets[t][v]][axis]);
+                    normals[3 * slot_[t] + axis].s[v] =
+                        static_cast<float>(options_.iso.normals[mesh.tets[t][v]][axis]);
         isoNormals_ = device_.upload("harc iso vertex normals (48 bytes per tet)", normals);
         residentBytes_ += normals.size() * sizeof(cl_float4);
     } else {
@@ -152,7 +161,7 @@ HarcRenderer::HarcRenderer(Device& device, const Scene& scene, const TetMesh& me
     kernel_ = device_.kernel("harc.cl", packet_ ? "harc_render_packet" : "harc_render");
     if (options_.entry == HarcOptions::Entry::Raster)
         rasterEntries_ = std::make_unique<HarcRasterEntries>(device_, mesh, topology, shift_, tets_, image_.width,
-                                                             image_.height, options_.maxLayers);
+                                                             image_.height, options_.maxLayers, slot_);
 }
 
 // The table over s in the hull of the transfer function's range and the mesh's: a segment whose s
@@ -196,13 +205,18 @@ Image4f HarcRenderer::render(FrameStats& stats)
 {
     const FrameClock clock;
     // Entry points: the boundary front faces' crossings per pixel, sorted by depth, every frame.
+    // The raster's lists come with the cells' places on the device (slot_); the host's are sorted in the mesh's
+    // numbering (ties by code) and mapped after, so that the order of the cells changes no list.
     HarcRasterEntryStats peel;
     HarcEntryLists lists = rasterEntries_ ? rasterEntries_->build(camera_, peel)
                                           : buildHarcEntryLists(mesh_, topology_, camera_, image_.width, image_.height);
+    if (!rasterEntries_)
+        for (cl_int2& entry : lists.entries)
+            entry.s[1] = harcDeviceCode(entry.s[1], slot_);
     // A perspective eye inside the mesh: every ray starts in the cell holding the eye, before any crossing.
     const std::int64_t eyeTet = camera_.parallel ? -1 : locatePoint(mesh_, camera_.position);
     if (eyeTet >= 0)
-        prependEyeEntry(lists, static_cast<std::uint32_t>(eyeTet));
+        prependEyeEntry(lists, slot_[static_cast<std::size_t>(eyeTet)]);
     const double entryMs = clock.ms();
     const cl::Buffer offsets = device_.upload("harc entry offsets", lists.offsets);
     std::vector<cl_int2> entries = lists.entries;
@@ -480,8 +494,62 @@ std::uint64_t harcMaxSteps(const HarcOptions& options, std::uint64_t tets)
     return static_cast<std::uint64_t>(4.0 * std::cbrt(static_cast<double>(tets))) + 10000;
 }
 
-std::vector<cl_float4> packHarcTets(const TetMesh& mesh, const TetTopology& topology, const glm::dvec3& shift)
+double harcNeighbourDistance(const TetTopology& topology, const std::vector<std::uint32_t>& slot)
 {
+    const auto place = [&slot](std::size_t t) { return static_cast<double>(slot.empty() ? t : slot[t]); };
+    double sum = 0.0;
+    std::size_t pairs = 0;
+    for (std::size_t t = 0; t < topology.neighbor.size(); ++t)
+        for (const std::int32_t n : topology.neighbor[t])
+            if (n >= 0) {
+                sum += std::log2(1.0 + std::abs(place(t) - place(static_cast<std::size_t>(n))));
+                ++pairs;
+            }
+    return pairs ? sum / static_cast<double>(pairs) : 0.0;
+}
+
+std::vector<std::uint32_t> harcCellOrder(const TetMesh& mesh, const TetTopology& topology)
+{
+    const std::size_t count = mesh.tets.size();
+    glm::dvec3 lo(INFINITY), hi(-INFINITY);
+    std::vector<glm::dvec3> centroid(count);
+    for (std::size_t t = 0; t < count; ++t) {
+        const glm::uvec4 v = mesh.tets[t];
+        centroid[t] = 0.25 * (mesh.points[v[0]] + mesh.points[v[1]] + mesh.points[v[2]] + mesh.points[v[3]]);
+        lo = glm::min(lo, centroid[t]);
+        hi = glm::max(hi, centroid[t]);
+    }
+    // 10 bits per axis on the centroids' box, interleaved z y x from the top bit down.
+    const auto spread = [](std::uint32_t v) {
+        std::uint64_t x = v & 0x3ff;
+        x = (x | (x << 16)) & 0x030000ff;
+        x = (x | (x << 8)) & 0x0300f00f;
+        x = (x | (x << 4)) & 0x030c30c3;
+        x = (x | (x << 2)) & 0x09249249;
+        return x;
+    };
+    const glm::dvec3 extent = glm::max(hi - lo, glm::dvec3(1e-300));
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> keys(count);
+    for (std::size_t t = 0; t < count; ++t) {
+        const glm::dvec3 q = glm::clamp((centroid[t] - lo) / extent * 1024.0, glm::dvec3(0.0), glm::dvec3(1023.0));
+        keys[t] = {spread(static_cast<std::uint32_t>(q.x)) | spread(static_cast<std::uint32_t>(q.y)) << 1 |
+                       spread(static_cast<std::uint32_t>(q.z)) << 2,
+                   static_cast<std::uint32_t>(t)};
+    }
+    std::sort(keys.begin(), keys.end());
+    std::vector<std::uint32_t> slot(count);
+    for (std::size_t i = 0; i < count; ++i)
+        slot[keys[i].second] = static_cast<std::uint32_t>(i);
+    if (harcNeighbourDistance(topology, slot) < harcNeighbourDistance(topology))
+        return slot;
+    std::iota(slot.begin(), slot.end(), 0u);  // the mesh's own order is the nearer
+    return slot;
+}
+
+std::vector<cl_float4> packHarcTets(const TetMesh& mesh, const TetTopology& topology, const glm::dvec3& shift,
+                                    const std::vector<std::uint32_t>& slot)
+{
+    const auto place = [&slot](std::size_t t) { return slot.empty() ? t : static_cast<std::size_t>(slot[t]); };
     std::vector<cl_float4> out(mesh.tets.size() * 5);
     for (std::size_t t = 0; t < mesh.tets.size(); ++t) {
         const glm::uvec4 v = mesh.tets[t];
@@ -504,7 +572,7 @@ std::vector<cl_float4> packHarcTets(const TetMesh& mesh, const TetTopology& topo
             g += mesh.scalars[v[i]] * h[i];
             g0 += mesh.scalars[v[i]] * k[i];
         }
-        cl_float4* o = &out[5 * t];
+        cl_float4* o = &out[5 * place(t)];
         for (int i = 0; i < 3; ++i)
             o[i] = toCl4(h[i], k[i]);
         o[3] = toCl4(g, g0);
@@ -517,7 +585,7 @@ std::vector<cl_float4> packHarcTets(const TetMesh& mesh, const TetTopology& topo
             if (n >= 0)
                 for (int j = 0; j < 4; ++j)
                     if (topology.neighbor[n][j] == static_cast<std::int32_t>(t))
-                        adj[i] = n * 4 + j;
+                        adj[i] = static_cast<cl_int>(place(static_cast<std::size_t>(n)) * 4 + j);
         }
         std::memcpy(&o[4], adj, sizeof adj);
     }

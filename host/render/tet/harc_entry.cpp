@@ -29,7 +29,7 @@ std::string entryFragmentSource()
 
 HarcRasterEntries::HarcRasterEntries(Device& device, const TetMesh& mesh, const TetTopology& topology,
                                      const glm::dvec3& shift, const cl::Buffer& tets, int width, int height,
-                                     int maxLayers)
+                                     int maxLayers, const std::vector<std::uint32_t>& slot)
     : device_(device), width_(width), height_(height), maxLayers_(maxLayers), shift_(shift)
 {
     if (maxLayers_ < 1 || maxLayers_ > 255)
@@ -46,7 +46,8 @@ HarcRasterEntries::HarcRasterEntries(Device& device, const TetMesh& mesh, const 
             lo = glm::min(lo, q);
             hi = glm::max(hi, q);
         }
-        codes_.push_back(static_cast<std::int32_t>(bf.tet * 4 + bf.face));
+        const auto code = static_cast<std::int32_t>(bf.tet * 4 + bf.face);
+        codes_.push_back(slot.empty() ? code : harcDeviceCode(code, slot));
     }
     if (!codes_.empty()) {
         boundsCenter_ = 0.5 * (lo + hi);
