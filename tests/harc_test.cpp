@@ -323,6 +323,82 @@ TEST(HarcLayout, CellOrderPlacesNeighboursNearAndMapsTheAdjacency)
     EXPECT_EQ(harcDeviceCode(4 * 9 + 3, slot), static_cast<std::int32_t>(4 * slot[9] + 3));
 }
 
+// buildHarcEntryLists against every pixel's ray tested against every boundary face (no boxes, no bands): the same
+// test (kernels/harc.cl's walk needs these exact lists: the faces a ray enters through, λ >= 0, margins at the
+// edges), sorted by λ, then code. Perspective from outside and from inside (faces behind the eye clipped), parallel,
+// a sort-first band of rows, sizes that are no multiple of the 8-row bands.
+HarcEntryLists bruteForceEntryLists(const TetMesh& mesh, const TetTopology& topology, const Camera& camera, int width,
+                                    int height)
+{
+    HarcEntryLists lists;
+    lists.offsets.push_back(0);
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            const Ray ray = PixelRays(camera, width, height).at(x, y);
+            std::vector<std::pair<float, std::int32_t>> hits;
+            for (const TetTopology::BoundaryFace& bf : topology.boundary) {
+                const std::array<glm::dvec3, 3> p = outwardFace(mesh, bf.tet, bf.face);
+                const glm::dvec3 e1 = p[1] - p[0], e2 = p[2] - p[0];
+                if (!(glm::dot(glm::cross(e1, e2), ray.direction) < 0.0))
+                    continue;
+                const glm::dvec3 pv = glm::cross(ray.direction, e2);
+                const double det = glm::dot(e1, pv);
+                if (det == 0.0)
+                    continue;
+                const glm::dvec3 tv0 = ray.origin - p[0], qv = glm::cross(tv0, e1);
+                const double bu = glm::dot(tv0, pv) / det, bv = glm::dot(ray.direction, qv) / det;
+                const double lambda = glm::dot(e2, qv) / det;
+                if (bu >= -1e-7 && bv >= -1e-7 && bu + bv <= 1.0 + 1e-7 && lambda >= 0.0)
+                    hits.push_back({static_cast<float>(lambda), static_cast<std::int32_t>(bf.tet * 4 + bf.face)});
+            }
+            std::sort(hits.begin(), hits.end());
+            for (const auto& [lambda, code] : hits) {
+                cl_int bits;
+                std::memcpy(&bits, &lambda, sizeof bits);
+                lists.entries.push_back(cl_int2{{bits, code}});
+            }
+            lists.offsets.push_back(static_cast<cl_uint>(lists.entries.size()));
+        }
+    return lists;
+}
+
+TEST(HarcEntryLists, EqualTheCrossingsOfEveryRayWithEveryFace)
+{
+    const std::vector<Box> lShape = {{{0.0, 0.0, 0.0}, {2.0, 1.0, 1.0}, 4}, {{0.0, 1.0, 0.0}, {1.0, 2.0, 1.0}, 3}};
+    TetMesh l = boxMesh(lShape, {0.3, 0.35, -0.4}, 0.4);
+    checkMesh(l);
+    const TetMesh gap = boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 0.4}, 3}, {{0.0, 0.0, 0.7}, {1.0, 1.0, 1.1}, 3}}, {0.3, 0.5, 0.2}, 0.1);
+    Camera band = perspective({0.9, 0.7, 3.2}, {0.5, 0.5, 0.5}, 40.0);
+    band.bandFullHeight = 53;  // rows 17..36 of a 53-row image
+    band.bandY0 = 17;
+    struct Case {
+        const char* name;
+        const TetMesh* mesh;
+        Camera camera;
+        int width, height;
+    };
+    const Case cases[] = {
+        {"L, perspective", &l, perspective({3.1, 2.4, 2.6}), 61, 45},
+        {"L, eye inside", &l, perspective({0.55, 0.45, 0.6}, {1.6, 1.3, 0.3}, 95.0), 40, 33},
+        {"L, parallel", &l, parallelView({3.5, -1.5, 2.5}, {1.0, 1.0, 0.5}, 1.4), 37, 29},
+        {"gap, a band of rows", &gap, band, 47, 20},
+        {"gap, one pixel", &gap, perspective({0.9, 0.7, 3.2}, {0.5, 0.5, 0.5}, 40.0), 1, 1},
+    };
+    for (const Case& c : cases) {
+        const TetTopology topology = handTopology(*c.mesh);
+        const HarcEntryLists lists = buildHarcEntryLists(*c.mesh, topology, c.camera, c.width, c.height);
+        const HarcEntryLists expected = bruteForceEntryLists(*c.mesh, topology, c.camera, c.width, c.height);
+        ASSERT_EQ(lists.offsets.size(), static_cast<std::size_t>(c.width) * c.height + 1) << c.name;
+        EXPECT_GT(expected.entries.size(), 0u) << c.name;  // the mesh is in view
+        EXPECT_TRUE(lists.offsets == expected.offsets) << c.name;
+        ASSERT_EQ(lists.entries.size(), expected.entries.size()) << c.name;
+        std::size_t differ = 0;
+        for (std::size_t k = 0; k < lists.entries.size(); ++k)
+            differ += lists.entries[k].s[0] != expected.entries[k].s[0] || lists.entries[k].s[1] != expected.entries[k].s[1];
+        EXPECT_EQ(differ, 0u) << c.name;
+    }
+}
+
 // The cells' order on the device changes no bit of any integration, packets or not, with the host's entry
 // lists, the raster's and an eye inside the mesh (whose entries name cells by their place).
 TEST(Harc, CellOrderChangesNoBit)

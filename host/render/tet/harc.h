@@ -119,7 +119,7 @@ inline std::int32_t harcDeviceCode(std::int32_t code, const std::vector<std::uin
 
 // Per pixel of a width x height image, the crossings of its ray (Camera::ray, λ >= 0) with boundary
 // faces that face the ray (outward normal . d < 0), sorted by λ: entries[offsets[p] .. offsets[p+1])
-// = (λ as float bits, tet * 4 + face).
+// = (λ as float bits, tet * 4 + face), ties in λ by code. Built over the host's threads in bands of rows (docs/harc.md).
 struct HarcEntryLists {
     std::vector<cl_uint> offsets;  // width * height + 1
     std::vector<cl_int2> entries;
