@@ -280,10 +280,13 @@ kernel void cubefan_fused_packet(global float4* out, global uint* steps, global 
         int8 hix = min(lox + side, nx), hiy = min(loy + side, ny), hiz = min(loz + side, nz);
         const int8 transparent = (code & 0x80) != 0;
         if (any(transparent & live)) {
-            /* the cube of empty bricks around a transparent cube, where it is wider than the cube */
+            /* the cube of empty bricks around a transparent cube, where it is wider than the cube (the radius less
+             * one in each lane's own load: CLVR_GATHER8 and a vector subtraction made the frame 25 % slower on
+             * PoCL 3.1, BENCHMARKS.md "cubefan's empty-space read") */
             int8 r;
-            CLVR_GATHER8(r, space, at >> 6);
-            r -= 1;
+#define CUBEFAN_SPACE(L) r.s##L = (int)space[at.s##L >> 6] - 1;
+            CLVR_EACH_LANE(CUBEFAN_SPACE)
+#undef CUBEFAN_SPACE
             const int8 wide = transparent & (r >= 0) & (8 * r + 4 > side);
             lox = select(lox, max(((vx >> 2) - r) << 2, 0), wide);
             loy = select(loy, max(((vy >> 2) - r) << 2, 0), wide);
