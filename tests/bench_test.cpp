@@ -6,6 +6,7 @@
 #include "tools/bench_mesh.cpp"
 #include "tools/bench_suites.cpp"
 #include "tools/ceiling.cpp"
+#include "tools/ceiling_cubefan.cpp"
 #include "tools/ceiling_harc.cpp"
 #include "tools/ceiling_spherical.cpp"
 #include "tools/ceiling_stack2d.cpp"
@@ -177,6 +178,51 @@ TEST(Stack2dCeiling, DoesTheFusedKernelsWork)
 std::filesystem::path benchScene(const std::string& name)
 {
     return std::filesystem::path(CLVR_SOURCE_DIR) / "data/scenes/bench" / name;
+}
+
+// cubefan's ceiling loop (tools/ceiling_cubefan.h) does the fused kernel's walk in plain C++ over the same selection
+// grid: the same image up to float rounding (exp against clvr_exp2, the transfer function's slopes, the camera's
+// rays in float; measured max ~1e-6) and the same cubes crossed but for rays through a cube's edge within rounding.
+// Perspective from outside and from inside the volume, parallel, exact cubes (0 %), merged ones, early termination.
+TEST(CubefanCeiling, DoesTheFusedKernelsWork)
+{
+    const clvr::Volume blobs = clvr::generateVolume("blobs", {41, 37, 30});
+    const clvr::TransferFunction sparse({{0.0, {0, 0, 0}, 0.0}, {0.35, {0, 0, 0}, 0.0}, {0.6, {1, 0.5, 0}, 6.0},
+                                         {1.0, {1, 1, 1}, 14.0}});
+    clvr::Camera inside;
+    inside.position = {0.13, -0.07, 0.41};
+    inside.focalPoint = {0.3, 0.2, -1.0};
+    inside.viewAngle = 70.0;
+    const clvr::Camera cameras[] = {clvr::test::obliquePerspectiveCamera(30.0), clvr::test::obliqueParallelCamera(1.3),
+                                    inside};
+    const nlohmann::json sets[] = {{{"error", 0.0}}, {{"error", 0.1}}, {{"error", 0.05}, {"early_termination", 0.6}}};
+    for (const clvr::Camera& camera : cameras)
+        for (const nlohmann::json& set : sets) {
+            clvr::Scene scene;
+            scene.technique = "cubefan";
+            scene.camera = camera;
+            scene.image = clvr::ImageSpec{52, 44, {0.05, 0.05, 0.1}};
+            scene.transferFunction = sparse;
+            scene.options = set;
+            clvr::FrameStats stats;
+            const clvr::Image4f kernel = clvr::test::renderScene(scene, blobs, &stats);
+            const clvr::tools::CubefanCeiling ceiling(blobs, sparse, *scene.camera, scene.image,
+                                                      clvr::parseCubefanOptions(set));
+            const clvr::tools::CeilingResult result = ceiling.render(2);
+            const clvr::test::ImageError e = clvr::test::imageError(result.image, clvr::raster::reference::toDouble(kernel));
+            std::printf("[ measured ] cubefan ceiling vs kernel (%s, camera %d): max %.3g, mean %.3g; cubes crossed %llu vs %llu\n",
+                        set.dump().c_str(), static_cast<int>(&camera - cameras),
+                        std::max({e.maxAbs.r, e.maxAbs.g, e.maxAbs.b, e.maxAbs.a}),
+                        std::max({e.meanAbs.r, e.meanAbs.g, e.meanAbs.b, e.meanAbs.a}),
+                        static_cast<unsigned long long>(result.samples), static_cast<unsigned long long>(stats.samples));
+            EXPECT_TRUE(clvr::test::imagesNear(result.image, clvr::raster::reference::toDouble(kernel),
+                                               {.maxAbs = 1e-4, .meanAbs = 1e-6}))
+                << set.dump();
+            EXPECT_GT(result.samples, 500u) << set.dump();
+            EXPECT_LE(std::abs(static_cast<double>(result.samples) - static_cast<double>(stats.samples)),
+                      1e-4 * static_cast<double>(stats.samples) + 2.0)
+                << set.dump();
+        }
 }
 
 TEST(BenchMesh, BluntfinScenesHaveTheStatedControlPointsAndImageSize)

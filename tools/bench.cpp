@@ -23,6 +23,7 @@
 #include "tools/bench_raster.h"
 #include "tools/ceiling.h"
 #include "tools/ceiling_harc.h"
+#include "tools/ceiling_cubefan.h"
 #include "tools/ceiling_spherical.h"
 #include "tools/ceiling_stack2d.h"
 
@@ -166,7 +167,7 @@ const Image4d& referenceImage(std::map<std::string, Image4d>& cache, const Scene
 // The plain C++ ceiling loop on the same scene, where there is one: slice3d's fused path with per-sample
 // classification (the raster path counts fragments, not samples; pre-integrated slabs and clip meshes are
 // other loops), stack2d's fused direct volume rendering (unshaded, no clip texture), spherical's fused
-// path. Its frames are interleaved with clvr's (see bench()), so that both
+// path, cubefan's fused path. Its frames are interleaved with clvr's (see bench()), so that both
 // see the same load on a shared machine.
 std::unique_ptr<VolumeCeiling> makeCeiling(const Scene& scene, const Volume& volume, const Camera& camera)
 {
@@ -192,6 +193,12 @@ std::unique_ptr<VolumeCeiling> makeCeiling(const Scene& scene, const Volume& vol
         if (options.path != SphericalOptions::Path::Fused)
             return nullptr;
         return std::make_unique<SphericalCeiling>(volume, scene.transferFunction, camera, scene.image, options);
+    }
+    if (scene.technique == cubefanTechnique().name) {
+        const CubefanOptions options = parseCubefanOptions(scene.options);
+        if (options.path != CubefanOptions::Path::Fused)
+            return nullptr;
+        return std::make_unique<CubefanCeiling>(volume, scene.transferFunction, camera, scene.image, options);
     }
     return nullptr;
 }

@@ -60,6 +60,26 @@ double maxExtinction(const TransferFunction& tf)
     return m;
 }
 
+CubefanWalkGrid buildCubefanWalkGrid(const cubefan::CubeOctree& octree, const glm::ivec3& dims, double tolerance,
+                                     const TransferFunction& tf, cubefan::SelectionStats* stats)
+{
+    CubefanWalkGrid walk;
+    walk.grid = octree.selectGrid(tolerance, tf, stats);
+    const glm::ivec3 bricks = (dims + 3) / 4;
+    std::vector<cl_uchar> empty(walk.grid.level.size() / 64);
+    for (std::size_t b = 0; b < empty.size(); ++b) {
+        const std::uint8_t* code = walk.grid.level.data() + 64 * b;
+        empty[b] = std::all_of(code, code + 64, [](std::uint8_t c) { return (c & cubefan::CubeOctree::kTransparent) != 0; });
+    }
+    walk.space = emptySpaceRadii(bricks, empty);
+    walk.emptyBricks = static_cast<std::uint64_t>(std::count(empty.begin(), empty.end(), cl_uchar(1)));
+    glm::ivec3 lo, hi;  // the bricks with a voxel that adds color
+    filledBricks(bricks, empty, lo, hi);
+    walk.filledLo = glm::min(lo * 4, dims);
+    walk.filledHi = glm::min((hi + 1) * 4, dims);
+    return walk;
+}
+
 namespace {
 
 // Vertices per draw: 2^19 raster::Vertex are 40 MiB on the host, about 14,000 cubes of 12 triangles.
@@ -339,21 +359,12 @@ double CubefanRenderer::updateSelectionGrid()
     if (gridCurrent_)
         return 0.0;
     const auto t0 = std::chrono::steady_clock::now();
-    const cubefan::CubeOctree::SelectionGrid grid = octree_->selectGrid(options_.error, tfHost_, &gridStats_);
-    // Empty space: per brick of 4^3 voxels (the grid's 64 entries), 0 where a voxel adds color, else r + 1
-    // where every brick within Chebyshev distance r is transparent throughout (kernels/empty_space.h).
-    const glm::ivec3 bricks = (dims_ + 3) / 4;
-    std::vector<cl_uchar> empty(grid.level.size() / 64);
-    for (std::size_t b = 0; b < empty.size(); ++b) {
-        const std::uint8_t* code = grid.level.data() + 64 * b;
-        empty[b] = std::all_of(code, code + 64, [](std::uint8_t c) { return (c & cubefan::CubeOctree::kTransparent) != 0; });
-    }
-    const std::vector<cl_uchar> space = emptySpaceRadii(bricks, empty);
-    gridEmptyBricks_ = static_cast<std::uint64_t>(std::count(empty.begin(), empty.end(), cl_uchar(1)));
-    glm::ivec3 lo, hi;  // the bricks with a voxel that adds color: the rays walk only in their box
-    filledBricks(bricks, empty, lo, hi);
-    filledLo_ = glm::min(lo * 4, dims_);
-    filledHi_ = glm::min((hi + 1) * 4, dims_);
+    const CubefanWalkGrid walk = buildCubefanWalkGrid(*octree_, dims_, options_.error, tfHost_, &gridStats_);
+    const cubefan::CubeOctree::SelectionGrid& grid = walk.grid;
+    const std::vector<std::uint8_t>& space = walk.space;
+    gridEmptyBricks_ = walk.emptyBricks;
+    filledLo_ = walk.filledLo;
+    filledHi_ = walk.filledHi;
     device_.queue().enqueueWriteBuffer(gridLevel_, CL_FALSE, 0, grid.level.size(), grid.level.data());
     device_.queue().enqueueWriteBuffer(gridSpace_, CL_FALSE, 0, space.size(), space.data());
     device_.queue().enqueueWriteBuffer(gridValue_, CL_TRUE, 0, grid.value.size() * sizeof(float), grid.value.data());

@@ -8,6 +8,7 @@
 #pragma once
 
 #include "host/model/transfer_function.h"
+#include "host/render/grid/cube_octree.h"
 #include "host/render/renderer.h"
 
 #include <nlohmann/json.hpp>
@@ -62,6 +63,20 @@ std::vector<float> expOpacityTexels(int size, double k);
 
 // The largest extinction the transfer function reaches (at a control point: it is piecewise linear).
 double maxExtinction(const TransferFunction& tf);
+
+// What the fused path's walk reads for one selection (kernels/cubefan.cl; tools/ceiling_cubefan.h reads the
+// same): the selection grid (CubeOctree::selectGrid), per brick of 4^3 voxels (the grid's 64 entries) its
+// empty-space radius — 0 where a voxel adds color, else r + 1 where every brick within Chebyshev distance r is
+// transparent throughout (kernels/empty_space.h) — and the box of voxels [filledLo, filledHi) that holds every
+// cube adding color (outside it the rays have nothing to walk).
+struct CubefanWalkGrid {
+    cubefan::CubeOctree::SelectionGrid grid;
+    std::vector<std::uint8_t> space;
+    glm::ivec3 filledLo{0}, filledHi{0};
+    std::uint64_t emptyBricks = 0;  // bricks with nothing to add
+};
+CubefanWalkGrid buildCubefanWalkGrid(const cubefan::CubeOctree& octree, const glm::ivec3& dims, double tolerance,
+                                     const TransferFunction& tf, cubefan::SelectionStats* stats = nullptr);
 
 // Renderer for "cubefan". Builds the octree at set-up (its time is stats' hierarchy_ms); the volume
 // itself never goes to the device. InputError for bad options.
