@@ -19,6 +19,7 @@
 #include "host/reference/tet_reference.h"
 #include "raster/reference/pixel_transfer.h"
 #include "host/render/renderer.h"
+#include "host/render/tet/tetslice.h"
 #include "tests/support/mesh_fixtures.h"
 #include "tests/support/test_util.h"
 
@@ -26,6 +27,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <random>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -446,6 +448,37 @@ TEST(HarcCeiling, WalksLikeTheKernelAndMatchesTheExactIntegral)
         const clvr::Image4d expected = clvr::tetReferenceIntegral(mesh, tf, c.camera, scene.image);
         EXPECT_TRUE(clvr::test::imagesNear(ceiling.render(2).image, expected, {.maxAbs = 2e-3, .meanAbs = 2e-4}));
         expectCeilingWalksLikeTheKernel(scene, mesh, 1e-5);
+    }
+}
+
+// The same loop on tetslice's fused path (harc's walk sampling the slices tetsliceWalkOptions plans): the same cells
+// entered and slices taken as the kernel, the same image up to float rounding; the cells shuffled as a mesher may
+// number them, so that the loop walks harc's Morton order (harcCellOrder) as the renderer does.
+TEST(HarcCeiling, WalksTetslicesSlicesLikeTheKernel)
+{
+    const glm::dvec3 gradient(0.3, 0.35, -0.4);
+    clvr::TetMesh mesh = clvr::test::boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 0.4}, 4}, {{0.0, 0.0, 0.7}, {1.0, 1.0, 1.2}, 4}},
+                                             gradient, 0.4);
+    clvr::checkMesh(mesh);
+    std::mt19937 random(5);
+    std::shuffle(mesh.tets.begin(), mesh.tets.end(), random);
+    const clvr::TetTopology topology = clvr::buildTopology(mesh);
+    ASSERT_FALSE(std::is_sorted(clvr::harcCellOrder(mesh, topology).begin(), clvr::harcCellOrder(mesh, topology).end()));
+    for (const clvr::Camera& camera : {clvr::test::perspective({0.4, 0.6, 3.0}, {0.5, 0.5, 0.6}, 40.0),
+                                       clvr::test::parallelView({2.5, -1.5, 1.8}, {0.5, 0.5, 0.6}, 0.9)}) {
+        clvr::Scene scene = clvr::test::meshScene("tetslice", camera, clvr::test::rampTransferFunction(), 40,
+                                                  {{"slices", 70}, {"path", "fused"}});
+        clvr::FrameStats stats;
+        const clvr::Image4f kernel = clvr::makeMeshRenderer(clvr::test::device(), scene, mesh)->render(stats);
+        const clvr::HarcOptions walk = clvr::tetsliceWalkOptions(scene, mesh, clvr::parseTetsliceOptions(scene.options));
+        ASSERT_EQ(walk.integration, clvr::HarcOptions::Integration::Slices);
+        const clvr::tools::HarcCeiling ceiling(mesh, topology, scene.transferFunction, *scene.camera, scene.image, walk);
+        const clvr::tools::HarcCeilingResult result = ceiling.render(2);
+        EXPECT_GT(result.pieces, 1000u);
+        EXPECT_EQ(result.steps, stats.extra["steps"].get<std::uint64_t>());
+        EXPECT_EQ(result.pieces, stats.samples);  // slices taken
+        EXPECT_TRUE(clvr::test::imagesNear(result.image, clvr::raster::reference::toDouble(kernel),
+                                           {.maxAbs = 1e-5, .meanAbs = 1e-6}));
     }
 }
 

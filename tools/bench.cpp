@@ -5,6 +5,8 @@
 // tools/peer_vtk_unstructured.py for meshes) on the same scene in the same run.
 #include "tools/bench.h"
 
+#include "host/render/tet/tetslice.h"
+
 #include "host/reference/image_error.h"
 #include "host/reference/reference_integral.h"
 
@@ -303,10 +305,15 @@ nlohmann::json benchMeshScene(Device& device, const fs::path& scenePath, const S
 
     // harc's ceiling loop (tools/ceiling_harc.h) walks the same entry lists and cells; its frames alternate
     // with clvr's, set beside the kernel's own pass (kHarcWalkPass), whose host entry stage it does not repeat.
+    // tetslice's fused path is harc's walk sampling slices: the same loop with the slices it hands harc.
     const bool isHarc = scene.technique == harcTechnique().name;
-    const HarcOptions harcOptions = isHarc ? parseHarcOptions(scene.options) : HarcOptions{};
+    const bool isFusedTetslice = scene.technique == tetsliceTechnique().name &&
+                                 parseTetsliceOptions(scene.options).path == TetsliceOptions::Path::Fused;
+    const HarcOptions harcOptions = isHarc            ? parseHarcOptions(scene.options)
+                                    : isFusedTetslice ? tetsliceWalkOptions(scene, mesh, parseTetsliceOptions(scene.options))
+                                                      : HarcOptions{};
     std::unique_ptr<HarcCeiling> ceiling;
-    if (isHarc && harcCeilingFits(mesh, harcOptions))
+    if ((isHarc || isFusedTetslice) && harcCeilingFits(mesh, harcOptions))
         ceiling = std::make_unique<HarcCeiling>(mesh, buildTopology(mesh), scene.transferFunction, session.camera(),
                                                 scene.image, harcOptions);
     const int threads = threadBudget();

@@ -32,7 +32,9 @@ glm::vec3 xyz(const cl_float4& v)
 
 bool harcCeilingFits(const TetMesh& mesh, const HarcOptions& options)
 {
-    return options.integration == HarcOptions::Integration::Partial && !mesh.part;
+    return (options.integration == HarcOptions::Integration::Partial ||
+            options.integration == HarcOptions::Integration::Slices) &&
+           !mesh.part;
 }
 
 HarcCeiling::HarcCeiling(const TetMesh& mesh, const TetTopology& topology, const TransferFunction& tf,
@@ -48,12 +50,22 @@ HarcCeiling::HarcCeiling(const TetMesh& mesh, const TetTopology& topology, const
                                                                    0xffffffffu));
     ertAlpha_ = options.earlyTermination < 1.0 ? static_cast<float>(options.earlyTermination) : 2.0f;
 
-    for (const cl_float4& v : packHarcTets(mesh, topology, shift))
+    // The cells in harc's order on the device (harcCellOrder), the entry lists' codes mapped to it, as the renderer.
+    const std::vector<std::uint32_t> slot = harcCellOrder(mesh, topology);
+    for (const cl_float4& v : packHarcTets(mesh, topology, shift, slot))
         tets_.push_back(toVec4(v));
     lists_ = buildHarcEntryLists(mesh, topology, camera, width_, height_);
+    for (cl_int2& entry : lists_.entries)
+        entry.s[1] = harcDeviceCode(entry.s[1], slot);
     const std::int64_t eyeTet = camera.parallel ? -1 : locatePoint(mesh, camera.position);
     if (eyeTet >= 0)
-        prependEyeEntry(lists_, static_cast<std::uint32_t>(eyeTet));
+        prependEyeEntry(lists_, slot[static_cast<std::size_t>(eyeTet)]);
+    if (options.integration == HarcOptions::Integration::Slices) {
+        slices_ = true;
+        sliceDepth0_ = static_cast<float>(options.sliceDepth0);
+        sliceSpacing_ = static_cast<float>(options.sliceSpacing);
+        sliceCount_ = options.sliceCount;
+    }
 
     const std::vector<float> packed = packTransferFunction(tf);
     const std::size_t n = tf.points().size(), m = (n + 3) / 4 * 4;
@@ -185,6 +197,30 @@ void HarcCeiling::renderRow(int y, Image4f& image, Counts& counts) const
         return pieces + 1;
     };
 
+    // kernels/harc.cl's harc_slices (tetslice's fused path): the slices of constant eye depth in [segF, segB), in
+    // order; df, the eye depth per unit λ.
+    auto slices = [&](float df, const glm::vec3& e, const glm::vec3& d, const glm::vec4& grad, float segF, float segB,
+                      glm::vec3& color, float& transmittance) {
+        const float negLog2e = -(sliceSpacing_ / df) * 1.44269504f;
+        int k = std::max(static_cast<int>(std::ceil((segF * df - sliceDepth0_) / sliceSpacing_)) - 1, 0);
+        std::uint32_t taken = 0;
+        for (; k < sliceCount_; ++k) {
+            const float lambdaK = (sliceDepth0_ + static_cast<float>(k) * sliceSpacing_) / df;
+            if (!(lambdaK < segB))
+                break;
+            if (lambdaK < segF)
+                continue;
+            const float s = glm::dot(glm::vec3(grad), e + lambdaK * d) + grad.w;  // kernels/transfer_function.h
+            const int kS = upper(s);
+            const glm::vec4 ct = tfAt(kS, s);
+            const float alpha = 1.0f - std::exp2(ct.w * negLog2e);
+            color += (transmittance * alpha) * glm::vec3(ct);
+            transmittance *= 1.0f - alpha;
+            ++taken;
+        }
+        return taken;
+    };
+
     // kernels/ray.h's clvr_ray_unit for the whole image (no band).
     const glm::vec3 position = xyz(camera_.position), forward = xyz(camera_.forward), right = xyz(camera_.right),
                     up = xyz(camera_.up);
@@ -253,15 +289,21 @@ void HarcCeiling::renderRow(int y, Image4f& image, Counts& counts) const
                 }
                 const float step = bestNum / bestDen;
                 const float lambdaExit = lambda + step;
-                const float sB = glm::dot(glm::vec3(grad), e + lambdaExit * d) + grad.w;
-                TfPoint front = carried;
-                if (!carry) {
-                    const float sF = glm::dot(glm::vec3(grad), pos) + grad.w;
-                    const int kF = upper(sF);
-                    front = {sF, kF, tfAt(kF, sF)};
+                if (slices_) {  // tetslice's fused path
+                    const float df = glm::dot(d, forward);
+                    if (df > 0.0f)
+                        rowPieces += slices(df, e, d, grad, lambda, lambdaExit, color, transmittance);
+                } else {
+                    const float sB = glm::dot(glm::vec3(grad), e + lambdaExit * d) + grad.w;
+                    TfPoint front = carried;
+                    if (!carry) {
+                        const float sF = glm::dot(glm::vec3(grad), pos) + grad.w;
+                        const int kF = upper(sF);
+                        front = {sF, kF, tfAt(kF, sF)};
+                    }
+                    rowPieces += static_cast<std::uint64_t>(segment(front, sB, step, color, transmittance, carried));
+                    carry = true;
                 }
-                rowPieces += static_cast<std::uint64_t>(segment(front, sB, step, color, transmittance, carried));
-                carry = true;
                 if (1.0f - transmittance >= ertAlpha_) {
                     stop = true;
                     break;

@@ -34,7 +34,8 @@ struct HarcCeilingResult {
 class HarcCeiling {
 public:
     // The mesh as harc renders it (checkMesh()'d, with its topology), the camera it uses (Session::camera),
-    // the image size and background, and harc's options (partial integration, no part box: harcCeilingFits).
+    // the image size and background, and harc's options (partial integration, or tetslice's slices
+// (tetsliceWalkOptions), no part box: harcCeilingFits).
     HarcCeiling(const TetMesh& mesh, const TetTopology& topology, const TransferFunction& tf, const Camera& camera,
                 const ImageSpec& image, const HarcOptions& options);
     // Walks every pixel with `threads` threads taking rows from a shared counter (<= 0: the thread budget).
@@ -57,6 +58,9 @@ private:
     std::vector<glm::vec4> tfValue_;    // their (r, g, b, tau)
     std::vector<glm::vec4> tfSlope_;    // d(r, g, b, tau)/ds of the segment after each point
     const PsiTable& psi_;
+    bool slices_ = false;  // tetslice's fused path (Integration::Slices): the slices, not the pieces
+    float sliceDepth0_ = 0.0f, sliceSpacing_ = 1.0f;
+    int sliceCount_ = 0;
 };
 
 // Whether the ceiling mirrors this harc scene's kernel path: partial integration of a whole mesh (not a

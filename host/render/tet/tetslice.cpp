@@ -340,6 +340,27 @@ TetsliceOptions parseTetsliceOptions(const nlohmann::json& options)
 
 namespace {
 
+// The slices the raster path plans for the scene's view of the mesh box [lo, hi] (its camera frame: the same eye
+// depths).
+SlicePlan fusedPlan(const Scene& scene, const glm::dvec3& lo, const glm::dvec3& hi, const TetsliceOptions& options)
+{
+    const glm::dvec3 shift = 0.5 * (lo + hi);
+    return planSlices(frameCamera(scene, lo, hi).relativeTo(shift), lo - shift, hi - shift, options.slices,
+                      options.sliceSpacing);
+}
+
+// The walk sampling the cells' field at those slices.
+HarcOptions walkOptions(const SlicePlan& plan, const std::optional<bool>& packets)
+{
+    HarcOptions harc;
+    harc.packets = packets;
+    harc.integration = HarcOptions::Integration::Slices;
+    harc.sliceDepth0 = plan.count ? plan.depth(0) : 0.0;
+    harc.sliceSpacing = plan.deltaS > 0.0 ? plan.deltaS : 1.0;
+    harc.sliceCount = plan.count;
+    return harc;
+}
+
 // The fused path: harc's renderer walking the cells with HARC_INTEGRATION_SLICES at the slices the raster path
 // plans (the same camera frame and mesh box, so the same eye depths), its stats named as tetslice's.
 class TetsliceFusedRenderer final : public Renderer {
@@ -347,7 +368,7 @@ public:
     TetsliceFusedRenderer(Device& device, const Scene& scene, const TetMesh& mesh)
         : options_(parseTetsliceOptions(scene.options)), lo_(mesh.boundsMin()), hi_(mesh.boundsMax())
     {
-        plan_ = planFor(scene);
+        plan_ = fusedPlan(scene, lo_, hi_, options_);
         walk_ = makeHarcRenderer(device, scene, mesh, buildTopology(mesh), walkOptions(plan_, options_.packets));
     }
     Image4f render(FrameStats& stats) override
@@ -363,7 +384,7 @@ public:
     void setTransferFunction(const TransferFunction& tf) override { walk_->setTransferFunction(tf); }
     bool setCamera(const Scene& scene) override
     {
-        const SlicePlan plan = planFor(scene);
+        const SlicePlan plan = fusedPlan(scene, lo_, hi_, options_);
         if (!harcSetView(*walk_, scene, walkOptions(plan, options_.packets)))
             return false;
         plan_ = plan;
@@ -371,25 +392,6 @@ public:
     }
 
 private:
-    // The slices the raster path plans for the scene's view (its camera frame and mesh box: the same eye depths).
-    SlicePlan planFor(const Scene& scene) const
-    {
-        const glm::dvec3 shift = 0.5 * (lo_ + hi_);
-        return planSlices(frameCamera(scene, lo_, hi_).relativeTo(shift), lo_ - shift, hi_ - shift, options_.slices,
-                          options_.sliceSpacing);
-    }
-    // The walk sampling the cells' field at those slices.
-    static HarcOptions walkOptions(const SlicePlan& plan, const std::optional<bool>& packets)
-    {
-        HarcOptions harc;
-        harc.packets = packets;
-        harc.integration = HarcOptions::Integration::Slices;
-        harc.sliceDepth0 = plan.count ? plan.depth(0) : 0.0;
-        harc.sliceSpacing = plan.deltaS > 0.0 ? plan.deltaS : 1.0;
-        harc.sliceCount = plan.count;
-        return harc;
-    }
-
     TetsliceOptions options_;
     glm::dvec3 lo_, hi_;  // the mesh box
     SlicePlan plan_;
@@ -397,6 +399,11 @@ private:
 };
 
 }  // namespace
+
+HarcOptions tetsliceWalkOptions(const Scene& scene, const TetMesh& mesh, const TetsliceOptions& options)
+{
+    return walkOptions(fusedPlan(scene, mesh.boundsMin(), mesh.boundsMax(), options), options.packets);
+}
 
 std::unique_ptr<Renderer> makeTetsliceRenderer(Device& device, const Scene& scene, const TetMesh& mesh)
 {

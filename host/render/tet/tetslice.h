@@ -13,6 +13,7 @@
 #include "host/model/camera.h"
 #include "host/model/mesh.h"
 #include "host/render/renderer.h"
+#include "host/render/tet/harc.h"
 
 #include <nlohmann/json.hpp>
 
@@ -72,5 +73,10 @@ private:
 // Renderer for "tetslice" on a mesh that checkMesh() has normalized. InputError for bad options, an
 // empty mesh or more than 2^24 cells (cell ids travel as two 12-bit halves in float channels).
 std::unique_ptr<Renderer> makeTetsliceRenderer(Device& device, const Scene& scene, const TetMesh& mesh);
+
+// The fused path's walk (harc with HarcOptions::Integration::Slices, `options.packets` passed on): the slices the
+// raster path plans for the scene's view of `mesh` (its camera frame and mesh box, so the same eye depths). What
+// the fused renderer hands harc, and what tools/ceiling_harc.h walks for tetslice scenes.
+HarcOptions tetsliceWalkOptions(const Scene& scene, const TetMesh& mesh, const TetsliceOptions& options);
 
 }  // namespace clvr
