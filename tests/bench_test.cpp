@@ -19,6 +19,7 @@
 #include "host/reference/tet_reference.h"
 #include "raster/reference/pixel_transfer.h"
 #include "host/render/renderer.h"
+#include "host/render/tet/tetiso.h"
 #include "host/render/tet/tetslice.h"
 #include "tests/support/mesh_fixtures.h"
 #include "tests/support/test_util.h"
@@ -479,6 +480,48 @@ TEST(HarcCeiling, WalksTetslicesSlicesLikeTheKernel)
         EXPECT_EQ(result.pieces, stats.samples);  // slices taken
         EXPECT_TRUE(clvr::test::imagesNear(result.image, clvr::raster::reference::toDouble(kernel),
                                            {.maxAbs = 1e-5, .meanAbs = 1e-6}));
+    }
+}
+
+// And on tetiso's fused path (harc's walk to each ray's first crossing of the iso-value, shaded from the vertex
+// normals tetisoWalkOptions hands harc): the same cells entered and rays that hit, the same image up to float
+// rounding; interpolated and equal weights, unshaded; the cells shuffled so that the loop walks harc's Morton order.
+TEST(HarcCeiling, WalksTetisosFirstCrossingLikeTheKernel)
+{
+    clvr::TetMesh mesh = clvr::test::boxMesh({{{0.0, 0.0, 0.0}, {1.0, 1.0, 0.4}, 4}, {{0.0, 0.0, 0.7}, {1.0, 1.0, 1.2}, 4}},
+                                             glm::dvec3(0.3, 0.35, -0.4), 0.4);
+    for (std::size_t i = 0; i < mesh.points.size(); ++i)  // a cone: the normals differ from point to point
+        mesh.scalars[i] = 1.0 - glm::length(mesh.points[i] - glm::dvec3(0.5, 0.45, 0.55));
+    clvr::checkMesh(mesh);
+    std::mt19937 random(9);
+    std::shuffle(mesh.tets.begin(), mesh.tets.end(), random);
+    const clvr::TetTopology topology = clvr::buildTopology(mesh);
+    struct Case {
+        const char* name;
+        nlohmann::json options;
+        clvr::IsoSpec::Shading shading;
+    };
+    for (const Case& c : {Case{"interpolated", {{"path", "fused"}}, clvr::IsoSpec::Shading::Gradient},
+                          Case{"equal", {{"path", "fused"}, {"weights", "equal"}}, clvr::IsoSpec::Shading::Gradient},
+                          Case{"unshaded", {{"path", "fused"}}, clvr::IsoSpec::Shading::None}}) {
+        clvr::Scene scene = clvr::test::meshScene("tetiso", clvr::test::perspective({0.4, 0.6, 3.0}, {0.5, 0.5, 0.6}, 40.0),
+                                                  clvr::test::rampTransferFunction(), 40, c.options);
+        scene.iso = clvr::IsoSpec{};
+        scene.iso->value = 0.62;
+        scene.iso->shading = c.shading;
+        clvr::FrameStats stats;
+        const clvr::Image4f kernel = clvr::makeMeshRenderer(clvr::test::device(), scene, mesh)->render(stats);
+        const clvr::HarcOptions walk = clvr::tetisoWalkOptions(scene, mesh);
+        ASSERT_EQ(walk.integration, clvr::HarcOptions::Integration::Iso);
+        const clvr::tools::HarcCeiling ceiling(mesh, topology, scene.transferFunction, *scene.camera, scene.image, walk);
+        const clvr::tools::HarcCeilingResult result = ceiling.render(2);
+        EXPECT_GT(result.pieces, 100u) << c.name;  // rays that hit (195 of 1600)
+        EXPECT_LT(result.pieces, 1600u) << c.name;  // and rays that miss
+        EXPECT_EQ(result.steps, stats.extra["steps"].get<std::uint64_t>()) << c.name;
+        EXPECT_EQ(result.pieces, stats.extra["pixels_hit"].get<std::uint64_t>()) << c.name;
+        EXPECT_TRUE(clvr::test::imagesNear(result.image, clvr::raster::reference::toDouble(kernel),
+                                           {.maxAbs = 1e-5, .meanAbs = 1e-6}))
+            << c.name;
     }
 }
 

@@ -5,6 +5,7 @@
 // tools/peer_vtk_unstructured.py for meshes) on the same scene in the same run.
 #include "tools/bench.h"
 
+#include "host/render/tet/tetiso.h"
 #include "host/render/tet/tetslice.h"
 
 #include "host/reference/image_error.h"
@@ -305,15 +306,19 @@ nlohmann::json benchMeshScene(Device& device, const fs::path& scenePath, const S
 
     // harc's ceiling loop (tools/ceiling_harc.h) walks the same entry lists and cells; its frames alternate
     // with clvr's, set beside the kernel's own pass (kHarcWalkPass), whose host entry stage it does not repeat.
-    // tetslice's fused path is harc's walk sampling slices: the same loop with the slices it hands harc.
+    // tetslice's and tetiso's fused paths are harc's walk sampling slices or stopping at the first crossing: the
+    // same loop with the options they hand harc.
     const bool isHarc = scene.technique == harcTechnique().name;
     const bool isFusedTetslice = scene.technique == tetsliceTechnique().name &&
                                  parseTetsliceOptions(scene.options).path == TetsliceOptions::Path::Fused;
+    const bool isFusedTetiso = scene.technique == tetisoTechnique().name &&
+                               parseTetisoOptions(scene.options).path == TetisoOptions::Path::Fused;
     const HarcOptions harcOptions = isHarc            ? parseHarcOptions(scene.options)
                                     : isFusedTetslice ? tetsliceWalkOptions(scene, mesh, parseTetsliceOptions(scene.options))
+                                    : isFusedTetiso   ? tetisoWalkOptions(scene, mesh)
                                                       : HarcOptions{};
     std::unique_ptr<HarcCeiling> ceiling;
-    if ((isHarc || isFusedTetslice) && harcCeilingFits(mesh, harcOptions))
+    if ((isHarc || isFusedTetslice || isFusedTetiso) && harcCeilingFits(mesh, harcOptions))
         ceiling = std::make_unique<HarcCeiling>(mesh, buildTopology(mesh), scene.transferFunction, session.camera(),
                                                 scene.image, harcOptions);
     const int threads = threadBudget();

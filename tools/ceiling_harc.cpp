@@ -33,7 +33,8 @@ glm::vec3 xyz(const cl_float4& v)
 bool harcCeilingFits(const TetMesh& mesh, const HarcOptions& options)
 {
     return (options.integration == HarcOptions::Integration::Partial ||
-            options.integration == HarcOptions::Integration::Slices) &&
+            options.integration == HarcOptions::Integration::Slices ||
+            options.integration == HarcOptions::Integration::Iso) &&
            !mesh.part;
 }
 
@@ -60,6 +61,22 @@ HarcCeiling::HarcCeiling(const TetMesh& mesh, const TetTopology& topology, const
     const std::int64_t eyeTet = camera.parallel ? -1 : locatePoint(mesh, camera.position);
     if (eyeTet >= 0)
         prependEyeEntry(lists_, slot[static_cast<std::size_t>(eyeTet)]);
+    if (options.integration == HarcOptions::Integration::Iso) {
+        const HarcOptions::HarcIso& iso = options.iso;
+        iso_ = true;
+        isoValue_ = static_cast<float>(iso.value);
+        isoAmbient_ = static_cast<float>(iso.ambient);
+        isoDiffuse_ = static_cast<float>(iso.diffuse);
+        isoShaded_ = iso.shaded;
+        isoEqualWeights_ = iso.equalWeights;
+        isoLight_ = glm::vec3(iso.light);
+        isoColor_ = tf.points().empty() ? glm::vec3(1.0f) : glm::vec3(glm::dvec3(tf(iso.value)));  // harc's isoColorOf
+        isoNormals_.resize(mesh.tets.size() * 3);
+        for (std::size_t t = 0; t < mesh.tets.size(); ++t)
+            for (int axis = 0; axis < 3; ++axis)
+                for (int v = 0; v < 4; ++v)
+                    isoNormals_[3 * slot[t] + axis][v] = static_cast<float>(iso.normals[mesh.tets[t][v]][axis]);
+    }
     if (options.integration == HarcOptions::Integration::Slices) {
         slices_ = true;
         sliceDepth0_ = static_cast<float>(options.sliceDepth0);
@@ -289,7 +306,30 @@ void HarcCeiling::renderRow(int y, Image4f& image, Counts& counts) const
                 }
                 const float step = bestNum / bestDen;
                 const float lambdaExit = lambda + step;
-                if (slices_) {  // tetslice's fused path
+                if (iso_) {  // tetiso's fused path: kernels/harc.cl's harc_iso_hit
+                    const float sF = glm::dot(glm::vec3(grad), pos) + grad.w;
+                    const float sB = glm::dot(glm::vec3(grad), e + lambdaExit * d) + grad.w;
+                    if ((sF <= isoValue_ && sB > isoValue_) || (sF >= isoValue_ && sB < isoValue_)) {
+                        const float q = (isoValue_ - sF) / (sB - sF);
+                        glm::vec3 c = glm::clamp(isoColor_, 0.0f, 1.0f);
+                        if (isoShaded_) {
+                            const float w = isoEqualWeights_ ? 0.5f : q;
+                            const glm::vec3 pf = e + lambda * d, pb = e + lambdaExit * d;
+                            glm::vec4 b;
+                            for (int i = 0; i < 4; ++i)
+                                b[i] = (1.0f - w) * (glm::dot(glm::vec3(planes[i]), pf) + planes[i].w) +
+                                       w * (glm::dot(glm::vec3(planes[i]), pb) + planes[i].w);
+                            const glm::vec4* normals = &isoNormals_[static_cast<std::size_t>(t) * 3];
+                            const glm::vec3 n(glm::dot(normals[0], b), glm::dot(normals[1], b), glm::dot(normals[2], b));
+                            c = glm::clamp(isoColor_ * (isoAmbient_ + isoDiffuse_ * glm::dot(isoLight_, n)), 0.0f, 1.0f);
+                        }
+                        color = c;
+                        transmittance = 0.0f;
+                        ++rowPieces;  // the hits
+                        stop = true;
+                        break;
+                    }
+                } else if (slices_) {  // tetslice's fused path
                     const float df = glm::dot(d, forward);
                     if (df > 0.0f)
                         rowPieces += slices(df, e, d, grad, lambda, lambdaExit, color, transmittance);

@@ -35,7 +35,7 @@ class HarcCeiling {
 public:
     // The mesh as harc renders it (checkMesh()'d, with its topology), the camera it uses (Session::camera),
     // the image size and background, and harc's options (partial integration, or tetslice's slices
-// (tetsliceWalkOptions), no part box: harcCeilingFits).
+// (tetsliceWalkOptions), or tetiso's first crossing (tetisoWalkOptions), no part box: harcCeilingFits).
     HarcCeiling(const TetMesh& mesh, const TetTopology& topology, const TransferFunction& tf, const Camera& camera,
                 const ImageSpec& image, const HarcOptions& options);
     // Walks every pixel with `threads` threads taking rows from a shared counter (<= 0: the thread budget).
@@ -61,6 +61,11 @@ private:
     bool slices_ = false;  // tetslice's fused path (Integration::Slices): the slices, not the pieces
     float sliceDepth0_ = 0.0f, sliceSpacing_ = 1.0f;
     int sliceCount_ = 0;
+    bool iso_ = false;     // tetiso's fused path (Integration::Iso): the first crossing, shaded; pieces = hits
+    float isoValue_ = 0.0f, isoAmbient_ = 0.0f, isoDiffuse_ = 0.0f;
+    bool isoShaded_ = true, isoEqualWeights_ = false;
+    glm::vec3 isoLight_{0.0f}, isoColor_{1.0f};
+    std::vector<glm::vec4> isoNormals_;  // 3 per cell in harc's order: the x, y, z of its vertex normals
 };
 
 // Whether the ceiling mirrors this harc scene's kernel path: partial integration of a whole mesh (not a

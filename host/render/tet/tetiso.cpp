@@ -435,19 +435,8 @@ public:
     TetisoFused(Device& device, const Scene& scene, const TetMesh& mesh)
         : iso_(checkedIso(scene)), lo_(mesh.boundsMin()), hi_(mesh.boundsMax())
     {
-        const TetisoOptions options = parseTetisoOptions(scene.options);
-        HarcOptions harc;
-        harc.integration = HarcOptions::Integration::Iso;
-        harc.iso.value = iso_.value;
-        harc.iso.normals = vertexNormals(mesh);
-        harc.iso.light = iso_.lightFor(frameCamera(scene, lo_, hi_));
-        harc.iso.ambient = iso_.ambient;
-        harc.iso.diffuse = iso_.diffuse;
-        harc.iso.shaded = iso_.shading != IsoSpec::Shading::None;
-        harc.iso.equalWeights = options.weights == TetisoOptions::Weights::Equal;
-        harc.packets = options.packets;
-        weights_ = options.weights == TetisoOptions::Weights::Equal ? "equal" : "interpolated";
-        walk_ = makeHarcRenderer(device, scene, mesh, buildTopology(mesh), harc);
+        weights_ = parseTetisoOptions(scene.options).weights == TetisoOptions::Weights::Equal ? "equal" : "interpolated";
+        walk_ = makeHarcRenderer(device, scene, mesh, buildTopology(mesh), tetisoWalkOptions(scene, mesh));
     }
     Image4f render(FrameStats& stats) override
     {
@@ -478,6 +467,23 @@ private:
 };
 
 }  // namespace
+
+HarcOptions tetisoWalkOptions(const Scene& scene, const TetMesh& mesh)
+{
+    const IsoSpec iso = checkedIso(scene);
+    const TetisoOptions options = parseTetisoOptions(scene.options);
+    HarcOptions harc;
+    harc.integration = HarcOptions::Integration::Iso;
+    harc.iso.value = iso.value;
+    harc.iso.normals = vertexNormals(mesh);
+    harc.iso.light = iso.lightFor(frameCamera(scene, mesh.boundsMin(), mesh.boundsMax()));
+    harc.iso.ambient = iso.ambient;
+    harc.iso.diffuse = iso.diffuse;
+    harc.iso.shaded = iso.shading != IsoSpec::Shading::None;
+    harc.iso.equalWeights = options.weights == TetisoOptions::Weights::Equal;
+    harc.packets = options.packets;
+    return harc;
+}
 
 TechniqueInfo tetisoTechnique()
 {

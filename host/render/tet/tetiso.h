@@ -15,6 +15,7 @@
 
 #include "host/model/mesh.h"
 #include "host/render/renderer.h"
+#include "host/render/tet/harc.h"
 
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
@@ -96,5 +97,10 @@ public:
     virtual std::vector<double> hitDepth() = 0;
 };
 std::unique_ptr<TetisoRenderer> makeTetisoRenderer(Device& device, const Scene& scene, const TetMesh& mesh);
+
+// The fused path's walk (harc with HarcOptions::Integration::Iso): the scene's iso-value, the mesh's vertex normals,
+// the light for the scene's view of the mesh box, the shading and weights, `packets` as the options say. What the
+// fused renderer hands harc, and what tools/ceiling_harc.h walks for tetiso scenes.
+HarcOptions tetisoWalkOptions(const Scene& scene, const TetMesh& mesh);
 
 }  // namespace clvr
