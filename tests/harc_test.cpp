@@ -384,7 +384,15 @@ TEST(HarcEntryLists, EqualTheCrossingsOfEveryRayWithEveryFace)
         {"gap, a band of rows", &gap, band, 47, 20},
         {"gap, one pixel", &gap, perspective({0.9, 0.7, 3.2}, {0.5, 0.5, 0.5}, 40.0), 1, 1},
     };
-    for (const Case& c : cases) {
+    std::vector<Case> all(std::begin(cases), std::end(cases));
+    std::mt19937 random(17);  // and views from all round, near and far, wide and narrow
+    std::uniform_real_distribution<double> unit(-1.0, 1.0), angle(25.0, 80.0), distance(1.6, 5.0);
+    for (int i = 0; i < 8; ++i) {
+        const glm::dvec3 direction = glm::normalize(glm::dvec3(unit(random), unit(random), unit(random)) + 1e-3);
+        const glm::dvec3 focal(0.8 + 0.3 * unit(random), 0.7 + 0.3 * unit(random), 0.5 + 0.3 * unit(random));
+        all.push_back({"L, a random view", &l, perspective(focal + distance(random) * direction, focal, angle(random)), 31, 27});
+    }
+    for (const Case& c : all) {
         const TetTopology topology = handTopology(*c.mesh);
         const HarcEntryLists lists = buildHarcEntryLists(*c.mesh, topology, c.camera, c.width, c.height);
         const HarcEntryLists expected = bruteForceEntryLists(*c.mesh, topology, c.camera, c.width, c.height);
