@@ -449,6 +449,13 @@ TEST(HarcCeiling, WalksLikeTheKernelAndMatchesTheExactIntegral)
         const clvr::Image4d expected = clvr::tetReferenceIntegral(mesh, tf, c.camera, scene.image);
         EXPECT_TRUE(clvr::test::imagesNear(ceiling.render(2).image, expected, {.maxAbs = 2e-3, .meanAbs = 2e-4}));
         expectCeilingWalksLikeTheKernel(scene, mesh, 1e-5);
+        // The whole segment at once: the average of its ends' colors and extinctions, or full pre-integration's
+        // table (built as harc builds it, looked up with its float arithmetic).
+        for (const nlohmann::json& options : {nlohmann::json{{"integration", "average"}},
+                                              nlohmann::json{{"integration", "full"}, {"full_table", {24, 16}}}}) {
+            SCOPED_TRACE(options.dump());
+            expectCeilingWalksLikeTheKernel(clvr::test::meshScene("harc", c.camera, tf, 40, options), mesh, 1e-5);
+        }
     }
 }
 

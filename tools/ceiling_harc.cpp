@@ -32,10 +32,8 @@ glm::vec3 xyz(const cl_float4& v)
 
 bool harcCeilingFits(const TetMesh& mesh, const HarcOptions& options)
 {
-    return (options.integration == HarcOptions::Integration::Partial ||
-            options.integration == HarcOptions::Integration::Slices ||
-            options.integration == HarcOptions::Integration::Iso) &&
-           !mesh.part;
+    (void)options;  // every integration
+    return !mesh.part;
 }
 
 HarcCeiling::HarcCeiling(const TetMesh& mesh, const TetTopology& topology, const TransferFunction& tf,
@@ -61,6 +59,15 @@ HarcCeiling::HarcCeiling(const TetMesh& mesh, const TetTopology& topology, const
     const std::int64_t eyeTet = camera.parallel ? -1 : locatePoint(mesh, camera.position);
     if (eyeTet >= 0)
         prependEyeEntry(lists_, slot[static_cast<std::size_t>(eyeTet)]);
+    integration_ = options.integration;
+    if (options.integration == HarcOptions::Integration::Full) {  // as HarcRenderer::buildFullTable
+        const glm::dvec2 range = mesh.scalarRange();
+        double lMax = longestTetEdge(mesh);
+        if (!(lMax > 0.0))
+            lMax = 1.0;
+        full_ = buildPreintegrationTable(tf, std::min(tf.sMin(), range.x), std::max(tf.sMax(), range.y), lMax,
+                                         options.fullScalarSamples, options.fullLengthSamples);
+    }
     if (options.integration == HarcOptions::Integration::Iso) {
         const HarcOptions::HarcIso& iso = options.iso;
         iso_ = true;
@@ -333,6 +340,21 @@ void HarcCeiling::renderRow(int y, Image4f& image, Counts& counts) const
                     const float df = glm::dot(d, forward);
                     if (df > 0.0f)
                         rowPieces += slices(df, e, d, grad, lambda, lambdaExit, color, transmittance);
+                } else if (integration_ == HarcOptions::Integration::Full ||
+                           integration_ == HarcOptions::Integration::Average) {  // one lookup or average a segment
+                    const float sF = glm::dot(glm::vec3(grad), pos) + grad.w;
+                    const float sB = glm::dot(glm::vec3(grad), e + lambdaExit * d) + grad.w;
+                    if (full_) {  // harc_full_lookup
+                        const glm::vec4 c = full_->lookup(sF, sB, step);
+                        color += transmittance * glm::vec3(c);
+                        transmittance *= 1.0f - c.w;
+                    } else {  // harc_segment_average
+                        const glm::vec4 c = 0.5f * (tfAt(upper(sF), sF) + tfAt(upper(sB), sB));
+                        const float zeta = std::exp(-c.w * step);
+                        color += transmittance * (1.0f - zeta) * glm::vec3(c);
+                        transmittance *= zeta;
+                    }
+                    ++rowPieces;
                 } else {
                     const float sB = glm::dot(glm::vec3(grad), e + lambdaExit * d) + grad.w;
                     TfPoint front = carried;

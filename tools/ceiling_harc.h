@@ -14,6 +14,7 @@
 #include "host/model/mesh.h"
 #include "host/model/scene.h"
 #include "host/model/transfer_function.h"
+#include "host/optics/preintegration_table.h"
 #include "host/optics/psi_table.h"
 #include "host/render/tet/harc.h"
 #include "kernels/ray.h"
@@ -21,6 +22,7 @@
 #include <glm/glm.hpp>
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 namespace clvr::tools {
@@ -34,8 +36,8 @@ struct HarcCeilingResult {
 class HarcCeiling {
 public:
     // The mesh as harc renders it (checkMesh()'d, with its topology), the camera it uses (Session::camera),
-    // the image size and background, and harc's options (partial integration, or tetslice's slices
-// (tetsliceWalkOptions), or tetiso's first crossing (tetisoWalkOptions), no part box: harcCeilingFits).
+    // the image size and background, and harc's options (any integration — partial, full, average, tetslice's
+// slices (tetsliceWalkOptions), tetiso's first crossing (tetisoWalkOptions) —, no part box: harcCeilingFits).
     HarcCeiling(const TetMesh& mesh, const TetTopology& topology, const TransferFunction& tf, const Camera& camera,
                 const ImageSpec& image, const HarcOptions& options);
     // Walks every pixel with `threads` threads taking rows from a shared counter (<= 0: the thread budget).
@@ -58,6 +60,8 @@ private:
     std::vector<glm::vec4> tfValue_;    // their (r, g, b, tau)
     std::vector<glm::vec4> tfSlope_;    // d(r, g, b, tau)/ds of the segment after each point
     const PsiTable& psi_;
+    HarcOptions::Integration integration_;
+    std::optional<PreintegrationTable> full_;  // Integration::Full: the table harc builds
     bool slices_ = false;  // tetslice's fused path (Integration::Slices): the slices, not the pieces
     float sliceDepth0_ = 0.0f, sliceSpacing_ = 1.0f;
     int sliceCount_ = 0;
