@@ -8,6 +8,7 @@
 #include "tools/ceiling.cpp"
 #include "tools/ceiling_cubefan.cpp"
 #include "tools/ceiling_harc.cpp"
+#include "tools/ceiling_iso3d.cpp"
 #include "tools/ceiling_spherical.cpp"
 #include "tools/ceiling_stack2d.cpp"
 
@@ -226,6 +227,53 @@ TEST(CubefanCeiling, DoesTheFusedKernelsWork)
                       1e-4 * static_cast<double>(stats.samples) + 2.0)
                 << set.dump();
         }
+}
+
+// iso3d's ceiling loop (tools/ceiling_iso3d.h) does the fused path's work: the same samples taken (empty bricks
+// skipped sample by sample where the kernel steps over runs) and the same surface, shaded through the same color
+// matrix — the image up to float rounding but for pixels whose sample lies within rounding of the iso-value.
+// Perspective and parallel, gradient shading and none, with and without empty-space skipping.
+TEST(Iso3dCeiling, DoesTheFusedPathsWork)
+{
+    const clvr::Volume volume = clvr::generateVolume("marschner-lobb", {41, 41, 41});
+    const clvr::TransferFunction tf({{0.0, {0.2, 0.4, 0.9}, 1.0}, {1.0, {1.0, 0.8, 0.3}, 1.0}});
+    std::uint64_t hitPixels = 0;
+    for (const clvr::Camera& camera : {clvr::test::obliquePerspectiveCamera(30.0), clvr::test::obliqueParallelCamera(1.3)})
+        for (const clvr::IsoSpec::Shading shading : {clvr::IsoSpec::Shading::Gradient, clvr::IsoSpec::Shading::None})
+            for (const bool skip : {true, false}) {
+                clvr::Scene scene;
+                scene.technique = "iso3d";
+                scene.camera = camera;
+                scene.image = clvr::ImageSpec{56, 48, {0.05, 0.05, 0.1}};
+                scene.transferFunction = tf;
+                scene.iso = clvr::IsoSpec{};
+                scene.iso->value = 0.55;
+                scene.iso->shading = shading;
+                scene.options = {{"slices", 90}, {"empty_space_skipping", skip}};
+                const std::string what = std::string(shading == clvr::IsoSpec::Shading::None ? "unshaded" : "shaded") +
+                                         (skip ? ", skipping" : "") + (camera.parallel ? ", parallel" : "");
+                clvr::FrameStats stats;
+                const clvr::Image4f kernel = clvr::test::renderScene(scene, volume, &stats);
+                const clvr::Iso3dOptions options = clvr::parseIso3dOptions(scene.options);
+                ASSERT_TRUE(clvr::tools::iso3dCeilingFits(options, *scene.iso));
+                const clvr::tools::Iso3dCeiling ceiling(volume, scene, *scene.camera, options);
+                const clvr::tools::CeilingResult result = ceiling.render(2);
+                std::size_t differ = 0;
+                for (std::size_t p = 0; p < kernel.pixelCount(); ++p) {
+                    const glm::vec4 d = glm::abs(kernel.pixels()[p] - result.image.pixels()[p]);
+                    differ += std::max({d.r, d.g, d.b, d.a}) > 1e-5f ? 1 : 0;
+                    hitPixels += kernel.pixels()[p].a > 0.5f ? 1 : 0;
+                }
+                std::printf("[ measured ] iso3d ceiling vs kernel (%s): %zu of %zu pixels over 1e-5; samples %llu vs %llu\n",
+                            what.c_str(), differ, kernel.pixelCount(), static_cast<unsigned long long>(result.samples),
+                            static_cast<unsigned long long>(stats.samples));
+                EXPECT_LE(differ * 200, kernel.pixelCount()) << what;  // at most 0.5 % of the pixels
+                EXPECT_GT(result.samples, 1000u) << what;
+                EXPECT_LE(std::abs(static_cast<double>(result.samples) - static_cast<double>(stats.samples)),
+                          1e-3 * static_cast<double>(stats.samples))
+                    << what;
+            }
+    EXPECT_GT(hitPixels, 8u * 56u * 48u / 10u);  // the surface covers a good part of the images
 }
 
 TEST(BenchMesh, BluntfinScenesHaveTheStatedControlPointsAndImageSize)

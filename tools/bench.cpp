@@ -27,6 +27,7 @@
 #include "tools/ceiling.h"
 #include "tools/ceiling_harc.h"
 #include "tools/ceiling_cubefan.h"
+#include "tools/ceiling_iso3d.h"
 #include "tools/ceiling_spherical.h"
 #include "tools/ceiling_stack2d.h"
 
@@ -170,7 +171,7 @@ const Image4d& referenceImage(std::map<std::string, Image4d>& cache, const Scene
 // The plain C++ ceiling loop on the same scene, where there is one: slice3d's fused path with per-sample
 // classification (the raster path counts fragments, not samples; pre-integrated slabs and clip meshes are
 // other loops), stack2d's fused direct volume rendering (unshaded, no clip texture), spherical's fused
-// path, cubefan's fused path. Its frames are interleaved with clvr's (see bench()), so that both
+// path, cubefan's fused path, iso3d's fused path (unbricked, gradient or no shading). Its frames are interleaved with clvr's (see bench()), so that both
 // see the same load on a shared machine.
 std::unique_ptr<VolumeCeiling> makeCeiling(const Scene& scene, const Volume& volume, const Camera& camera)
 {
@@ -196,6 +197,12 @@ std::unique_ptr<VolumeCeiling> makeCeiling(const Scene& scene, const Volume& vol
         if (options.path != SphericalOptions::Path::Fused)
             return nullptr;
         return std::make_unique<SphericalCeiling>(volume, scene.transferFunction, camera, scene.image, options);
+    }
+    if (scene.technique == iso3dTechnique().name && scene.iso) {
+        const Iso3dOptions options = parseIso3dOptions(scene.options);
+        if (!iso3dCeilingFits(options, *scene.iso))
+            return nullptr;
+        return std::make_unique<Iso3dCeiling>(volume, scene, camera, options);
     }
     if (scene.technique == cubefanTechnique().name) {
         const CubefanOptions options = parseCubefanOptions(scene.options);

@@ -178,17 +178,10 @@ Iso3dRendererImpl::Iso3dRendererImpl(Device& device, const Scene& scene, const V
     if (options_.path == Iso3dOptions::Path::Fused) {
         values_ = device_.upload("iso3d scalar volume (fused path's alpha test; float32)", volume.values);
         residentBytes_ += volume.values.size() * sizeof(float);
-        // Empty-space skipping: slice3d's bricks (kernels/empty_space.h), empty where every value lies below
-        // the iso-value by more than float rounding in the trilinear interpolation could make up.
-        const BrickGrid grid = buildBrickGrid(volume);
-        const double margin = 1e-5 * std::max({std::abs(range.x), std::abs(range.y), std::abs(iso_.value)});
-        std::vector<cl_uchar> empty(grid.minMax.size());
-        for (std::size_t b = 0; b < empty.size(); ++b)
-            empty[b] = static_cast<double>(grid.minMax[b].y) + margin < iso_.value ? 1 : 0;
-        emptyBrickCount_ = static_cast<std::uint64_t>(std::count(empty.begin(), empty.end(), cl_uchar(1)));
-        brickDims_ = grid.dims;
-        space_ = device_.upload("iso3d empty-space radii", emptySpaceRadii(grid.dims, empty));
-        residentBytes_ += empty.size();
+        // Empty-space skipping: slice3d's bricks whose values all lie below the iso-value.
+        const std::vector<std::uint8_t> space = iso3dEmptySpace(volume, iso_.value, brickDims_, emptyBrickCount_);
+        space_ = device_.upload("iso3d empty-space radii", space);
+        residentBytes_ += space.size();
         fused_ = device_.kernel("iso3d.cl", "iso3d_fused");
         fusedSamples_ = device_.buffer("iso3d fused samples per pixel", framebuffer_->pixelCount() * sizeof(cl_uint),
                                        CL_MEM_WRITE_ONLY);
@@ -645,6 +638,20 @@ IsoSurface isoSurface(const Scene& scene, const Camera& camera)
     if (!scene.transferFunction.points().empty())
         iso.color = glm::dvec3(scene.transferFunction(iso.value));
     return iso;
+}
+
+std::vector<std::uint8_t> iso3dEmptySpace(const Volume& volume, double iso, glm::ivec3& brickDims,
+                                          std::uint64_t& emptyBricks)
+{
+    const glm::dvec2 range = volume.range();
+    const BrickGrid grid = buildBrickGrid(volume);
+    const double margin = 1e-5 * std::max({std::abs(range.x), std::abs(range.y), std::abs(iso)});
+    std::vector<cl_uchar> empty(grid.minMax.size());
+    for (std::size_t b = 0; b < empty.size(); ++b)
+        empty[b] = static_cast<double>(grid.minMax[b].y) + margin < iso ? 1 : 0;
+    emptyBricks = static_cast<std::uint64_t>(std::count(empty.begin(), empty.end(), cl_uchar(1)));
+    brickDims = grid.dims;
+    return emptySpaceRadii(grid.dims, empty);
 }
 
 std::vector<glm::vec4> encodedNormalVolume(const Volume& volume)

@@ -69,6 +69,12 @@ IsoSurface isoSurface(const Scene& scene, const Camera& camera);
 // 0.5) where the gradient is 0. The paper's "gradient components scaled and translated by 0.5", in float32.
 std::vector<glm::vec4> encodedNormalVolume(const Volume& volume);
 
+// The fused path's empty space (kernels/empty_space.h): slice3d's bricks of 4^3 cells, empty where every value lies
+// below `iso` by more than float rounding in the trilinear interpolation could make up; per brick 0, or r + 1 where
+// every brick within Chebyshev distance r is empty. Sets the brick grid's dims and the empty bricks' count.
+std::vector<std::uint8_t> iso3dEmptySpace(const Volume& volume, double iso, glm::ivec3& brickDims,
+                                          std::uint64_t& emptyBricks);
+
 // The median Sobel gradient length (data units per world unit) over the grid points next to a crossing of
 // `iso` (the point or its +x, +y or +z neighbour on the other side): gradientless shading's default
 // normalization, |grad|~ in 1 / (Delta |grad|~). 1 when no edge crosses.
