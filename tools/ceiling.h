@@ -16,6 +16,8 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <limits>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -77,6 +79,37 @@ private:
     std::vector<float> s_;          // control points' s, increasing
     std::vector<glm::vec4> value_;  // their (r, g, b, tau)
 };
+
+// kernels/volume_sampling.h's clvr_box_chord for the box [0, hi) (hi per axis the next float above the last grid
+// point): the eye-depth interval [zin, zout] of the ray go + z gd inside it, zin > zout where it misses.
+inline void boxChord(const glm::vec3& go, const glm::vec3& gd, const glm::vec3& hi, float& zin, float& zout)
+{
+    zin = -std::numeric_limits<float>::infinity();
+    zout = std::numeric_limits<float>::infinity();
+    for (int a = 0; a < 3; ++a) {
+        if (gd[a] == 0.0f) {
+            if (go[a] < 0.0f || go[a] >= hi[a])
+                zout = -std::numeric_limits<float>::infinity();
+            continue;
+        }
+        const float t0 = (0.0f - go[a]) / gd[a], t1 = (hi[a] - go[a]) / gd[a];
+        zin = std::max(zin, std::min(t0, t1));
+        zout = std::min(zout, std::max(t0, t1));
+    }
+}
+
+// kernels/volume_sampling.h's clvr_slice_range: the slices kLo..kHi (of 0..count - 1, at depth0 + k deltaS) near
+// the chord [zin, zout], one more each way; none (kLo > kHi) for an empty chord.
+inline void sliceRange(float zin, float zout, float depth0, float deltaS, int count, int& kLo, int& kHi)
+{
+    kLo = 0;
+    kHi = -1;
+    if (zin <= zout) {
+        const float n = static_cast<float>(count);
+        kLo = static_cast<int>(std::clamp(std::ceil((zin - depth0) / deltaS) - 1.0f, 0.0f, n));
+        kHi = static_cast<int>(std::clamp(std::floor((zout - depth0) / deltaS) + 1.0f, -1.0f, n - 1.0f));
+    }
+}
 
 // A ceiling loop for a regular-grid technique's fused kernel (slice3d's below, spherical's in
 // tools/ceiling_spherical.h): clvr bench times render() interleaved with clvr's frames.

@@ -82,24 +82,10 @@ std::uint64_t Iso3dCeiling::renderRow(int y, Image4f& image) const
         else
             d = forward + sx * right + sy * up;
         const glm::vec3 go = (o - origin_) * invSpacing_, gd = d * invSpacing_;
-        // kernels/volume_sampling.h's clvr_box_chord over [0, top) and clvr_slice_range
-        float z0 = -INFINITY, z1 = INFINITY;
-        for (int a = 0; a < 3; ++a) {
-            if (gd[a] == 0.0f) {
-                if (go[a] < 0.0f || go[a] >= top[a])
-                    z1 = -INFINITY;
-                continue;
-            }
-            const float t0 = (0.0f - go[a]) / gd[a], t1 = (top[a] - go[a]) / gd[a];
-            z0 = std::max(z0, std::min(t0, t1));
-            z1 = std::min(z1, std::max(t0, t1));
-        }
-        int kLo = 0, kHi = -1;
-        if (z0 <= z1) {
-            const float count = static_cast<float>(plan_.count);
-            kLo = static_cast<int>(std::clamp(std::ceil((z0 - depth0) / deltaS) - 1.0f, 0.0f, count));
-            kHi = static_cast<int>(std::clamp(std::floor((z1 - depth0) / deltaS) + 1.0f, -1.0f, count - 1.0f));
-        }
+        float z0, z1;
+        boxChord(go, gd, top, z0, z1);
+        int kLo, kHi;
+        sliceRange(z0, z1, depth0, deltaS, plan_.count, kLo, kHi);
         glm::vec4 out(background_, 0.0f);
         for (int k = kLo; k <= kHi; ++k) {
             const glm::vec3 g = go + (depth0 + static_cast<float>(k) * deltaS) * gd;

@@ -84,24 +84,10 @@ std::uint64_t Stack2dCeiling::renderRow(int y, Image4f& image) const
             const glm::vec3 q1d(qd.x / qd.z, qd.y / qd.z, 1.0f);
             const glm::vec3 q1o(qo.x - qo.z * q1d.x, qo.y - qo.z * q1d.y, 0.0f);
             // The chord through the box in u (kernels/volume_sampling.h's clvr_box_chord on [0, n - 1]).
-            float uin = -inf, uout = inf;
-            const glm::vec3 hi(std::nextafter(bMax, inf), std::nextafter(cMax, inf), aMax);
-            for (int a = 0; a < 3; ++a) {
-                if (q1d[a] == 0.0f) {
-                    if (q1o[a] < 0.0f || q1o[a] >= hi[a])
-                        uout = -inf;
-                    continue;
-                }
-                const float t0 = (0.0f - q1o[a]) / q1d[a], t1 = (hi[a] - q1o[a]) / q1d[a];
-                uin = std::max(uin, std::min(t0, t1));
-                uout = std::min(uout, std::max(t0, t1));
-            }
-            int jLo = 0, jHi = -1;
-            if (uin <= uout) {
-                const float count = static_cast<float>(planes_);
-                jLo = static_cast<int>(std::clamp(std::ceil(uin / step_) - 1.0f, 0.0f, count));
-                jHi = static_cast<int>(std::clamp(std::floor(uout / step_) + 1.0f, -1.0f, count - 1.0f));
-            }
+            float uin, uout;
+            boxChord(q1o, q1d, glm::vec3(std::nextafter(bMax, inf), std::nextafter(cMax, inf), aMax), uin, uout);
+            int jLo, jHi;
+            sliceRange(uin, uout, 0.0f, step_, planes_, jLo, jHi);
             const int dir = qd.z > 0.0f ? 1 : -1, jEnd = dir > 0 ? jHi : jLo;
             const float negFull = -step_ * glm::length(d) / std::fabs(qd.z);
             for (int j = dir > 0 ? jLo : jHi; dir * (jEnd - j) >= 0; j += dir) {
