@@ -303,9 +303,7 @@ TEST(HarcLayout, CellOrderPlacesNeighboursNearAndMapsTheAdjacency)
     TetMesh numbered = mesh;
     for (std::size_t t = 0; t < mesh.tets.size(); ++t)
         numbered.tets[slot[t]] = mesh.tets[t];
-    const std::vector<std::uint32_t> kept = harcCellOrder(numbered, handTopology(numbered));
-    for (std::size_t t = 0; t < kept.size(); ++t)
-        ASSERT_EQ(kept[t], t) << "a mesh in Morton order was reordered";
+    EXPECT_TRUE(harcCellOrder(numbered, handTopology(numbered)).empty()) << "a mesh in Morton order was reordered";
 
     const glm::dvec3 shift(0.5);
     const std::vector<cl_float4> plain = packHarcTets(mesh, topology, shift);

@@ -54,11 +54,12 @@ HarcCeiling::HarcCeiling(const TetMesh& mesh, const TetTopology& topology, const
     for (const cl_float4& v : packHarcTets(mesh, topology, shift, slot))
         tets_.push_back(toVec4(v));
     lists_ = buildHarcEntryLists(mesh, topology, camera, width_, height_);
-    for (cl_int2& entry : lists_.entries)
-        entry.s[1] = harcDeviceCode(entry.s[1], slot);
+    if (!slot.empty())
+        for (cl_int2& entry : lists_.entries)
+            entry.s[1] = harcDeviceCode(entry.s[1], slot);
     const std::int64_t eyeTet = camera.parallel ? -1 : locatePoint(mesh, camera.position);
     if (eyeTet >= 0)
-        prependEyeEntry(lists_, slot[static_cast<std::size_t>(eyeTet)]);
+        prependEyeEntry(lists_, harcCellPlace(static_cast<std::size_t>(eyeTet), slot));
     integration_ = options.integration;
     if (options.integration == HarcOptions::Integration::Full) {  // as HarcRenderer::buildFullTable
         const glm::dvec2 range = mesh.scalarRange();
@@ -82,7 +83,7 @@ HarcCeiling::HarcCeiling(const TetMesh& mesh, const TetTopology& topology, const
         for (std::size_t t = 0; t < mesh.tets.size(); ++t)
             for (int axis = 0; axis < 3; ++axis)
                 for (int v = 0; v < 4; ++v)
-                    isoNormals_[3 * slot[t] + axis][v] = static_cast<float>(iso.normals[mesh.tets[t][v]][axis]);
+                    isoNormals_[3 * harcCellPlace(t, slot) + axis][v] = static_cast<float>(iso.normals[mesh.tets[t][v]][axis]);
     }
     if (options.integration == HarcOptions::Integration::Slices) {
         slices_ = true;

@@ -21,7 +21,6 @@
 #include <cstring>
 #include <limits>
 #include <mutex>
-#include <numeric>
 #include <string>
 
 namespace clvr {
@@ -67,7 +66,7 @@ private:
     ImageSpec image_;
     TetMesh mesh_;          // copies: the renderer outlives the caller's mesh
     TetTopology topology_;
-    std::vector<std::uint32_t> slot_;  // each tetrahedron's place on the device (harcCellOrder)
+    std::vector<std::uint32_t> slot_;  // each tetrahedron's place on the device (harcCellOrder; empty: its own)
     glm::dvec3 shift_{0.0};
     glm::dvec3 lo_{0.0}, hi_{0.0};  // the mesh's bounds, which frame the camera (harcBounds)
     std::optional<MeshPart> part_;  // the box to integrate in, for a part of a larger mesh
@@ -113,12 +112,8 @@ HarcRenderer::HarcRenderer(Device& device, const Scene& scene, const TetMesh& me
     counts_ = MeshCounts::of(mesh);
     maxSteps_ = harcMaxSteps(options_, counts_.rendered);
 
-    if (options_.meshCellOrder) {
-        slot_.resize(mesh.tets.size());
-        std::iota(slot_.begin(), slot_.end(), 0u);
-    } else {
+    if (!options_.meshCellOrder)
         slot_ = harcCellOrder(mesh, topology);
-    }
     const std::vector<cl_float4> tets = packHarcTets(mesh, topology, shift_, slot_);
     tets_ = device_.upload("harc tetrahedra (80 bytes each)", tets);
     tf_.upload(device_, "harc transfer function", scene.transferFunction);
@@ -145,7 +140,7 @@ HarcRenderer::HarcRenderer(Device& device, const Scene& scene, const TetMesh& me
         for (std::size_t t = 0; t < mesh.tets.size(); ++t)
             for (int axis = 0; axis < 3; ++axis)
                 for (int v = 0; v < 4; ++v)
-                    normals[3 * slot_[t] + axis].s[v] =
+                    normals[3 * harcCellPlace(t, slot_) + axis].s[v] =
                         static_cast<float>(options_.iso.normals[mesh.tets[t][v]][axis]);
         isoNormals_ = device_.upload("harc iso vertex normals (48 bytes per tet)", normals);
         residentBytes_ += normals.size() * sizeof(cl_float4);
@@ -210,7 +205,7 @@ Image4f HarcRenderer::render(FrameStats& stats)
     HarcRasterEntryStats peel;
     HarcEntryLists lists = rasterEntries_ ? rasterEntries_->build(camera_, peel)
                                           : buildHarcEntryLists(mesh_, topology_, camera_, image_.width, image_.height);
-    if (!rasterEntries_)
+    if (!rasterEntries_ && !slot_.empty())
         for (cl_int2& entry : lists.entries)
             entry.s[1] = harcDeviceCode(entry.s[1], slot_);
     // A perspective eye inside the mesh: every ray starts in the cell holding the eye, before any crossing.
@@ -222,7 +217,7 @@ Image4f HarcRenderer::render(FrameStats& stats)
                           glm::all(glm::lessThanEqual(camera_.position, hi_ + margin));
     const std::int64_t eyeTet = camera_.parallel || !eyeInBox ? -1 : locatePoint(mesh_, camera_.position);
     if (eyeTet >= 0)
-        prependEyeEntry(lists, slot_[static_cast<std::size_t>(eyeTet)]);
+        prependEyeEntry(lists, harcCellPlace(static_cast<std::size_t>(eyeTet), slot_));
     const double entryMs = clock.ms();
     const cl::Buffer offsets = device_.upload("harc entry offsets", lists.offsets);
     std::vector<cl_int2> entries = lists.entries;
@@ -502,13 +497,13 @@ std::uint64_t harcMaxSteps(const HarcOptions& options, std::uint64_t tets)
 
 double harcNeighbourDistance(const TetTopology& topology, const std::vector<std::uint32_t>& slot)
 {
-    const auto place = [&slot](std::size_t t) { return static_cast<double>(slot.empty() ? t : slot[t]); };
     double sum = 0.0;
     std::size_t pairs = 0;
     for (std::size_t t = 0; t < topology.neighbor.size(); ++t)
         for (const std::int32_t n : topology.neighbor[t])
             if (n >= 0) {
-                sum += std::log2(1.0 + std::abs(place(t) - place(static_cast<std::size_t>(n))));
+                sum += std::log2(1.0 + std::abs(static_cast<double>(harcCellPlace(t, slot)) -
+                                                 static_cast<double>(harcCellPlace(static_cast<std::size_t>(n), slot))));
                 ++pairs;
             }
     return pairs ? sum / static_cast<double>(pairs) : 0.0;
@@ -548,14 +543,12 @@ std::vector<std::uint32_t> harcCellOrder(const TetMesh& mesh, const TetTopology&
         slot[keys[i].second] = static_cast<std::uint32_t>(i);
     if (harcNeighbourDistance(topology, slot) < harcNeighbourDistance(topology))
         return slot;
-    std::iota(slot.begin(), slot.end(), 0u);  // the mesh's own order is the nearer
-    return slot;
+    return {};  // the mesh's own order is the nearer
 }
 
 std::vector<cl_float4> packHarcTets(const TetMesh& mesh, const TetTopology& topology, const glm::dvec3& shift,
                                     const std::vector<std::uint32_t>& slot)
 {
-    const auto place = [&slot](std::size_t t) { return slot.empty() ? t : static_cast<std::size_t>(slot[t]); };
     std::vector<cl_float4> out(mesh.tets.size() * 5);
     for (std::size_t t = 0; t < mesh.tets.size(); ++t) {
         const glm::uvec4 v = mesh.tets[t];
@@ -578,7 +571,7 @@ std::vector<cl_float4> packHarcTets(const TetMesh& mesh, const TetTopology& topo
             g += mesh.scalars[v[i]] * h[i];
             g0 += mesh.scalars[v[i]] * k[i];
         }
-        cl_float4* o = &out[5 * place(t)];
+        cl_float4* o = &out[5 * static_cast<std::size_t>(harcCellPlace(t, slot))];
         for (int i = 0; i < 3; ++i)
             o[i] = toCl4(h[i], k[i]);
         o[3] = toCl4(g, g0);
@@ -591,7 +584,7 @@ std::vector<cl_float4> packHarcTets(const TetMesh& mesh, const TetTopology& topo
             if (n >= 0)
                 for (int j = 0; j < 4; ++j)
                     if (topology.neighbor[n][j] == static_cast<std::int32_t>(t))
-                        adj[i] = static_cast<cl_int>(place(static_cast<std::size_t>(n)) * 4 + j);
+                        adj[i] = static_cast<cl_int>(harcCellPlace(static_cast<std::size_t>(n), slot) * 4 + j);
         }
         std::memcpy(&o[4], adj, sizeof adj);
     }

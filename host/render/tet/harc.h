@@ -91,16 +91,16 @@ inline constexpr const char* kHarcWalkPass = "harc: walk";
 // The device layout, 5 float4 = 80 bytes per tetrahedron (kernels/harc.cl describes it): three
 // barycentric planes (the fourth is 1 minus their sum), the gradient and scalar term of Eq. 6, and the
 // adjacency. Coordinates are relative to `shift` (the mesh's bounding-box center, for float precision).
-// `slot` places tetrahedron t at cell slot[t] (its adjacency mapped alike); empty: cell t is tetrahedron t.
+// `slot` places tetrahedron t at cell harcCellPlace(t, slot) (its adjacency mapped alike).
 inline constexpr std::size_t kHarcBytesPerTet = 5 * sizeof(cl_float4);
 std::vector<cl_float4> packHarcTets(const TetMesh& mesh, const TetTopology& topology, const glm::dvec3& shift,
                                     const std::vector<std::uint32_t>& slot = {});
 
 // The cells' order on the device: slot[t] is tetrahedron t's place in packHarcTets' layout, so that the next
-// cell of a ray's walk is near in memory. TetGen numbers its cells in the order it made them (face neighbours
+// cell of a ray's walk is near in memory; empty where the mesh's own order is kept. TetGen numbers its cells in the order it made them (face neighbours
 // lie a median 40,000 cells apart on a 205 k-cell mesh): those are sorted along a Morton (Z-order) curve
 // through their centroids (ties in the mesh's order). A mesh whose own numbering keeps neighbours nearer
-// (a structured grid split into cells, as bluntfin) keeps it: the order with the smaller
+// (a structured grid split into cells, as bluntfin) keeps it (an empty slot): the order with the smaller
 // harcNeighbourDistance wins. The walk's results do not depend on it: the entry lists are sorted in the
 // mesh's numbering and only then mapped (harcDeviceCode).
 std::vector<std::uint32_t> harcCellOrder(const TetMesh& mesh, const TetTopology& topology);
@@ -109,12 +109,18 @@ std::vector<std::uint32_t> harcCellOrder(const TetMesh& mesh, const TetTopology&
 // neighbour pairs of log2(1 + |slot[t] - slot[n]|), about the number of cache levels a step jumps.
 double harcNeighbourDistance(const TetTopology& topology, const std::vector<std::uint32_t>& slot = {});
 
+// Tetrahedron t's place on the device: slot[t], or t where `slot` is empty (the mesh's own order).
+inline std::uint32_t harcCellPlace(std::size_t t, const std::vector<std::uint32_t>& slot)
+{
+    return slot.empty() ? static_cast<std::uint32_t>(t) : slot[t];
+}
+
 // An entry code of HarcEntryLists (tet * 4 + face, or -1 - tet for the eye's cell) with the tetrahedron at its
-// place in `slot`.
+// place in `slot` (harcCellPlace).
 inline std::int32_t harcDeviceCode(std::int32_t code, const std::vector<std::uint32_t>& slot)
 {
-    return code >= 0 ? static_cast<std::int32_t>(slot[static_cast<std::uint32_t>(code) >> 2] * 4 + (code & 3))
-                     : -1 - static_cast<std::int32_t>(slot[static_cast<std::uint32_t>(-1 - code)]);
+    return code >= 0 ? static_cast<std::int32_t>(harcCellPlace(static_cast<std::uint32_t>(code) >> 2, slot) * 4 + (code & 3))
+                     : -1 - static_cast<std::int32_t>(harcCellPlace(static_cast<std::uint32_t>(-1 - code), slot));
 }
 
 // Per pixel of a width x height image, the crossings of its ray (Camera::ray, λ >= 0) with boundary

@@ -46,8 +46,7 @@ HarcRasterEntries::HarcRasterEntries(Device& device, const TetMesh& mesh, const 
             lo = glm::min(lo, q);
             hi = glm::max(hi, q);
         }
-        const auto code = static_cast<std::int32_t>(bf.tet * 4 + bf.face);
-        codes_.push_back(slot.empty() ? code : harcDeviceCode(code, slot));
+        codes_.push_back(harcDeviceCode(static_cast<std::int32_t>(bf.tet * 4 + bf.face), slot));
     }
     if (!codes_.empty()) {
         boundsCenter_ = 0.5 * (lo + hi);

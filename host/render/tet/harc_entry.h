@@ -38,8 +38,8 @@ public:
     // renderer's origin); `tets` is packHarcTets(mesh, topology, shift) on the device (the fragment
     // program takes λ from the entry face's plane). A frame buffer of width x height on `device`;
     // at most maxLayers (1..255) peeling layers per frame.
-    // `slot`: where packHarcTets placed each tetrahedron (harcCellOrder; empty: in the mesh's order); the
-    // lists' codes are those places (harcDeviceCode).
+    // `slot`: where packHarcTets placed each tetrahedron (harcCellOrder, harcCellPlace); the lists' codes are
+    // those places (harcDeviceCode).
     HarcRasterEntries(Device& device, const TetMesh& mesh, const TetTopology& topology, const glm::dvec3& shift,
                       const cl::Buffer& tets, int width, int height, int maxLayers,
                       const std::vector<std::uint32_t>& slot = {});
