@@ -325,7 +325,7 @@ nlohmann::json benchMeshScene(Device& device, const fs::path& scenePath, const S
                                     : isFusedTetiso   ? tetisoWalkOptions(scene, mesh)
                                                       : HarcOptions{};
     std::unique_ptr<HarcCeiling> ceiling;
-    if ((isHarc || isFusedTetslice || isFusedTetiso) && harcCeilingFits(mesh, harcOptions))
+    if ((isHarc || isFusedTetslice || isFusedTetiso) && harcCeilingFits(mesh))
         ceiling = std::make_unique<HarcCeiling>(mesh, buildTopology(mesh), scene.transferFunction, session.camera(),
                                                 scene.image, harcOptions);
     const int threads = threadBudget();

@@ -30,9 +30,8 @@ glm::vec3 xyz(const cl_float4& v)
 
 }  // namespace
 
-bool harcCeilingFits(const TetMesh& mesh, const HarcOptions& options)
+bool harcCeilingFits(const TetMesh& mesh)
 {
-    (void)options;  // every integration
     return !mesh.part;
 }
 

@@ -72,8 +72,8 @@ private:
     std::vector<glm::vec4> isoNormals_;  // 3 per cell in harc's order: the x, y, z of its vertex normals
 };
 
-// Whether the ceiling mirrors this harc scene's kernel path: partial integration of a whole mesh (not a
-// sort-last part, whose box the kernel also cuts segments to).
-bool harcCeilingFits(const TetMesh& mesh, const HarcOptions& options);
+// Whether the ceiling mirrors the kernel's walk of this mesh: a whole mesh, any integration (not a sort-last part,
+// whose box the kernel also cuts segments to).
+bool harcCeilingFits(const TetMesh& mesh);
 
 }  // namespace clvr::tools
