@@ -209,9 +209,9 @@ Image4f HarcRenderer::render(FrameStats& stats)
         for (cl_int2& entry : lists.entries)
             entry.s[1] = harcDeviceCode(entry.s[1], slot_);
     // A perspective eye inside the mesh: every ray starts in the cell holding the eye, before any crossing.
-    // No cell holds an eye outside the mesh's box (for a part, the whole mesh's): the search is linear in the cells
-    // (40 ms on the 1.16 M-cell torus), the box test free.
-    // (widened by far more than locatePoint's tolerance, 1e-12 of a cell's volume, can reach past a face)
+    // The search is linear in the cells (40 ms on the 1.16 M-cell torus), so it runs only for an eye in the mesh's
+    // box (for a part, the whole mesh's), widened by far more than locatePoint's tolerance (1e-12 of a cell's volume)
+    // can reach past a face.
     const glm::dvec3 margin = 1e-9 * (hi_ - lo_) + 1e-300;
     const bool eyeInBox = glm::all(glm::greaterThanEqual(camera_.position, lo_ - margin)) &&
                           glm::all(glm::lessThanEqual(camera_.position, hi_ + margin));
