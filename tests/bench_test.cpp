@@ -9,6 +9,7 @@
 #include "tools/ceiling_cubefan.cpp"
 #include "tools/ceiling_harc.cpp"
 #include "tools/ceiling_iso3d.cpp"
+#include "tools/ceiling_projtet.cpp"
 #include "tools/ceiling_spherical.cpp"
 #include "tools/ceiling_stack2d.cpp"
 
@@ -72,6 +73,81 @@ TEST(Ceiling, MatchesReferenceIntegralOnMarschnerLobb)
     // alpha, mean 1.2e-4).
     EXPECT_TRUE(clvr::test::imagesNear(result.image, expected, {.maxAbs = 6e-3, .meanAbs = 3e-4}));
     EXPECT_GT(result.samples, 0u);
+}
+
+// How two images of one size differ: the pixels that differ by more than 1e-5 in some channel, the largest and the
+// mean channel difference.
+struct PixelsApart {
+    std::size_t over = 0;
+    double max = 0.0, mean = 0.0;
+};
+PixelsApart pixelsApart(const clvr::Image4f& a, const clvr::Image4f& b)
+{
+    PixelsApart r;
+    for (std::size_t p = 0; p < a.pixelCount(); ++p) {
+        const glm::vec4 d = glm::abs(a.pixels()[p] - b.pixels()[p]);
+        const float m = std::max({d.r, d.g, d.b, d.a});
+        r.over += m > 1e-5f ? 1 : 0;
+        r.max = std::max(r.max, static_cast<double>(m));
+        r.mean += static_cast<double>(d.r + d.g + d.b + d.a) / 4.0;
+    }
+    r.mean /= static_cast<double>(a.pixelCount());
+    return r;
+}
+
+// slice3d's ceiling loop with a clip mesh and with pre-integrated slabs does the fused kernel's work: the same
+// samples, and the same image up to float rounding — the loop's layers come from the CPU reference rasterizer
+// in double, the kernel's from the raster stage in float, so a sample within rounding of a surface, or a pixel
+// on the mesh's silhouette, may fall the other way (measured: a few pixels of each image); its exp against
+// clvr_exp2. Two-pass, naive and inverse, perspective and parallel, back to front and front to back.
+TEST(Ceiling, ClipsAndPreintegratesLikeTheKernel)
+{
+    const clvr::Volume volume = clvr::generateVolume("marschner-lobb", {41, 37, 33});
+    const nlohmann::json sphere = {{"generator", "sphere"}, {"center", {0.1, -0.05, 0.0}}, {"radius", 0.75}, {"segments", 48}};
+    struct Case {
+        std::string what;
+        nlohmann::json options;
+    };
+    const std::vector<Case> cases = {
+        {"two-pass", {{"slices", 90}, {"path", "fused"}, {"clip", {{"mesh", sphere}}}}},
+        {"two-pass inverse, front to back",
+         {{"slices", 90}, {"path", "fused"}, {"order", "front-to-back"}, {"clip", {{"mesh", sphere}, {"inverse", true}}}}},
+        {"naive", {{"slices", 90}, {"path", "fused"}, {"clip", {{"mesh", sphere}, {"method", "naive"}}}}},
+        {"preintegrated", {{"slices", 60}, {"integration", "preintegrated"}, {"order", "front-to-back"}}},
+        {"preintegrated, early termination",
+         {{"slices", 60}, {"integration", "preintegrated"}, {"order", "front-to-back"}, {"early_termination", 0.6}}},
+    };
+    for (const clvr::Camera& camera : {clvr::test::obliquePerspectiveCamera(30.0), clvr::test::obliqueParallelCamera(1.3)})
+        for (const Case& c : cases) {
+            const std::string what = c.what + (camera.parallel ? ", parallel" : ", perspective");
+            clvr::Scene scene;
+            scene.technique = "slice3d";
+            scene.camera = camera;
+            scene.image = clvr::ImageSpec{56, 48, {0.05, 0.05, 0.1}};
+            scene.transferFunction = testTransferFunction();
+            scene.options = c.options;
+            clvr::FrameStats stats;
+            const clvr::Image4f kernel = clvr::test::renderScene(scene, volume, &stats);
+            clvr::tools::CeilingScene cs;
+            cs.camera = camera;
+            cs.width = scene.image.width;
+            cs.height = scene.image.height;
+            cs.background = scene.image.background;
+            cs.options = clvr::parseSlice3dOptions(scene.options);
+            if (cs.options.clip)
+                cs.clipMesh = clvr::loadClipMesh(cs.options.clip->mesh, {});
+            const clvr::tools::Ceiling ceiling(volume, scene.transferFunction, cs);
+            const clvr::tools::CeilingResult result = ceiling.render(2);
+            const PixelsApart d = pixelsApart(kernel, result.image);
+            std::printf("[ measured ] slice3d ceiling vs kernel (%s): %zu of %zu pixels over 1e-5, max %.2g, mean %.2g; "
+                        "samples %llu vs %llu\n",
+                        what.c_str(), d.over, kernel.pixelCount(), d.max, d.mean,
+                        static_cast<unsigned long long>(result.samples), static_cast<unsigned long long>(stats.samples));
+            EXPECT_LE(d.over * 100, kernel.pixelCount()) << what;  // at most 1 % of the pixels
+            EXPECT_LT(d.mean, 2e-4) << what;
+            EXPECT_GT(result.samples, 10000u) << what;
+            EXPECT_EQ(result.samples, stats.samples) << what;  // with early termination: up to where the ray stopped
+        }
 }
 
 // spherical's ceiling loop (tools/ceiling_spherical.h) does the fused kernel's work in plain C++: the same image
@@ -504,6 +580,56 @@ TEST(HarcCeiling, WalksLikeTheKernelAndMatchesTheExactIntegral)
             SCOPED_TRACE(options.dump());
             expectCeilingWalksLikeTheKernel(clvr::test::meshScene("harc", c.camera, tf, 40, options), mesh, 1e-5);
         }
+    }
+}
+
+// projtet's ceiling loop (tools/ceiling_projtet.h) draws what the renderer draws: the same image up to float
+// rounding (the raster stage's blending and PoCL's contracted multiply-adds; measured max 1.2e-7), within the exact
+// integral's tolerance of it, and one segment per ray and cell it meets — as many as harc's walk enters cells
+// (harc's steps), and no more than the fragments of the grown silhouettes the raster stage covers. Two boxes with a
+// gap along the view (perspective and parallel) and an eye inside an L of boxes (cells cut by the near plane).
+TEST(ProjtetCeiling, DrawsLikeTheRendererAndMatchesTheExactIntegral)
+{
+    const glm::dvec3 gradient(0.3, 0.35, -0.4);
+    struct Case {
+        std::vector<clvr::test::Box> boxes;
+        clvr::Camera camera;
+    };
+    const std::vector<clvr::test::Box> gap = {{{0.0, 0.0, 0.0}, {1.0, 1.0, 0.4}, 3}, {{0.0, 0.0, 0.7}, {1.0, 1.0, 1.2}, 3}};
+    const std::vector<Case> cases = {
+        {gap, clvr::test::perspective({0.4, 0.6, 3.0}, {0.5, 0.5, 0.6}, 40.0)},
+        {gap, clvr::test::parallelView({2.5, -1.5, 1.8}, {0.5, 0.5, 0.6}, 0.9)},
+        {{{{0.0, 0.0, 0.0}, {2.0, 1.0, 1.0}, 4}, {{0.0, 1.0, 0.0}, {1.0, 2.0, 1.0}, 3}},
+         clvr::test::perspective({0.55, 0.45, 0.6}, {1.6, 1.3, 0.3}, 95.0)},
+    };
+    for (const Case& c : cases) {
+        clvr::TetMesh mesh = clvr::test::boxMesh(c.boxes, gradient, 0.4);
+        clvr::checkMesh(mesh);
+        const clvr::TetTopology topology = clvr::buildTopology(mesh);
+        const clvr::TransferFunction tf = clvr::test::rampTransferFunction();
+        const clvr::Scene scene = clvr::test::meshScene("projtet", c.camera, tf, 40);
+        clvr::FrameStats stats, harcStats;
+        const clvr::Image4f kernel = clvr::makeMeshRenderer(clvr::test::device(), scene, mesh)->render(stats);
+        clvr::makeHarcRenderer(clvr::test::device(), clvr::test::meshScene("harc", c.camera, tf, 40), mesh, topology)
+            ->render(harcStats);
+        const clvr::tools::ProjtetCeiling ceiling(mesh, topology, tf, c.camera, scene.image,
+                                                  clvr::parseProjtetOptions(scene.options));
+        const clvr::tools::ProjtetCeilingResult result = ceiling.render(2);
+        const std::uint64_t fragments = stats.extra["raster_fragments"].get<std::uint64_t>();
+        const std::uint64_t steps = harcStats.extra["steps"].get<std::uint64_t>();
+        const PixelsApart d = pixelsApart(kernel, result.image);
+        std::printf("[ measured ] projtet ceiling: %zu pixels over 1e-5 (max %.2g); %llu segments, harc's steps %llu, "
+                    "fragments %llu, %llu pixels tested\n",
+                    d.over, d.max, static_cast<unsigned long long>(result.segments), static_cast<unsigned long long>(steps),
+                    static_cast<unsigned long long>(fragments), static_cast<unsigned long long>(result.pixelsTested));
+        EXPECT_TRUE(clvr::test::imagesNear(result.image, clvr::raster::reference::toDouble(kernel),
+                                           {.maxAbs = 1e-5, .meanAbs = 1e-6}));
+        EXPECT_TRUE(clvr::test::imagesNear(result.image, clvr::tetReferenceIntegral(mesh, tf, c.camera, scene.image),
+                                           {.maxAbs = 2e-3, .meanAbs = 2e-4}));
+        EXPECT_GT(result.segments, 1000u);
+        EXPECT_LE(std::abs(static_cast<double>(result.segments) - static_cast<double>(steps)), 2e-3 * static_cast<double>(steps));
+        EXPECT_LE(result.segments, fragments);
+        EXPECT_GE(result.pixelsTested, result.segments);
     }
 }
 

@@ -28,6 +28,7 @@
 #include "tools/ceiling_harc.h"
 #include "tools/ceiling_cubefan.h"
 #include "tools/ceiling_iso3d.h"
+#include "tools/ceiling_projtet.h"
 #include "tools/ceiling_spherical.h"
 #include "tools/ceiling_stack2d.h"
 
@@ -168,9 +169,9 @@ const Image4d& referenceImage(std::map<std::string, Image4d>& cache, const Scene
     return cache.emplace(k, std::move(image)).first->second;
 }
 
-// The plain C++ ceiling loop on the same scene, where there is one: slice3d's fused path with per-sample
-// classification (the raster path counts fragments, not samples; pre-integrated slabs and clip meshes are
-// other loops), stack2d's fused direct volume rendering (unshaded, no clip texture), spherical's fused
+// The plain C++ ceiling loop on the same scene, where there is one: slice3d's fused path (per-sample
+// classification or pre-integrated slabs, a clip mesh or none; not a clip texture; the raster path counts
+// fragments, not samples), stack2d's fused direct volume rendering (unshaded, no clip texture), spherical's fused
 // path, cubefan's fused path, iso3d's fused path (unbricked, gradient or no shading). Its frames are interleaved with clvr's (see bench()), so that both
 // see the same load on a shared machine.
 std::unique_ptr<VolumeCeiling> makeCeiling(const Scene& scene, const Volume& volume, const Camera& camera)
@@ -182,8 +183,10 @@ std::unique_ptr<VolumeCeiling> makeCeiling(const Scene& scene, const Volume& vol
         cs.height = scene.image.height;
         cs.background = scene.image.background;
         cs.options = parseSlice3dOptions(scene.options);
-        if (cs.options.path != Slice3dOptions::Path::Fused || cs.options.preintegrated || cs.options.clip)
+        if (cs.options.path != Slice3dOptions::Path::Fused || cs.options.clipTexture)
             return nullptr;
+        if (cs.options.clip)
+            cs.clipMesh = loadClipMesh(cs.options.clip->mesh, scene.baseDir);
         return std::make_unique<Ceiling>(volume, scene.transferFunction, cs);
     }
     if (scene.technique == stack2dTechnique().name) {
@@ -332,6 +335,18 @@ nlohmann::json benchMeshScene(Device& device, const fs::path& scenePath, const S
     HarcCeilingResult ceilingResult;
     if (ceiling)
         ceilingResult = ceiling->render(threads);  // warms its caches
+    // projtet's ceiling loop (tools/ceiling_projtet.h): the projection and the draw, set beside the renderer's
+    // passes that do that work (kProjtetDrawPasses), not its visibility sort.
+    std::unique_ptr<ProjtetCeiling> projtetCeiling;
+    ProjtetCeilingResult projtetResult;
+    if (scene.technique == projtetTechnique().name) {
+        projtetCeiling = std::make_unique<ProjtetCeiling>(mesh, buildTopology(mesh), scene.transferFunction,
+                                                          session.camera(), scene.image, parseProjtetOptions(scene.options));
+        projtetResult = projtetCeiling->render(threads);
+    }
+    static const char* const kProjtetDrawPasses[] = {"projtet: projection and classification (host)",
+                                                     "projtet: raster set-up and binning (host)", "raster: fragments"};
+    std::vector<double> drawMs;
 
     std::vector<double> ms, statsMs, walkMs, ceilingMs;
     FrameStats stats;
@@ -340,14 +355,24 @@ nlohmann::json benchMeshScene(Device& device, const fs::path& scenePath, const S
         Frame frame = session.render();
         ms.push_back(frame.wallMs);
         statsMs.push_back(frame.stats.frameMs);
-        for (const PassTime& p : frame.stats.passes)
+        double draw = 0.0;
+        for (const PassTime& p : frame.stats.passes) {
             if (p.name == kHarcWalkPass)
                 walkMs.push_back(p.ms);
+            for (const char* pass : kProjtetDrawPasses)
+                draw += p.name == pass ? p.ms : 0.0;
+        }
+        drawMs.push_back(draw);
         stats = std::move(frame.stats);
         image = std::move(frame.image);
         if (ceiling) {
             const auto c0 = Clock::now();
             ceilingResult = ceiling->render(threads);
+            ceilingMs.push_back(msSince(c0));
+        }
+        if (projtetCeiling) {
+            const auto c0 = Clock::now();
+            projtetResult = projtetCeiling->render(threads);
             ceilingMs.push_back(msSince(c0));
         }
     }
@@ -433,6 +458,32 @@ nlohmann::json benchMeshScene(Device& device, const fs::path& scenePath, const S
                   << si(walkStepsPerS) << " steps/s: " << fixed(100.0 * walkStepsPerS / ceilingStepsPerS, 1)
                   << "% of it; steps " << ceilingResult.steps << " vs " << f.steps << ", image |diff| max "
                   << fixed(d.max, 4) << ", mean " << fixed(d.mean, 5) << '\n'
+                  << std::flush;
+    }
+
+    if (projtetCeiling) {
+        const Spread c = spread(ceilingMs), w = spread(drawMs);
+        const fs::path png = prefix.string() + ".ceiling.png";
+        writeImage(png.string(), projtetResult.image);
+        const ImageDiff d = imageDiff(image, projtetResult.image);
+        r["ceiling"] = {{"threads", threads},
+                        {"frame_ms", c.median},
+                        {"frame_ms_min", c.min},
+                        {"frame_ms_max", c.max},
+                        {"frame_ms_all", ceilingMs},
+                        {"pixels_tested", projtetResult.pixelsTested},
+                        {"segments", projtetResult.segments},
+                        {"clvr_draw_ms", w.median},
+                        {"clvr_draw_ms_all", drawMs},
+                        {"clvr_ratio", c.median / w.median},
+                        {"image", png.string()},
+                        {"image_diff_vs_clvr", {{"mean", d.mean}, {"max", d.max}}}};
+        std::cout << "  ceiling      projection and draw " << fixed(c.median, 1) << " ms (" << threads
+                  << " threads, interleaved with clvr's; " << si(static_cast<double>(projtetResult.segments))
+                  << " segments of " << si(static_cast<double>(projtetResult.pixelsTested))
+                  << " pixels tested); clvr's projection, set-up and fragments " << fixed(w.median, 1) << " ms: "
+                  << fixed(100.0 * c.median / w.median, 1) << "% of its speed; image |diff| max " << fixed(d.max, 4)
+                  << ", mean " << fixed(d.mean, 5) << '\n'
                   << std::flush;
     }
 

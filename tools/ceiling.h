@@ -1,9 +1,11 @@
 // tools/ceiling.h — the interface of the regular-grid ceiling loops, and the speed ceiling for slice3d:
 // the per-sample work of its fused kernel (kernels/slice3d.cl: ray–slice intersection, trilinear sample
 // from a float array, exact piecewise-linear transfer-function lookup, alpha = 1 - exp(-tau Delta), "over"
-// compositing) as a plain C++ loop, multithreaded with std::thread over rows. clvr bench reports clvr's samples/s as
-// a fraction of this loop's (docs/benchmarks.md). Not part of the library; tests/bench_test.cpp
-// checks its image against host/reference/reference_integral.h.
+// compositing; with a clip mesh, the test of each sample against the mesh's peeled layers; with pre-integrated
+// slabs, each slab between consecutive samples integrated by kernels/segment_integral.h's pieces) as a plain C++
+// loop, multithreaded with std::thread over rows. clvr bench reports clvr's samples/s as a fraction of this
+// loop's (docs/benchmarks.md). Not part of the library; tests/bench_test.cpp checks its image against
+// host/reference/reference_integral.h and, clipped or pre-integrated, against the kernel's.
 #pragma once
 
 #include "host/model/camera.h"
@@ -11,6 +13,8 @@
 #include "host/render/grid/slice3d.h"
 #include "host/model/transfer_function.h"
 #include "host/model/volume.h"
+#include "host/optics/clip_mesh.h"
+#include "tools/ceiling_segment.h"
 
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
@@ -19,6 +23,7 @@
 #include <limits>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 namespace clvr::tools {
@@ -27,7 +32,8 @@ struct CeilingScene {
     Camera camera;
     int width = 512, height = 512;
     glm::dvec3 background{0.0};
-    Slice3dOptions options;  // slices / slice_spacing, order, early_termination as slice3d reads them
+    Slice3dOptions options;  // slices / slice_spacing, order, early_termination, integration, clip as slice3d reads them
+    std::optional<ClipMesh> clipMesh;  // options.clip's mesh, loaded (loadClipMesh)
 };
 
 struct CeilingResult {
@@ -47,7 +53,10 @@ public:
             value_.emplace_back(glm::vec3(p.color), static_cast<float>(p.tau));
         }
     }
-    glm::vec4 operator()(const glm::vec3& g) const
+    glm::vec4 operator()(const glm::vec3& g) const { return classify(value(g)); }
+
+    // clvr_trilinear: the scalar at grid coordinates g.
+    float value(const glm::vec3& g) const
     {
         const glm::ivec3 n = volume_.dims;
         const std::size_t nx = static_cast<std::size_t>(n.x), nxy = nx * n.y;
@@ -61,7 +70,12 @@ public:
         const float c01 = p[nxy] + fx * (p[nxy + 1] - p[nxy]);
         const float c11 = p[nxy + nx] + fx * (p[nxy + nx + 1] - p[nxy + nx]);
         const float c0 = c00 + fy * (c10 - c00), c1 = c01 + fy * (c11 - c01);
-        const float s = c0 + fz * (c1 - c0);
+        return c0 + fz * (c1 - c0);
+    }
+
+    // clvr_tf_eval: (r, g, b, tau) at the scalar s.
+    glm::vec4 classify(float s) const
+    {
         const int count = static_cast<int>(s_.size());
         if (!(s > s_[0]))
             return value_[0];
@@ -129,20 +143,31 @@ protected:
     int width_, height_;
 };
 
+// slice3d's fused path: per-sample classification, clipped by a mesh or not, or pre-integrated slabs (the fused
+// path's options; InputError for a clip mesh that scene.clipMesh does not hold).
 class Ceiling final : public VolumeCeiling {
 public:
     Ceiling(const Volume& volume, const TransferFunction& tf, const CeilingScene& scene);
-    nlohmann::json describe() const override { return {{"slices", plan_.count}, {"slice_spacing", plan_.deltaS}}; }
+    nlohmann::json describe() const override;
     // The slices, as slice3d plans them (planSlices).
     const SlicePlan& plan() const { return plan_; }
 
 private:
     std::uint64_t renderRow(int y, Image4f& image) const override;
+    // Pixel (x, y) with pre-integrated slabs; returns the samples taken.
+    std::uint64_t preintegratedPixel(int x, int y, const glm::vec3& go, const glm::vec3& gd, float stretch,
+                                     Image4f& image) const;
+    // The clip mesh's surfaces along every pixel's ray, as the renderer peels them (kernels/clip_layers.cl's rule)
+    // but drawn by the CPU reference rasterizer (raster/reference/rasterizer.h).
+    void peel(const ClipMesh& mesh);
 
     const Volume& volume_;
     CeilingScene scene_;
     SlicePlan plan_;
     CeilingClassifier classify_;
+    std::optional<CeilingSegments> segments_;  // integration "preintegrated"
+    std::vector<glm::vec2> layers_;  // clip mesh: layer l of pixel p at l * pixels + p, (eye depth, 1 if front-facing)
+    int layerCount_ = 0;
 };
 
 }  // namespace clvr::tools

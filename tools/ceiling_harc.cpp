@@ -37,7 +37,7 @@ bool harcCeilingFits(const TetMesh& mesh)
 
 HarcCeiling::HarcCeiling(const TetMesh& mesh, const TetTopology& topology, const TransferFunction& tf,
                          const Camera& camera, const ImageSpec& image, const HarcOptions& options)
-    : width_(image.width), height_(image.height), background_(image.background), psi_(psiTable())
+    : width_(image.width), height_(image.height), background_(image.background), segments_(tf)
 {
     // The renderer's frame: coordinates relative to the centre of harc's box.
     glm::dvec3 lo, hi;
@@ -91,14 +91,6 @@ HarcCeiling::HarcCeiling(const TetMesh& mesh, const TetTopology& topology, const
         sliceCount_ = options.sliceCount;
     }
 
-    const std::vector<float> packed = packTransferFunction(tf);
-    const std::size_t n = tf.points().size(), m = (n + 3) / 4 * 4;
-    for (std::size_t i = 0; i < n; ++i) {
-        tfS_.push_back(packed[i]);
-        tfValue_.emplace_back(packed[m + 4 * i], packed[m + 4 * i + 1], packed[m + 4 * i + 2], packed[m + 4 * i + 3]);
-        const float* slope = &packed[m + 4 * n + 4 * i];
-        tfSlope_.emplace_back(slope[0], slope[1], slope[2], slope[3]);
-    }
 }
 
 HarcCeilingResult HarcCeiling::render(int threads) const
@@ -126,100 +118,11 @@ HarcCeilingResult HarcCeiling::render(int threads) const
 
 void HarcCeiling::renderRow(int y, Image4f& image, Counts& counts) const
 {
-    const int n = static_cast<int>(tfS_.size());
-    const float* tfS = tfS_.data();
-    const glm::vec4* tfValue = tfValue_.data();
-    const glm::vec4* tfSlope = tfSlope_.data();
-    const int psiN = psi_.size;
-    const float* psi = psi_.values.data();
     const glm::vec4* tets = tets_.data();
     const cl_uint* offsets = lists_.offsets.data();
     const cl_int2* entries = lists_.entries.data();
-
-    // kernels/segment_integral.h, the same functions as lambdas.
-    auto psiLookup = [&](float front, float back) {  // harc_psi
-        const float f = std::min(front, 1e30f), b = std::min(back, 1e30f);
-        const float n1 = static_cast<float>(psiN - 1);
-        const float x = f / (1.0f + f) * n1, yy = b / (1.0f + b) * n1;
-        const int i = std::min(static_cast<int>(x), psiN - 2), j = std::min(static_cast<int>(yy), psiN - 2);
-        const float fx = x - static_cast<float>(i), fy = yy - static_cast<float>(j);
-        const float* r0 = psi + j * psiN + i;
-        const float* r1 = r0 + psiN;
-        const float a = r0[0] + fx * (r0[1] - r0[0]);
-        const float c = r1[0] + fx * (r1[1] - r1[0]);
-        return a + fy * (c - a);
-    };
-    auto piece = [&](const glm::vec4& cf, const glm::vec4& cb, float l, glm::vec3& color, float& transmittance) {
-        const float tf = cf.w * l, tb = cb.w * l;  // harc_piece: Eq. 2-4
-        if (tf == 0.0f && tb == 0.0f)
-            return;
-        const float zeta = std::exp2(-0.5f * 1.44269504f * (tf + tb));
-        const float p = psiLookup(tf, tb);
-        color += transmittance * (glm::vec3(cb) * (p - zeta) + glm::vec3(cf) * (1.0f - p));
-        transmittance *= zeta;
-    };
-    auto tfAt = [&](int k, float x) -> glm::vec4 {  // harc_tf_at
-        if (k == 0)
-            return tfValue[0];
-        if (k == n)
-            return tfValue[n - 1];
-        return tfValue[k - 1] + (x - tfS[k - 1]) * tfSlope[k - 1];
-    };
-    auto upper = [&](float x) {  // harc_upper
-        int lo = 0, hi = n;
-        while (lo < hi) {
-            const int mid = (lo + hi) >> 1;
-            if (tfS[mid] <= x)
-                lo = mid + 1;
-            else
-                hi = mid;
-        }
-        return lo;
-    };
-    struct TfPoint {
-        float s;
-        int k;
-        glm::vec4 c;
-    };
-    // harc_segment_from: the segment split at the control points strictly between its ends.
-    auto segment = [&](const TfPoint& front, float sB, float l, glm::vec3& color, float& transmittance, TfPoint& back) {
-        const float sF = front.s;
-        glm::vec4 cFront = front.c;
-        if (!(sB != sF)) {
-            piece(cFront, cFront, l, color, transmittance);
-            back = front;
-            return 1;
-        }
-        const float invDs = 1.0f / (sB - sF);
-        float lambdaFront = 0.0f;
-        int pieces = 0, kB;
-        if (sB > sF) {
-            int k = front.k;
-            for (; k < n && tfS[k] < sB; ++k) {
-                const float lambda = l * ((tfS[k] - sF) * invDs);
-                piece(cFront, tfValue[k], lambda - lambdaFront, color, transmittance);
-                cFront = tfValue[k];
-                lambdaFront = lambda;
-                ++pieces;
-            }
-            kB = k < n && tfS[k] <= sB ? k + 1 : k;
-        } else {
-            int k = front.k - 1;
-            while (k >= 0 && tfS[k] >= sF)
-                --k;
-            for (; k >= 0 && tfS[k] > sB; --k) {
-                const float lambda = l * ((tfS[k] - sF) * invDs);
-                piece(cFront, tfValue[k], lambda - lambdaFront, color, transmittance);
-                cFront = tfValue[k];
-                lambdaFront = lambda;
-                ++pieces;
-            }
-            kB = k + 1;
-        }
-        back = {sB, kB, tfAt(kB, sB)};
-        piece(cFront, back.c, l - lambdaFront, color, transmittance);
-        return pieces + 1;
-    };
+    const CeilingSegments& seg = segments_;  // kernels/segment_integral.h
+    using TfPoint = CeilingSegments::Point;
 
     // kernels/harc.cl's harc_slices (tetslice's fused path): the slices of constant eye depth in [segF, segB), in
     // order; df, the eye depth per unit λ.
@@ -235,8 +138,7 @@ void HarcCeiling::renderRow(int y, Image4f& image, Counts& counts) const
             if (lambdaK < segF)
                 continue;
             const float s = glm::dot(glm::vec3(grad), e + lambdaK * d) + grad.w;  // kernels/transfer_function.h
-            const int kS = upper(s);
-            const glm::vec4 ct = tfAt(kS, s);
+            const glm::vec4 ct = seg.tfAt(seg.upper(s), s);
             const float alpha = 1.0f - std::exp2(ct.w * negLog2e);
             color += (transmittance * alpha) * glm::vec3(ct);
             transmittance *= 1.0f - alpha;
@@ -349,7 +251,7 @@ void HarcCeiling::renderRow(int y, Image4f& image, Counts& counts) const
                         color += transmittance * glm::vec3(c);
                         transmittance *= 1.0f - c.w;
                     } else {  // harc_segment_average
-                        const glm::vec4 c = 0.5f * (tfAt(upper(sF), sF) + tfAt(upper(sB), sB));
+                        const glm::vec4 c = 0.5f * (seg.tfAt(seg.upper(sF), sF) + seg.tfAt(seg.upper(sB), sB));
                         const float zeta = std::exp(-c.w * step);
                         color += transmittance * (1.0f - zeta) * glm::vec3(c);
                         transmittance *= zeta;
@@ -360,10 +262,9 @@ void HarcCeiling::renderRow(int y, Image4f& image, Counts& counts) const
                     TfPoint front = carried;
                     if (!carry) {
                         const float sF = glm::dot(glm::vec3(grad), pos) + grad.w;
-                        const int kF = upper(sF);
-                        front = {sF, kF, tfAt(kF, sF)};
+                        front = seg.point(sF);
                     }
-                    rowPieces += static_cast<std::uint64_t>(segment(front, sB, step, color, transmittance, carried));
+                    rowPieces += static_cast<std::uint64_t>(seg.segment(front, sB, step, color, transmittance, carried));
                     carry = true;
                 }
                 if (1.0f - transmittance >= ertAlpha_) {

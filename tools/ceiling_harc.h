@@ -18,6 +18,7 @@
 #include "host/optics/psi_table.h"
 #include "host/render/tet/harc.h"
 #include "kernels/ray.h"
+#include "tools/ceiling_segment.h"
 
 #include <glm/glm.hpp>
 
@@ -56,10 +57,7 @@ private:
     float ertAlpha_;
     std::vector<glm::vec4> tets_;       // packHarcTets: 5 per tetrahedron
     HarcEntryLists lists_;
-    std::vector<float> tfS_;            // control points' s (packTransferFunction's first block)
-    std::vector<glm::vec4> tfValue_;    // their (r, g, b, tau)
-    std::vector<glm::vec4> tfSlope_;    // d(r, g, b, tau)/ds of the segment after each point
-    const PsiTable& psi_;
+    CeilingSegments segments_;          // the transfer function and ψ, kernels/segment_integral.h's functions
     HarcOptions::Integration integration_;
     std::optional<PreintegrationTable> full_;  // Integration::Full: the table harc builds
     bool slices_ = false;  // tetslice's fused path (Integration::Slices): the slices, not the pieces

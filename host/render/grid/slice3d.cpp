@@ -404,13 +404,7 @@ void Slice3dRenderer::peelClipMesh()
     constexpr int kMaxLayers = 64;
     const auto t0 = std::chrono::steady_clock::now();
     const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
-    // The raster path's projection (renderRaster): surfaces nearer than its near plane lie in front of every
-    // slice, where the rule never looks; the far plane lies beyond the mesh.
-    const double nearZ = 0.5 * plan_.depth(0);
-    const double farZ = 2.0 * std::max(plan_.depthMax, clipDepthMax_) + 1.0;
-    const glm::dmat4 viewProjection =
-        camera_.projectionMatrix(image_.width, image_.height, nearZ, farZ) * camera_.viewMatrix();
-    const std::vector<raster::Vertex> mesh = clipMeshVertices(*clipMesh_, viewProjection);
+    const std::vector<raster::Vertex> mesh = clipPeelVertices(*clipMesh_, camera_, image_.width, image_.height, plan_);
     raster::FragmentProgram peel;
     peel.source = "#define CLVR_CLIP_LAYERS_FRAGMENT 1\n" + std::string(embeddedKernelSource("clip_layers.cl"));
     peel.attributes = 1;
@@ -589,6 +583,18 @@ raster::DrawStats Slice3dRenderer::drawClipped(const std::vector<raster::Vertex>
 }
 
 }  // namespace
+
+std::vector<raster::Vertex> clipPeelVertices(const ClipMesh& mesh, const Camera& camera, int width, int height,
+                                             const SlicePlan& plan)
+{
+    // The raster path's projection (renderRaster): surfaces nearer than its near plane lie in front of every
+    // slice, where the peel's rule never looks; the far plane lies beyond the box and the mesh.
+    double depthMax = plan.depthMax;
+    for (const glm::dvec3& p : mesh.points)
+        depthMax = std::max(depthMax, glm::dot(camera.forward(), p - camera.position));
+    const double nearZ = 0.5 * plan.depth(0), farZ = 2.0 * depthMax + 1.0;
+    return clipMeshVertices(mesh, camera.projectionMatrix(width, height, nearZ, farZ) * camera.viewMatrix());
+}
 
 namespace {
 

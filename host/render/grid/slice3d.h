@@ -9,6 +9,7 @@
 #include "host/optics/clip_texture.h"
 #include "host/render/renderer.h"
 #include "host/render/slice_plan.h"
+#include "raster/rasterizer.h"
 
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
@@ -61,6 +62,13 @@ Slice3dOptions parseSlice3dOptions(const nlohmann::json& options);
 // Slices over the eye-depth range of the box [lo, hi] as options.slices and options.sliceSpacing ask
 // (planSlices of host/render/slice_plan.h).
 SlicePlan planSlices(const Camera& camera, const glm::dvec3& lo, const glm::dvec3& hi, const Slice3dOptions& options);
+
+// The fused path's clip-mesh peel draws (kernels/clip_layers.cl, docs/slice3d.md "Clipping with closed meshes"; also
+// tools/ceiling.h's): the mesh's triangles as raster::draw takes them, projected as the raster path projects its
+// slices for `camera` and `plan` (near plane at half the first slice's depth, far plane beyond the box and the
+// mesh), attribute 0 the world position.
+std::vector<raster::Vertex> clipPeelVertices(const ClipMesh& mesh, const Camera& camera, int width, int height,
+                                             const SlicePlan& plan);
 
 // Empty-space skipping (docs/slice3d.md): bricks of B^3 cells, B = kBrickCells (= 2^CLVR_BRICK_SHIFT
 // in kernels/empty_space.h; 4 measured faster than 8 on the engine); brick b covers the grid points
