@@ -32,8 +32,9 @@ T trilinearAt(const T* v, const glm::ivec3& n, const glm::vec3& g)
 
 bool iso3dCeilingFits(const Iso3dOptions& options, const IsoSpec& iso)
 {
-    return options.path == Iso3dOptions::Path::Fused && options.bricks.x <= 0 && options.brickBudget == 0 &&
-           !options.interior && iso.shading != IsoSpec::Shading::Gradientless;
+    const bool unbricked = options.bricks.x <= 0 && options.brickBudget == 0;
+    return (options.path == Iso3dOptions::Path::Raster || unbricked) && !options.interior &&
+           iso.shading != IsoSpec::Shading::Gradientless;
 }
 
 Iso3dCeiling::Iso3dCeiling(const Volume& volume, const Scene& scene, const Camera& camera, const Iso3dOptions& options)
@@ -55,6 +56,35 @@ Iso3dCeiling::Iso3dCeiling(const Volume& volume, const Scene& scene, const Camer
     alphaRef_ = (static_cast<float>(iso_.value) - valueLo_) * valueScale_;
     origin_ = glm::vec3(volume.origin);
     invSpacing_ = glm::vec3(1.0 / volume.spacing);
+    raster_ = options.path == Iso3dOptions::Path::Raster;
+    if (raster_) {  // as Iso3dRendererImpl's raster frame: its projection, its brick grid and draws
+        const double nearZ = 0.5 * plan_.depth(0), farZ = 2.0 * plan_.depthMax + 1.0;
+        const glm::dmat4 viewProjection =
+            camera_.projectionMatrix(width_, height_, nearZ, farZ) * camera_.viewMatrix();
+        bricks_ = iso3dBrickGrid(volume.dims, options, sizeof(glm::vec4));
+        for (const BrickDraw& d : brickDraws(bricks_, camera_, volume.origin, volume.spacing, plan_, viewProjection,
+                                             width_, height_)) {
+            Draw draw;
+            draw.draw = d;
+            draw.texels = brickPoints(rgba_, volume.dims, bricks_, d.brick);
+            draw.dims = bricks_.dims(d.brick);
+            const glm::ivec3 lo = bricks_.lo(d.brick), hi = bricks_.hi(d.brick), n = volume.dims;
+            draw.lo = glm::vec3(lo);
+            draw.end = glm::vec3(hi.x == n.x - 1 ? n.x : hi.x, hi.y == n.y - 1 ? n.y : hi.y, hi.z == n.z - 1 ? n.z : hi.z);
+            draws_.push_back(std::move(draw));
+        }
+    }
+}
+
+nlohmann::json Iso3dCeiling::describe() const
+{
+    nlohmann::json d = {{"slices", plan_.count}, {"iso_value", iso_.value}};
+    if (raster_) {
+        d["path"] = "raster";
+        d["bricks"] = bricks_.count();
+        d["samples_are"] = "fragments tested, up to each pixel's hit";
+    }
+    return d;
 }
 
 std::uint64_t Iso3dCeiling::renderRow(int y, Image4f& image) const
@@ -87,6 +117,40 @@ std::uint64_t Iso3dCeiling::renderRow(int y, Image4f& image) const
         int kLo, kHi;
         sliceRange(z0, z1, depth0, deltaS, plan_.count, kLo, kHi);
         glm::vec4 out(background_, 0.0f);
+        // The hit's color: iso3d_color, then the shading color matrix and the finish pass's clamp.
+        auto shade = [&](const glm::vec4& t) {
+            if (iso_.shading == IsoSpec::Shading::None)
+                return glm::vec4(glm::vec3(iso_.color), 1.0f);
+            const glm::dvec4 c =
+                raster::reference::pixelTransfer(glm::dvec4(t.x, t.y, t.z, (t.w - valueLo_) * valueScale_), shading_);
+            return glm::vec4(glm::clamp(glm::vec3(c), 0.0f, 1.0f), 1.0f);
+        };
+        if (raster_) {  // the bricks' draws, front to back; the first fragment that passes locks the pixel
+            bool hit = false;
+            for (const Draw& b : draws_) {
+                const BrickDraw& dr = b.draw;
+                if (dr.scissor && (x < dr.x0 || x >= dr.x1 || y < dr.y0 || y >= dr.y1))
+                    continue;
+                for (int k = dr.kLo; k <= dr.kHi && !hit; ++k) {
+                    const glm::vec3 g = go + (depth0 + static_cast<float>(k) * deltaS) * gd;
+                    if (!(g.x >= 0.0f && g.y >= 0.0f && g.z >= 0.0f && g.x <= static_cast<float>(n.x - 1) &&
+                          g.y <= static_cast<float>(n.y - 1) && g.z <= static_cast<float>(n.z - 1)))
+                        continue;  // not on the slice polygon: no fragment
+                    ++taken;
+                    if (g.x < b.lo.x || g.y < b.lo.y || g.z < b.lo.z || g.x >= b.end.x || g.y >= b.end.y || g.z >= b.end.z)
+                        continue;  // another brick's
+                    const glm::vec4 t = trilinearAt(b.texels.data(), b.dims, g - b.lo);
+                    if ((t.w - valueLo_) * valueScale_ >= alphaRef_) {
+                        out = shade(t);
+                        hit = true;
+                    }
+                }
+                if (hit)
+                    break;
+            }
+            image.at(x, y) = out;
+            continue;
+        }
         for (int k = kLo; k <= kHi; ++k) {
             const glm::vec3 g = go + (depth0 + static_cast<float>(k) * deltaS) * gd;
             if (!(g.x >= 0.0f && g.y >= 0.0f && g.z >= 0.0f && g.x <= static_cast<float>(n.x - 1) &&
@@ -100,14 +164,7 @@ std::uint64_t Iso3dCeiling::renderRow(int y, Image4f& image) const
             }
             ++taken;
             if ((trilinearAt(values, n, g) - valueLo_) * valueScale_ >= alphaRef_) {
-                if (iso_.shading == IsoSpec::Shading::None) {
-                    out = glm::vec4(glm::vec3(iso_.color), 1.0f);
-                } else {  // iso3d_color, the shading color matrix, the finish pass's clamp
-                    const glm::vec4 t = trilinearAt(rgba_.data(), n, g);
-                    const glm::dvec4 c = raster::reference::pixelTransfer(
-                        glm::dvec4(t.x, t.y, t.z, (t.w - valueLo_) * valueScale_), shading_);
-                    out = glm::vec4(glm::clamp(glm::vec3(c), 0.0f, 1.0f), 1.0f);
-                }
+                out = shade(iso_.shading == IsoSpec::Shading::None ? glm::vec4(0.0f) : trilinearAt(rgba_.data(), n, g));
                 break;
             }
         }

@@ -121,12 +121,7 @@ Iso3dRendererImpl::Iso3dRendererImpl(Device& device, const Scene& scene, const V
     const bool gradientless = iso_.shading == IsoSurface::Shading::Gradientless;
     // Every byte of texture per grid point: the RGBA volume, and gradientless shading's scalar texture.
     const std::uint64_t bytesPerPoint = sizeof(glm::vec4) + (gradientless ? sizeof(float) : 0);
-    if (options_.bricks.x > 0)
-        bricks_ = splitBricks(volume.dims, options_.bricks, bytesPerPoint);
-    else if (options_.brickBudget > 0)
-        bricks_ = planBricks(volume.dims, bytesPerPoint, options_.brickBudget);
-    else
-        bricks_ = splitBricks(volume.dims, glm::ivec3(1), bytesPerPoint);
+    bricks_ = iso3dBrickGrid(volume.dims, options_, bytesPerPoint);
     const std::string brickKey = options_.bricks.x > 0 ? "bricks" : "brick_budget";
     const std::string brickGrid = std::to_string(bricks_.counts.x) + "x" + std::to_string(bricks_.counts.y) + "x" +
                                   std::to_string(bricks_.counts.z);
@@ -146,19 +141,8 @@ Iso3dRendererImpl::Iso3dRendererImpl(Device& device, const Scene& scene, const V
         // brick faces are the unbricked ones), and one device buffer as large as the largest brick.
         for (int bz = 0; bz < bricks_.counts.z; ++bz)
             for (int by = 0; by < bricks_.counts.y; ++by)
-                for (int bx = 0; bx < bricks_.counts.x; ++bx) {
-                    const glm::ivec3 b(bx, by, bz), lo = bricks_.lo(b), n = bricks_.dims(b);
-                    std::vector<glm::vec4> data;
-                    data.reserve(static_cast<std::size_t>(n.x) * n.y * n.z);
-                    for (int k = 0; k < n.z; ++k)
-                        for (int j = 0; j < n.y; ++j) {
-                            const std::size_t row =
-                                (static_cast<std::size_t>(lo.z + k) * volume.dims.y + (lo.y + j)) * volume.dims.x + lo.x;
-                            data.insert(data.end(), rgba.begin() + static_cast<std::ptrdiff_t>(row),
-                                        rgba.begin() + static_cast<std::ptrdiff_t>(row + n.x));
-                        }
-                    brickData_.push_back(std::move(data));
-                }
+                for (int bx = 0; bx < bricks_.counts.x; ++bx)
+                    brickData_.push_back(brickPoints(rgba, volume.dims, bricks_, glm::ivec3(bx, by, bz)));
         residentBytes_ = bricks_.maxBytes();
         volume_ = device_.buffer("iso3d brick (RGBA: normal, value; float32)", residentBytes_, CL_MEM_READ_ONLY);
     }
@@ -453,52 +437,20 @@ raster::DrawStats Iso3dRendererImpl::drawBricks(const raster::DrawState& unbrick
     state.fragment.stencil.dppass = raster::StencilOp::Replace;
     framebuffer_->clearStencil(device_, 0);
 
-    const glm::dvec3 forward = camera_.forward();
     raster::DrawStats total;
     std::uint64_t uploads = 0, uploadBytes = 0;
     double uploadMs = 0.0;
     raster::FragmentProgram program = fragmentProgram_;
     ClIso3dUniforms brick = fragmentUniforms_;
-    for (const glm::ivec3& b : brickOrder(bricks_, camera_, origin_, spacing_)) {
-        const glm::ivec3 lo = bricks_.lo(b), hi = bricks_.hi(b), n = bricks_.dims(b);
-        const glm::dvec3 boxLo = origin_ + glm::dvec3(lo) * spacing_, boxHi = origin_ + glm::dvec3(hi) * spacing_;
-        // The slices that can reach the brick: its corners' eye-depth range, one slice more on each side
-        // (a slice drawn for a brick it misses only costs discarded fragments; one missed would lose samples).
-        double dMin = std::numeric_limits<double>::infinity(), dMax = -dMin;
-        bool allInFront = true;
-        glm::dvec2 wMin(std::numeric_limits<double>::infinity()), wMax(-std::numeric_limits<double>::infinity());
-        for (int c = 0; c < 8; ++c) {
-            const glm::dvec3 p((c & 1) ? boxHi.x : boxLo.x, (c & 2) ? boxHi.y : boxLo.y, (c & 4) ? boxHi.z : boxLo.z);
-            const double d = glm::dot(forward, p - camera_.position);
-            dMin = std::min(dMin, d);
-            dMax = std::max(dMax, d);
-            const glm::dvec4 clip = viewProjection * glm::dvec4(p, 1.0);
-            if (!(clip.w > 0.0)) {
-                allInFront = false;
-                continue;
-            }
-            const glm::dvec2 window((clip.x / clip.w + 1.0) * 0.5 * image_.width,
-                                    (1.0 - clip.y / clip.w) * 0.5 * image_.height);
-            wMin = glm::min(wMin, window);
-            wMax = glm::max(wMax, window);
-        }
-        const int kLo = std::max(0, static_cast<int>(std::floor((dMin - plan_.depthMin) / plan_.deltaS - 0.5)) - 1);
-        const int kHi =
-            std::min(plan_.count - 1, static_cast<int>(std::ceil((dMax - plan_.depthMin) / plan_.deltaS - 0.5)) + 1);
-        if (kLo > kHi || sliceFirst[kLo] == sliceFirst[kHi + 1])
+    for (const BrickDraw& draw : brickDraws(bricks_, camera_, origin_, spacing_, plan_, viewProjection, image_.width,
+                                            image_.height)) {
+        const glm::ivec3 b = draw.brick, lo = bricks_.lo(b), hi = bricks_.hi(b), n = bricks_.dims(b);
+        const int kLo = draw.kLo, kHi = draw.kHi;
+        if (sliceFirst[kLo] == sliceFirst[kHi + 1])
             continue;
-        // The scissor: the brick's projected box (the hull of its corners when all are in front of the
-        // eye), one pixel wider on every side; the whole frame otherwise (the eye near or in the brick).
         state.scissor = {};
-        if (allInFront) {
-            const int x0 = std::max(0, static_cast<int>(std::floor(wMin.x)) - 1);
-            const int y0 = std::max(0, static_cast<int>(std::floor(wMin.y)) - 1);
-            const int x1 = std::min(image_.width, static_cast<int>(std::ceil(wMax.x)) + 1);
-            const int y1 = std::min(image_.height, static_cast<int>(std::ceil(wMax.y)) + 1);
-            if (x0 >= x1 || y0 >= y1)
-                continue;  // off screen
-            state.scissor = {true, x0, y0, x1 - x0, y1 - y0};
-        }
+        if (draw.scissor)
+            state.scissor = {true, draw.x0, draw.y0, draw.x1 - draw.x0, draw.y1 - draw.y0};
 
         const std::vector<glm::vec4>& data = brickData_[static_cast<std::size_t>(b.x + bricks_.counts.x * (b.y + bricks_.counts.y * b.z))];
         const auto t0 = std::chrono::steady_clock::now();
@@ -770,6 +722,79 @@ MemoryBricks planBricks(const glm::ivec3& dims, std::uint64_t bytesPerPoint, std
         }
         ++counts[axis];  // axis >= 0: 2x2x2 points fit the budget
     }
+}
+
+MemoryBricks iso3dBrickGrid(const glm::ivec3& dims, const Iso3dOptions& options, std::uint64_t bytesPerPoint)
+{
+    if (options.bricks.x > 0)
+        return splitBricks(dims, options.bricks, bytesPerPoint);
+    if (options.brickBudget > 0)
+        return planBricks(dims, bytesPerPoint, options.brickBudget);
+    return splitBricks(dims, glm::ivec3(1), bytesPerPoint);
+}
+
+std::vector<glm::vec4> brickPoints(const std::vector<glm::vec4>& points, const glm::ivec3& dims, const MemoryBricks& grid,
+                                   const glm::ivec3& b)
+{
+    const glm::ivec3 lo = grid.lo(b), n = grid.dims(b);
+    std::vector<glm::vec4> data;
+    data.reserve(static_cast<std::size_t>(n.x) * n.y * n.z);
+    for (int k = 0; k < n.z; ++k)
+        for (int j = 0; j < n.y; ++j) {
+            const std::size_t row = (static_cast<std::size_t>(lo.z + k) * dims.y + (lo.y + j)) * dims.x + lo.x;
+            data.insert(data.end(), points.begin() + static_cast<std::ptrdiff_t>(row),
+                        points.begin() + static_cast<std::ptrdiff_t>(row + n.x));
+        }
+    return data;
+}
+
+std::vector<BrickDraw> brickDraws(const MemoryBricks& grid, const Camera& camera, const glm::dvec3& origin,
+                                  const glm::dvec3& spacing, const SlicePlan& plan, const glm::dmat4& viewProjection,
+                                  int width, int height)
+{
+    const glm::dvec3 forward = camera.forward();
+    std::vector<BrickDraw> draws;
+    for (const glm::ivec3& b : brickOrder(grid, camera, origin, spacing)) {
+        const glm::dvec3 boxLo = origin + glm::dvec3(grid.lo(b)) * spacing, boxHi = origin + glm::dvec3(grid.hi(b)) * spacing;
+        // The slices that can reach the brick: its corners' eye-depth range, one slice more on each side
+        // (a slice drawn for a brick it misses only costs discarded fragments; one missed would lose samples).
+        double dMin = std::numeric_limits<double>::infinity(), dMax = -dMin;
+        bool allInFront = true;
+        glm::dvec2 wMin(std::numeric_limits<double>::infinity()), wMax(-std::numeric_limits<double>::infinity());
+        for (int c = 0; c < 8; ++c) {
+            const glm::dvec3 p((c & 1) ? boxHi.x : boxLo.x, (c & 2) ? boxHi.y : boxLo.y, (c & 4) ? boxHi.z : boxLo.z);
+            const double d = glm::dot(forward, p - camera.position);
+            dMin = std::min(dMin, d);
+            dMax = std::max(dMax, d);
+            const glm::dvec4 clip = viewProjection * glm::dvec4(p, 1.0);
+            if (!(clip.w > 0.0)) {
+                allInFront = false;
+                continue;
+            }
+            const glm::dvec2 window((clip.x / clip.w + 1.0) * 0.5 * width, (1.0 - clip.y / clip.w) * 0.5 * height);
+            wMin = glm::min(wMin, window);
+            wMax = glm::max(wMax, window);
+        }
+        BrickDraw draw;
+        draw.brick = b;
+        draw.kLo = std::max(0, static_cast<int>(std::floor((dMin - plan.depthMin) / plan.deltaS - 0.5)) - 1);
+        draw.kHi = std::min(plan.count - 1, static_cast<int>(std::ceil((dMax - plan.depthMin) / plan.deltaS - 0.5)) + 1);
+        if (draw.kLo > draw.kHi)
+            continue;
+        // The scissor: the brick's projected box (the hull of its corners when all are in front of the
+        // eye), one pixel wider on every side; the whole frame otherwise (the eye near or in the brick).
+        if (allInFront) {
+            draw.scissor = true;
+            draw.x0 = std::max(0, static_cast<int>(std::floor(wMin.x)) - 1);
+            draw.y0 = std::max(0, static_cast<int>(std::floor(wMin.y)) - 1);
+            draw.x1 = std::min(width, static_cast<int>(std::ceil(wMax.x)) + 1);
+            draw.y1 = std::min(height, static_cast<int>(std::ceil(wMax.y)) + 1);
+            if (draw.x0 >= draw.x1 || draw.y0 >= draw.y1)
+                continue;  // off screen
+        }
+        draws.push_back(draw);
+    }
+    return draws;
 }
 
 std::vector<glm::ivec3> brickOrder(const MemoryBricks& grid, const Camera& camera, const glm::dvec3& origin,

@@ -7,6 +7,7 @@
 #pragma once
 
 #include "host/render/renderer.h"
+#include "host/render/slice_plan.h"
 #include "raster/pixel_transfer.h"
 
 #include <glm/glm.hpp>
@@ -123,12 +124,35 @@ MemoryBricks splitBricks(const glm::ivec3& dims, const glm::ivec3& counts, std::
 // ("options.brick_budget: ...") when the budget is below the smallest brick, 2x2x2 grid points.
 MemoryBricks planBricks(const glm::ivec3& dims, std::uint64_t bytesPerPoint, std::uint64_t budget);
 
+// The brick grid iso3d renders with for these options: exactly options.bricks, else planBricks for
+// options.brickBudget, else one brick (unbricked).
+MemoryBricks iso3dBrickGrid(const glm::ivec3& dims, const Iso3dOptions& options, std::uint64_t bytesPerPoint);
+
+// Brick b's grid points cut out of a whole grid's `points` (x fastest, `dims` per axis), x fastest.
+std::vector<glm::vec4> brickPoints(const std::vector<glm::vec4>& points, const glm::ivec3& dims, const MemoryBricks& grid,
+                                   const glm::ivec3& b);
+
 // The bricks front to back for `camera`: a visibility order of the axis-aligned grid (a ray from the eye
 // crosses the slabs of each axis monotonically away from the eye's slab, so its bricks have increasing
 // sum over the axes of |slab - eye slab|; parallel projection: slabs counted along the view direction).
 // Sorted by that sum, ties by index. `origin`, `spacing`: the volume's.
 std::vector<glm::ivec3> brickOrder(const MemoryBricks& grid, const Camera& camera, const glm::dvec3& origin,
                                    const glm::dvec3& spacing);
+
+// One brick's draw in the raster path's bricked frame (§3.1; also tools/ceiling_iso3d.h's loop): the slices that can
+// reach the brick (its corners' eye-depth range, one slice more each side, of plan's slices) and the scissor
+// box of pixels they are drawn in (the hull of its projected corners one pixel wider, [x0, x1) x [y0, y1); the
+// whole image when a corner is not in front of the eye: scissor false).
+struct BrickDraw {
+    glm::ivec3 brick{0};
+    int kLo = 0, kHi = -1;
+    bool scissor = false;
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+};
+// The bricks' draws in brickOrder, those with no slice or off screen left out; viewProjection: the draws'.
+std::vector<BrickDraw> brickDraws(const MemoryBricks& grid, const Camera& camera, const glm::dvec3& origin,
+                                  const glm::dvec3& spacing, const SlicePlan& plan, const glm::dmat4& viewProjection,
+                                  int width, int height);
 
 // Renderer for "iso3d". hitDepth() gives the last frame's eye depth (along the camera's forward axis,
 // world units) of the surface per pixel, row 0 at the top, +infinity where no sample passed.
