@@ -664,27 +664,47 @@ Image4f ProjtetRenderer::render(FrameStats& stats)
     std::vector<glm::vec4> clip(points_.size());
     std::vector<glm::dvec2> ndc(points_.size());
     std::vector<std::uint8_t> inFront(points_.size());
-    for (std::size_t p = 0; p < points_.size(); ++p) {
-        const glm::dvec4 c = viewProjection * glm::dvec4(points_[p], 1.0);
-        clip[p] = glm::vec4(c);
-        inFront[p] = camera_.parallel || c.w > nearZ;
-        ndc[p] = glm::dvec2(glm::vec2(static_cast<float>(c.x / c.w), static_cast<float>(c.y / c.w)));
-    }
+    const std::size_t cellCount = sorted.order.size();
+    // On the host's threads, in chunks of cells taken from a shared counter: the points, then each cell's
+    // vertex count, then (at offsets from their prefix sum, so the triangles stay in visibility order, the same
+    // vertices as one thread writes) the vertices themselves.
+    constexpr std::size_t kChunk = 8192;
+    const int threads = threadsToUse(0, static_cast<int>(std::max(points_.size(), cellCount) / kChunk + 1));
+    auto inChunks = [&](std::size_t n, const auto& work) {
+        std::atomic<std::size_t> next{0};
+        runOnThreads(threads, threads, [&] {
+            for (std::size_t begin; (begin = next.fetch_add(kChunk)) < n;)
+                work(begin, std::min(begin + kChunk, n));
+        });
+    };
+    inChunks(points_.size(), [&](std::size_t begin, std::size_t end) {
+        for (std::size_t p = begin; p < end; ++p) {
+            const glm::dvec4 c = viewProjection * glm::dvec4(points_[p], 1.0);
+            clip[p] = glm::vec4(c);
+            inFront[p] = camera_.parallel || c.w > nearZ;
+            ndc[p] = glm::dvec2(glm::vec2(static_cast<float>(c.x / c.w), static_cast<float>(c.y / c.w)));
+        }
+    });
     const glm::dvec2 pixelScale(0.5 * image_.width, 0.5 * image_.height);  // NDC to pixels
-    std::vector<raster::Vertex>& vertices = vertices_;  // kept: its pages are touched once, not every frame
-    vertices.clear();
-    std::uint64_t class1 = 0, class2 = 0, degenerate = 0, nearCells = 0;
-    for (const std::uint32_t t : sorted.order) {
+    // Cell t's vertices, written to `out` when it is not null; returns their number. Counts its kind.
+    struct Kinds {
+        std::uint64_t class1 = 0, class2 = 0, degenerate = 0, nearCells = 0;
+    };
+    auto emitCell = [&](std::uint32_t t, raster::Vertex* out, Kinds& kinds) -> std::uint32_t {
         const glm::uvec4 tet = tets_[t];
         const glm::vec4 id(static_cast<float>(t & 4095u), static_cast<float>(t >> 12), 0.0f, 0.0f);
+        std::uint32_t written = 0;
         auto vertex = [&](const glm::vec4& position) {
-            raster::Vertex v;
-            v.position = position;
-            v.attributes[0] = id;
-            vertices.push_back(v);
+            if (out) {
+                raster::Vertex& v = out[written];
+                v.position = position;
+                v.attributes = {};
+                v.attributes[0] = id;
+            }
+            ++written;
         };
         if (!(inFront[tet[0]] && inFront[tet[1]] && inFront[tet[2]] && inFront[tet[3]])) {
-            ++nearCells;
+            ++kinds.nearCells;
             for (int f = 0; f < 4; ++f) {
                 int corner[3], n = 0;
                 for (int i = 0; i < 4; ++i)
@@ -698,15 +718,17 @@ Image4f ProjtetRenderer::render(FrameStats& stats)
                     for (const int k : corner)
                         vertex(clip[k]);
             }
-            continue;
+            return written;
         }
         const std::array<glm::dvec2, 4> q = {ndc[tet[0]], ndc[tet[1]], ndc[tet[2]], ndc[tet[3]]};
         const ProjectedTet pt = classifyProjection(q);
         if (pt.kind == ProjectedTet::Kind::Degenerate) {
-            ++degenerate;
-            continue;
+            ++kinds.degenerate;
+            return 0;
         }
-        (pt.kind == ProjectedTet::Kind::Class1 ? class1 : class2)++;
+        (pt.kind == ProjectedTet::Kind::Class1 ? kinds.class1 : kinds.class2)++;
+        if (!out)
+            return static_cast<std::uint32_t>(3 * pt.triangleCount);
         // Conservative coverage: the silhouette's corners moved outwards by kGrowPixels (miter, capped),
         // so that no pixel centre the cell's own ray meets is lost to the raster stage's 1/256-pixel
         // snapping at a silhouette edge; the fragment's exact ray-cell intersection makes the extra
@@ -738,7 +760,28 @@ Image4f ProjtetRenderer::render(FrameStats& stats)
             for (const int c : pt.triangles[k])
                 vertex(c == 4 ? thick
                               : glm::vec4(static_cast<float>(corner[c].x), static_cast<float>(corner[c].y), 0.0f, 1.0f));
-    }
+        return written;
+    };
+    std::vector<std::uint64_t> first(cellCount + 1, 0);  // cell i's vertices start at first[i]
+    std::atomic<std::uint64_t> class1{0}, class2{0}, degenerate{0}, nearCells{0};
+    inChunks(cellCount, [&](std::size_t begin, std::size_t end) {
+        Kinds kinds;
+        for (std::size_t i = begin; i < end; ++i)
+            first[i + 1] = emitCell(sorted.order[i], nullptr, kinds);
+        class1 += kinds.class1;
+        class2 += kinds.class2;
+        degenerate += kinds.degenerate;
+        nearCells += kinds.nearCells;
+    });
+    for (std::size_t i = 0; i < cellCount; ++i)
+        first[i + 1] += first[i];
+    std::vector<raster::Vertex>& vertices = vertices_;  // kept: its pages are touched once, not every frame
+    vertices.resize(first[cellCount]);
+    inChunks(cellCount, [&](std::size_t begin, std::size_t end) {
+        Kinds ignored;
+        for (std::size_t i = begin; i < end; ++i)
+            emitCell(sorted.order[i], vertices.data() + first[i], ignored);
+    });
     const double projectMs = msSince(t0);
 
     // Back to front, premultiplied: dst = src + (1 - src.alpha) dst (GL_ONE, GL_ONE_MINUS_SRC_ALPHA).
@@ -784,10 +827,10 @@ Image4f ProjtetRenderer::render(FrameStats& stats)
         stats.extra["boundary_relations"] = sorted.boundary.relations;
     }
     stats.extra["projection_ms"] = projectMs;
-    stats.extra["cells_class1"] = class1;
-    stats.extra["cells_class2"] = class2;
-    stats.extra["cells_degenerate_projection"] = degenerate;
-    stats.extra["cells_near_plane"] = nearCells;
+    stats.extra["cells_class1"] = class1.load();
+    stats.extra["cells_class2"] = class2.load();
+    stats.extra["cells_degenerate_projection"] = degenerate.load();
+    stats.extra["cells_near_plane"] = nearCells.load();
     stats.extra["raster_triangles"] = drawn.triangles;
     stats.extra["raster_fragments"] = drawn.fragments;
     stats.extra["integration"] = "partial";  // harc's partial pre-integration, per fragment
