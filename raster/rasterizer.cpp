@@ -6,8 +6,10 @@
 #include "raster/rasterizer.h"
 
 #include "host/runtime/errors.h"
+#include "host/runtime/parallel.h"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstddef>
@@ -211,6 +213,8 @@ inline std::array<std::uint32_t, 3> triangleIndices(Topology topology, std::uint
 }
 
 constexpr std::size_t kMaxRows = 16384;  // Framebuffer's largest height: one fragment counter per item row
+// A draw of at least twice this many triangles is set up in chunks of it on the host's threads (setUpDraw).
+constexpr std::size_t kSetUpChunk = 16384;
 
 }  // namespace
 
@@ -248,6 +252,17 @@ struct SetUpDraws {
     std::uint64_t setUp = 0;            // DrawStats::triangles: also those whose pixel box is empty
     std::size_t draws = 0;
     std::vector<ClipVertex> polygon, scratch;
+    // A large draw's triangles set up in chunks on the host's threads (setUpDraw), each into its own arrays,
+    // kept with their capacity between draws.
+    struct Chunk {
+        std::vector<cl_float4> triangles;
+        std::vector<std::array<cl_uint, 2>> pairs;  // (tile, triangle of the chunk)
+        std::vector<cl_uint> tileCounts;            // the pass's tiles
+        std::vector<ClipVertex> polygon, scratch;
+        std::size_t count = 0;                      // triangles set up with a nonempty pixel box
+        std::uint64_t setUp = 0;
+    };
+    std::vector<Chunk> chunks;
 
     void clear()
     {
@@ -299,6 +314,166 @@ void lendCapacity(SetUpDraws& from, SetUpDraws& to)
     lend(from.triangles, to.triangles);
     lend(from.pairs, to.pairs);
 }
+
+// Where set-up triangles go: records appended to `triangles`, (tile, index) pairs to `pairs` (index counted
+// from `index` on), the pass's tile counts, the triangles set up (DrawStats::triangles) in setUp.
+struct TriangleSink {
+    std::vector<cl_float4>& triangles;
+    std::vector<std::array<cl_uint, 2>>& pairs;
+    cl_uint* tileCounts;  // the pass's tiles, tile (tx, ty) at ty * tilesX + tx
+    std::size_t index;
+    std::uint64_t setUp;
+    std::vector<ClipVertex>& polygon;  // clipping scratch
+    std::vector<ClipVertex>& scratch;
+};
+
+// One draw's triangles [first, last) set up and binned into a sink (docs/raster.md, steps 1-6): clipped against
+// the planes, snapped to the subpixel grid, culled, and binned to every tile of the pass they can cover.
+struct TriangleSetUp {
+    Topology topology;
+    const std::vector<Vertex>& vertices;
+    const std::vector<glm::dvec4>& planes;
+    const ResolvedViewport& vp;
+    const Rect& rect;  // the pass's (the viewport's) rectangle
+    const Rect& clip;  // the scissored rectangle
+    const FragmentState& fs;
+    int attributes;
+    const TileGrid& grid;
+    std::size_t tileBase;  // the pass's first tile
+
+    void run(std::uint32_t first, std::uint32_t last, TriangleSink& sink) const
+    {
+        const int tilesX = grid.tilesX();
+        const int tileWLog2 = log2Of(grid.tileW), tileHLog2 = log2Of(grid.tileH);
+        const std::size_t stride = CLVR_TRIANGLE_FLOAT4S(attributes);
+        std::vector<ClipVertex>& polygon = sink.polygon;
+        std::vector<ClipVertex>& scratch = sink.scratch;
+        // The clipped polygon in window coordinates: each of the planes (near, far, the user's, four guard
+        // band planes) adds at most one vertex to a convex polygon.
+        std::array<WindowVertex, 3 + 2 + kMaxClipPlanes + 4> window;
+        std::size_t windowSize = 0;
+        for (std::uint32_t triangle = first; triangle < last; ++triangle) {
+            const std::array<std::uint32_t, 3> indices = triangleIndices(topology, triangle);
+            bool inside = true;
+            glm::dvec4 position[3];
+            for (int j = 0; j < 3; ++j) {
+                position[j] = glm::dvec4(vertices[indices[j]].position);
+                for (const glm::dvec4& p : planes)
+                    inside = inside && glm::dot(p, position[j]) >= 0.0;
+            }
+            windowSize = 0;
+            bool finite = true;
+            const auto project = [&](const glm::dvec4& pos, const std::array<glm::dvec4, kMaxAttributes>& attrs) {
+                finite = finite && toWindow(pos, attrs, attributes, vp, window[windowSize++]);
+            };
+            std::array<glm::dvec4, kMaxAttributes> attrs;
+            if (inside) {  // the common case: no clipping, straight from the vertices
+                for (int j = 0; j < 3 && finite; ++j) {
+                    for (int k = 0; k < attributes; ++k)
+                        attrs[k] = glm::dvec4(vertices[indices[j]].attributes[k]);
+                    project(position[j], attrs);
+                }
+            } else {
+                polygon.clear();
+                for (int j = 0; j < 3; ++j) {
+                    ClipVertex v{position[j], {}};
+                    for (int k = 0; k < kMaxAttributes; ++k)
+                        v.attributes[k] = glm::dvec4(vertices[indices[j]].attributes[k]);
+                    polygon.push_back(v);
+                }
+                for (const glm::dvec4& p : planes) {
+                    clipPolygon(polygon, p, scratch);
+                    if (polygon.size() < 3)
+                        break;
+                }
+                if (polygon.size() < 3)
+                    continue;
+                for (const ClipVertex& v : polygon) {
+                    project(v.position, v.attributes);
+                    if (!finite)
+                        break;
+                }
+            }
+            if (!finite)
+                continue;
+
+            // Facing from the polygon's signed area. cross() > 0 is clockwise on the row-down screen,
+            // so counter-clockwise as GL sees it (y up) is cross() < 0.
+            std::int64_t area2 = 0;
+            for (std::size_t i = 1; i + 1 < windowSize; ++i)
+                area2 += cross(window[0], window[i], window[i + 1]);
+            if (area2 == 0)
+                continue;
+            const bool front = fs.frontFaceCCW ? area2 < 0 : area2 > 0;
+            if (fs.cull == CullFace::FrontAndBack || (fs.cull == CullFace::Front && front) ||
+                (fs.cull == CullFace::Back && !front))
+                continue;
+
+            for (std::size_t i = 1; i + 1 < windowSize; ++i) {
+                const WindowVertex* v[3] = {&window[0], &window[i], &window[i + 1]};
+                const std::int64_t a2 = cross(*v[0], *v[1], *v[2]);
+                // A fan triangle whose snapped orientation disagrees with the polygon's is a snapping
+                // sliver of zero true area: drop it with the zero-area ones.
+                if (a2 == 0 || (a2 > 0) != (area2 > 0))
+                    continue;
+                if (a2 < 0)
+                    std::swap(v[1], v[2]);
+                ++sink.setUp;
+
+                // Pixels whose centers (x + 0.5) can be inside, clipped to the scissored viewport rectangle.
+                const std::int64_t minX = std::min({v[0]->x, v[1]->x, v[2]->x}), maxX = std::max({v[0]->x, v[1]->x, v[2]->x});
+                const std::int64_t minY = std::min({v[0]->y, v[1]->y, v[2]->y}), maxY = std::max({v[0]->y, v[1]->y, v[2]->y});
+                const std::int64_t half = CLVR_SUBPIXEL_SCALE / 2;
+                const int px0 = static_cast<int>(std::max<std::int64_t>(clip.x, ceilSubpixel(minX - half)));
+                const int px1 = static_cast<int>(std::min<std::int64_t>(clip.x + clip.width - 1, floorSubpixel(maxX - half)));
+                const int py0 = static_cast<int>(std::max<std::int64_t>(clip.y, ceilSubpixel(minY - half)));
+                const int py1 = static_cast<int>(std::min<std::int64_t>(clip.y + clip.height - 1, floorSubpixel(maxY - half)));
+                if (px0 > px1 || py0 > py1)
+                    continue;
+
+                ClTriangle t{};
+                for (int j = 0; j < 3; ++j) {
+                    const WindowVertex& a = *v[j];
+                    const WindowVertex& b = *v[(j + 1) % 3];
+                    t.x[j] = static_cast<cl_int>(a.x);
+                    t.y[j] = static_cast<cl_int>(a.y);
+                    const std::int64_t dx = b.x - a.x, dy = b.y - a.y;
+                    // Top-left rule (row-down, edge functions positive inside): a left edge runs up, a
+                    // top edge runs exactly horizontal to the right.
+                    t.bias[j] = (dy < 0 || (dy == 0 && dx > 0)) ? 0 : -1;
+                }
+                t.front_facing = front ? 1u : 0u;
+                t.inv_area = f(1.0 / static_cast<double>(std::llabs(a2)));
+                t.col_min = px0;
+                t.col_max = px1;
+                t.row_min = py0;
+                t.row_max = py1;
+                t.depth = cl_float4{{f(v[0]->depth), f(v[1]->depth), f(v[2]->depth), 0.0f}};
+                t.inv_w = cl_float4{{f(v[0]->invW), f(v[1]->invW), f(v[2]->invW), 0.0f}};
+                std::array<cl_float4, CLVR_TRIANGLE_FLOAT4S(kMaxAttributes)> record;
+                std::memcpy(record.data(), &t, sizeof t);
+                for (int k = 0; k < attributes; ++k)
+                    for (int j = 0; j < 3; ++j)
+                        record[CLVR_TRIANGLE_FLOAT4S(k) + j] = toCl4(v[j]->attrOverW[k]);
+                sink.triangles.insert(sink.triangles.end(), record.begin(), record.begin() + static_cast<std::ptrdiff_t>(stride));
+
+                // Binned now, while the record is in cache: every tile of its pixel box that it can cover.
+                const auto index = static_cast<cl_uint>(sink.index++);
+                const int tx0 = (px0 - rect.x) >> tileWLog2, tx1 = (px1 - rect.x) >> tileWLog2;
+                const int ty0 = (py0 - rect.y) >> tileHLog2, ty1 = (py1 - rect.y) >> tileHLog2;
+                // One tile holds every center the triangle can cover: the corner test could only drop it.
+                const bool single = tx0 == tx1 && ty0 == ty1;
+                for (int ty = ty0; ty <= ty1; ++ty)
+                    for (int tx = tx0; tx <= tx1; ++tx)
+                        if (single || touches(t, grid, tx, ty)) {
+                            const std::size_t local = static_cast<std::size_t>(ty) * tilesX + tx;
+                            ++sink.tileCounts[local];
+                            sink.pairs.push_back({static_cast<cl_uint>(tileBase + local), index});
+                        }
+            }
+        }
+    }
+};
 
 // Sets up and bins one draw into `out` (docs/raster.md, steps 1-6), extending its last pass when the draw
 // shares that pass's program, buffers, uniforms, rectangle and fragment state.
@@ -358,136 +533,57 @@ void setUpDraw(SetUpDraws& out, const DrawState& state, Topology topology, const
     }
     Pass& pass = out.passes.back();
     const TileGrid& grid = pass.grid;
-    const int tilesX = grid.tilesX();
-    const int tileWLog2 = log2Of(grid.tileW), tileHLog2 = log2Of(grid.tileH);
-    const std::size_t stride = CLVR_TRIANGLE_FLOAT4S(attributes);
 
-    std::vector<ClipVertex>& polygon = out.polygon;
-    std::vector<ClipVertex>& scratch = out.scratch;
-    // The clipped polygon in window coordinates: each of the planes (near, far, the user's, four guard
-    // band planes) adds at most one vertex to a convex polygon.
-    std::array<WindowVertex, 3 + 2 + kMaxClipPlanes + 4> window;
-    std::size_t windowSize = 0;
+    const TriangleSetUp setUpTriangles{topology, vertices, planes, vp, rect, clip, fs, attributes, grid, pass.tileBase};
     const std::uint32_t count = triangleCount(topology, vertices.size());
-    for (std::uint32_t triangle = 0; triangle < count; ++triangle) {
-        const std::array<std::uint32_t, 3> indices = triangleIndices(topology, triangle);
-        bool inside = true;
-        glm::dvec4 position[3];
-        for (int j = 0; j < 3; ++j) {
-            position[j] = glm::dvec4(vertices[indices[j]].position);
-            for (const glm::dvec4& p : planes)
-                inside = inside && glm::dot(p, position[j]) >= 0.0;
+    const int threads = count >= 2 * kSetUpChunk ? threadsToUse(0, static_cast<int>(count / kSetUpChunk)) : 1;
+    if (threads == 1) {  // into `out` directly
+        TriangleSink sink{out.triangles, out.pairs, out.tileCounts.data() + pass.tileBase, pass.triangles, 0,
+                          out.polygon, out.scratch};
+        setUpTriangles.run(0, count, sink);
+        pass.triangles = sink.index;
+        out.setUp += sink.setUp;
+        return;
+    }
+    // In chunks of kSetUpChunk triangles on the host's threads, each into its own arrays; then joined in
+    // submission order, the chunks' triangle indices moved past the triangles before them: the arrays a single
+    // thread makes.
+    const std::size_t chunkCount = (count + kSetUpChunk - 1) / kSetUpChunk;
+    const std::size_t tiles = static_cast<std::size_t>(grid.tilesX()) * grid.tilesY();
+    if (out.chunks.size() < chunkCount)
+        out.chunks.resize(chunkCount);
+    std::atomic<std::size_t> next{0};
+    runOnThreads(threads, threads, [&] {
+        for (std::size_t c; (c = next.fetch_add(1)) < chunkCount;) {
+            SetUpDraws::Chunk& chunk = out.chunks[c];
+            chunk.triangles.clear();
+            chunk.pairs.clear();
+            chunk.tileCounts.assign(tiles, 0);
+            TriangleSink sink{chunk.triangles, chunk.pairs, chunk.tileCounts.data(), 0, 0, chunk.polygon, chunk.scratch};
+            const auto first = static_cast<std::uint32_t>(c * kSetUpChunk);
+            setUpTriangles.run(first, static_cast<std::uint32_t>(std::min<std::size_t>(first + kSetUpChunk, count)), sink);
+            chunk.count = sink.index;
+            chunk.setUp = sink.setUp;
         }
-        windowSize = 0;
-        bool finite = true;
-        const auto project = [&](const glm::dvec4& pos, const std::array<glm::dvec4, kMaxAttributes>& attrs) {
-            finite = finite && toWindow(pos, attrs, attributes, vp, window[windowSize++]);
-        };
-        std::array<glm::dvec4, kMaxAttributes> attrs;
-        if (inside) {  // the common case: no clipping, straight from the vertices
-            for (int j = 0; j < 3 && finite; ++j) {
-                for (int k = 0; k < attributes; ++k)
-                    attrs[k] = glm::dvec4(vertices[indices[j]].attributes[k]);
-                project(position[j], attrs);
-            }
-        } else {
-            polygon.clear();
-            for (int j = 0; j < 3; ++j) {
-                ClipVertex v{position[j], {}};
-                for (int k = 0; k < kMaxAttributes; ++k)
-                    v.attributes[k] = glm::dvec4(vertices[indices[j]].attributes[k]);
-                polygon.push_back(v);
-            }
-            for (const glm::dvec4& p : planes) {
-                clipPolygon(polygon, p, scratch);
-                if (polygon.size() < 3)
-                    break;
-            }
-            if (polygon.size() < 3)
-                continue;
-            for (const ClipVertex& v : polygon) {
-                project(v.position, v.attributes);
-                if (!finite)
-                    break;
-            }
-        }
-        if (!finite)
-            continue;
-
-        // Facing from the polygon's signed area. cross() > 0 is clockwise on the row-down screen,
-        // so counter-clockwise as GL sees it (y up) is cross() < 0.
-        std::int64_t area2 = 0;
-        for (std::size_t i = 1; i + 1 < windowSize; ++i)
-            area2 += cross(window[0], window[i], window[i + 1]);
-        if (area2 == 0)
-            continue;
-        const bool front = fs.frontFaceCCW ? area2 < 0 : area2 > 0;
-        if (fs.cull == CullFace::FrontAndBack || (fs.cull == CullFace::Front && front) ||
-            (fs.cull == CullFace::Back && !front))
-            continue;
-
-        for (std::size_t i = 1; i + 1 < windowSize; ++i) {
-            const WindowVertex* v[3] = {&window[0], &window[i], &window[i + 1]};
-            const std::int64_t a2 = cross(*v[0], *v[1], *v[2]);
-            // A fan triangle whose snapped orientation disagrees with the polygon's is a snapping
-            // sliver of zero true area: drop it with the zero-area ones.
-            if (a2 == 0 || (a2 > 0) != (area2 > 0))
-                continue;
-            if (a2 < 0)
-                std::swap(v[1], v[2]);
-            ++out.setUp;
-
-            // Pixels whose centers (x + 0.5) can be inside, clipped to the scissored viewport rectangle.
-            const std::int64_t minX = std::min({v[0]->x, v[1]->x, v[2]->x}), maxX = std::max({v[0]->x, v[1]->x, v[2]->x});
-            const std::int64_t minY = std::min({v[0]->y, v[1]->y, v[2]->y}), maxY = std::max({v[0]->y, v[1]->y, v[2]->y});
-            const std::int64_t half = CLVR_SUBPIXEL_SCALE / 2;
-            const int px0 = static_cast<int>(std::max<std::int64_t>(clip.x, ceilSubpixel(minX - half)));
-            const int px1 = static_cast<int>(std::min<std::int64_t>(clip.x + clip.width - 1, floorSubpixel(maxX - half)));
-            const int py0 = static_cast<int>(std::max<std::int64_t>(clip.y, ceilSubpixel(minY - half)));
-            const int py1 = static_cast<int>(std::min<std::int64_t>(clip.y + clip.height - 1, floorSubpixel(maxY - half)));
-            if (px0 > px1 || py0 > py1)
-                continue;
-
-            ClTriangle t{};
-            for (int j = 0; j < 3; ++j) {
-                const WindowVertex& a = *v[j];
-                const WindowVertex& b = *v[(j + 1) % 3];
-                t.x[j] = static_cast<cl_int>(a.x);
-                t.y[j] = static_cast<cl_int>(a.y);
-                const std::int64_t dx = b.x - a.x, dy = b.y - a.y;
-                // Top-left rule (row-down, edge functions positive inside): a left edge runs up, a
-                // top edge runs exactly horizontal to the right.
-                t.bias[j] = (dy < 0 || (dy == 0 && dx > 0)) ? 0 : -1;
-            }
-            t.front_facing = front ? 1u : 0u;
-            t.inv_area = f(1.0 / static_cast<double>(std::llabs(a2)));
-            t.col_min = px0;
-            t.col_max = px1;
-            t.row_min = py0;
-            t.row_max = py1;
-            t.depth = cl_float4{{f(v[0]->depth), f(v[1]->depth), f(v[2]->depth), 0.0f}};
-            t.inv_w = cl_float4{{f(v[0]->invW), f(v[1]->invW), f(v[2]->invW), 0.0f}};
-            std::array<cl_float4, CLVR_TRIANGLE_FLOAT4S(kMaxAttributes)> record;
-            std::memcpy(record.data(), &t, sizeof t);
-            for (int k = 0; k < attributes; ++k)
-                for (int j = 0; j < 3; ++j)
-                    record[CLVR_TRIANGLE_FLOAT4S(k) + j] = toCl4(v[j]->attrOverW[k]);
-            out.triangles.insert(out.triangles.end(), record.begin(), record.begin() + static_cast<std::ptrdiff_t>(stride));
-
-            // Binned now, while the record is in cache: every tile of its pixel box that it can cover.
-            const auto index = static_cast<cl_uint>(pass.triangles++);
-            const int tx0 = (px0 - rect.x) >> tileWLog2, tx1 = (px1 - rect.x) >> tileWLog2;
-            const int ty0 = (py0 - rect.y) >> tileHLog2, ty1 = (py1 - rect.y) >> tileHLog2;
-            // One tile holds every center the triangle can cover: the corner test could only drop it.
-            const bool single = tx0 == tx1 && ty0 == ty1;
-            for (int ty = ty0; ty <= ty1; ++ty)
-                for (int tx = tx0; tx <= tx1; ++tx)
-                    if (single || touches(t, grid, tx, ty)) {
-                        const auto tile = static_cast<cl_uint>(pass.tileBase + static_cast<std::size_t>(ty) * tilesX + tx);
-                        ++out.tileCounts[tile];
-                        out.pairs.push_back({tile, index});
-                    }
-        }
+    });
+    std::size_t records = out.triangles.size(), pairs = out.pairs.size();
+    for (std::size_t c = 0; c < chunkCount; ++c) {
+        records += out.chunks[c].triangles.size();
+        pairs += out.chunks[c].pairs.size();
+    }
+    out.triangles.reserve(records);
+    out.pairs.reserve(pairs);
+    cl_uint* tileCounts = out.tileCounts.data() + pass.tileBase;
+    for (std::size_t c = 0; c < chunkCount; ++c) {
+        const SetUpDraws::Chunk& chunk = out.chunks[c];
+        out.triangles.insert(out.triangles.end(), chunk.triangles.begin(), chunk.triangles.end());
+        const auto base = static_cast<cl_uint>(pass.triangles);
+        for (const std::array<cl_uint, 2>& p : chunk.pairs)
+            out.pairs.push_back({p[0], p[1] + base});
+        for (std::size_t t = 0; t < tiles; ++t)
+            tileCounts[t] += chunk.tileCounts[t];
+        pass.triangles += chunk.count;
+        out.setUp += chunk.setUp;
     }
 }
 

@@ -2,6 +2,7 @@
 // reference (raster/reference/rasterizer.h) and against closed-form geometry: coverage and stencil
 // exact, color and depth within stated float tolerances, fill rule, clipping, perspective, order.
 #include "host/runtime/errors.h"
+#include "host/runtime/parallel.h"
 #include "raster/rasterizer.h"
 #include "raster/reference/rasterizer.h"
 #include "raster/texture.h"
@@ -698,6 +699,62 @@ TEST(RasterDeterminism, TwoRunsAreBitIdentical)
         raster::draw(device, *fb, blendedDepthStencil(), raster::Topology::Triangles, v);
     }
     expectIdentical(device, a, b);
+    device.takePassTimes();
+}
+
+// A draw of at least 2 x 16,384 triangles is set up in chunks on the host's threads and joined in submission
+// order (raster/rasterizer.cpp, setUpDraw): the frame buffer's bits and the draw's stats must be those of the same
+// triangles drawn in pieces small enough to be set up on one thread. 100,000 small triangles, overlapping
+// (blending, depth and stencil see their order), a tenth of them large and crossing the near, far and side
+// planes (clipped, with fan triangles that replace one); on 2 threads or more (CI has 2).
+TEST(RasterSetUp, ThreadedSetUpGivesTheBitsOfTheDrawInPieces)
+{
+    if (clvr::threadBudget() < 2)
+        GTEST_SKIP() << "one host thread: the set-up is never split";
+    clvr::Device& device = clvr::test::device();
+    Rng rng(2024);
+    std::vector<raster::Vertex> v;
+    const int triangles = 100000;
+    for (int t = 0; t < triangles; ++t) {
+        const bool large = rng.integer(0, 9) == 0;
+        const double w = rng.uniform(0.5, 1.5);
+        const glm::dvec3 centre(rng.uniform(-1.1, 1.1), rng.uniform(-1.1, 1.1), rng.uniform(-0.9, 0.9));
+        for (int k = 0; k < 3; ++k) {
+            const double r = large ? 1.2 : 0.06;
+            raster::Vertex x;
+            const glm::dvec3 p = centre + glm::dvec3(rng.uniform(-r, r), rng.uniform(-r, r), rng.uniform(-r, r));
+            x.position = glm::vec4(glm::vec3(p * w), static_cast<float>(w));
+            x.attributes[0] = randomVec4(rng);
+            v.push_back(x);
+        }
+    }
+    const raster::DrawState state = blendedDepthStencil();
+    raster::Framebuffer whole(device, 64, 48), pieces(device, 64, 48);
+    for (raster::Framebuffer* fb : {&whole, &pieces}) {
+        fb->clearColor(device, glm::vec4(0.2f));
+        fb->clearDepth(device, 1.0f);
+        fb->clearStencil(device, 0);
+    }
+    raster::Rasterizer rasterizer(device);
+    rasterizer.draw(whole, state, raster::Topology::Triangles, v);
+    const raster::DrawStats wholeStats = rasterizer.takeStats();
+    raster::DrawStats pieceStats;
+    const std::size_t piece = 3 * 10000;  // vertices: 10,000 triangles, set up on one thread
+    for (std::size_t first = 0; first < v.size(); first += piece) {
+        const std::vector<raster::Vertex> part(v.begin() + static_cast<std::ptrdiff_t>(first),
+                                               v.begin() + static_cast<std::ptrdiff_t>(std::min(first + piece, v.size())));
+        rasterizer.draw(pieces, state, raster::Topology::Triangles, part);
+        const raster::DrawStats d = rasterizer.takeStats();
+        pieceStats.triangles += d.triangles;
+        pieceStats.fragments += d.fragments;
+    }
+    std::printf("[ measured ] %llu triangles set up, %llu fragments\n", static_cast<unsigned long long>(wholeStats.triangles),
+                static_cast<unsigned long long>(wholeStats.fragments));
+    EXPECT_GT(wholeStats.triangles, static_cast<std::uint64_t>(triangles) * 8 / 10);
+    EXPECT_GT(wholeStats.fragments, 64u * 48u * 10u);  // every pixel many times over: the order is seen
+    EXPECT_EQ(wholeStats.triangles, pieceStats.triangles);
+    EXPECT_EQ(wholeStats.fragments, pieceStats.fragments);
+    expectIdentical(device, whole, pieces);
     device.takePassTimes();
 }
 
