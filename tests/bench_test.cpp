@@ -305,6 +305,21 @@ TEST(CubefanCeiling, DoesTheFusedKernelsWork)
         }
 }
 
+// The iso3d scene both iso3d ceiling tests render: Marschner–Lobb's surface at 0.55 on 56x48, with these options.
+clvr::Scene iso3dCeilingScene(const clvr::Camera& camera, clvr::IsoSpec::Shading shading, nlohmann::json options)
+{
+    clvr::Scene scene;
+    scene.technique = "iso3d";
+    scene.camera = camera;
+    scene.image = clvr::ImageSpec{56, 48, {0.05, 0.05, 0.1}};
+    scene.transferFunction = clvr::TransferFunction({{0.0, {0.2, 0.4, 0.9}, 1.0}, {1.0, {1.0, 0.8, 0.3}, 1.0}});
+    scene.iso = clvr::IsoSpec{};
+    scene.iso->value = 0.55;
+    scene.iso->shading = shading;
+    scene.options = std::move(options);
+    return scene;
+}
+
 // iso3d's ceiling loop (tools/ceiling_iso3d.h) does the fused path's work: the same samples taken (empty bricks
 // skipped sample by sample where the kernel steps over runs) and the same surface, shaded through the same color
 // matrix — the image up to float rounding but for pixels whose sample lies within rounding of the iso-value.
@@ -312,20 +327,12 @@ TEST(CubefanCeiling, DoesTheFusedKernelsWork)
 TEST(Iso3dCeiling, DoesTheFusedPathsWork)
 {
     const clvr::Volume volume = clvr::generateVolume("marschner-lobb", {41, 41, 41});
-    const clvr::TransferFunction tf({{0.0, {0.2, 0.4, 0.9}, 1.0}, {1.0, {1.0, 0.8, 0.3}, 1.0}});
     std::uint64_t hitPixels = 0;
     for (const clvr::Camera& camera : {clvr::test::obliquePerspectiveCamera(30.0), clvr::test::obliqueParallelCamera(1.3)})
         for (const clvr::IsoSpec::Shading shading : {clvr::IsoSpec::Shading::Gradient, clvr::IsoSpec::Shading::None})
             for (const bool skip : {true, false}) {
-                clvr::Scene scene;
-                scene.technique = "iso3d";
-                scene.camera = camera;
-                scene.image = clvr::ImageSpec{56, 48, {0.05, 0.05, 0.1}};
-                scene.transferFunction = tf;
-                scene.iso = clvr::IsoSpec{};
-                scene.iso->value = 0.55;
-                scene.iso->shading = shading;
-                scene.options = {{"slices", 90}, {"empty_space_skipping", skip}};
+                const clvr::Scene scene =
+                    iso3dCeilingScene(camera, shading, {{"slices", 90}, {"empty_space_skipping", skip}});
                 const std::string what = std::string(shading == clvr::IsoSpec::Shading::None ? "unshaded" : "shaded") +
                                          (skip ? ", skipping" : "") + (camera.parallel ? ", parallel" : "");
                 clvr::FrameStats stats;
@@ -362,20 +369,11 @@ TEST(Iso3dCeiling, DoesTheFusedPathsWork)
 TEST(Iso3dCeiling, DoesTheRasterPathsWorkBrickedOrNot)
 {
     const clvr::Volume volume = clvr::generateVolume("marschner-lobb", {41, 37, 33});
-    const clvr::TransferFunction tf({{0.0, {0.2, 0.4, 0.9}, 1.0}, {1.0, {1.0, 0.8, 0.3}, 1.0}});
     for (const clvr::Camera& camera : {clvr::test::obliquePerspectiveCamera(30.0), clvr::test::obliqueParallelCamera(1.3)})
         for (const clvr::IsoSpec::Shading shading : {clvr::IsoSpec::Shading::Gradient, clvr::IsoSpec::Shading::None}) {
             clvr::Image4f unbricked;
             for (const nlohmann::json& bricks : {nlohmann::json(nullptr), nlohmann::json{2, 3, 2}}) {
-                clvr::Scene scene;
-                scene.technique = "iso3d";
-                scene.camera = camera;
-                scene.image = clvr::ImageSpec{56, 48, {0.05, 0.05, 0.1}};
-                scene.transferFunction = tf;
-                scene.iso = clvr::IsoSpec{};
-                scene.iso->value = 0.55;
-                scene.iso->shading = shading;
-                scene.options = {{"slices", 90}, {"path", "raster"}};
+                clvr::Scene scene = iso3dCeilingScene(camera, shading, {{"slices", 90}, {"path", "raster"}});
                 if (!bricks.is_null())
                     scene.options["bricks"] = bricks;
                 const std::string what = std::string(shading == clvr::IsoSpec::Shading::None ? "unshaded" : "shaded") +
