@@ -8,6 +8,7 @@
 #include "iso3d_params.h"
 #include "pixel_transfer_params.h"
 #include "planes_params.h"
+#include "projtet_params.h"
 #include "ray.h"
 #include "slice3d_params.h"
 #include "spherical_params.h"

@@ -1,19 +1,19 @@
 // kernels/projtet.cl — cell projection in visibility order (Shirley & Tuchman 1990; Williams 1992),
-// the fragment program of its one draw, appended after kernels/raster.cl (host/render/tet/projtet.h).
+// the fragment program of its one draw, appended after kernels/raster.cl (host/render/tet/projtet.h), and
+// (without CLVR_PROJTET_FRAGMENT) the fused path's kernel, projtet_fused, which does that draw's work per pixel.
 // The projected triangles of a tetrahedron only give coverage (its silhouette, once); each fragment then
 // intersects its own ray with the tetrahedron's four planes, so (s_f, s_b, l) are exact for perspective
 // and parallel cameras alike, and integrates the segment with harc's partial pre-integration
 // (kernels/segment_integral.h: ψ table, split at the transfer function's control points). Blending
 // ONE, ONE_MINUS_SRC_ALPHA back to front composites the segments.
 #include "projtet_params.h"
-
-#ifdef CLVR_PROJTET_FRAGMENT
-#include "segment_integral.h"
+#include "segment_integral.h"  /* once, for both parts: the embedded source holds each header once */
 
 /* Per tetrahedron, kernels/harc.cl's 5 float4 (host/render/tet/harc.h packHarcTets): three barycentric
  * planes (h_i, k_i), the fourth 1 minus their sum, the gradient and scalar term; the adjacency is unused. */
 #define PROJTET_TET_FLOAT4S 5
 
+#ifdef CLVR_PROJTET_FRAGMENT
 /* attr[0] = (tet id low 12 bits, tet id high 12 bits, 0, 0), the same at every corner: interpolated
  * constants within a few ulps of integers below 2^12. buffer[0] the tetrahedra, buffer[1] the transfer
  * function (transfer_function.h layout), buffer[2] the ψ table. uniforms: ClProjtetUniforms.
@@ -55,6 +55,74 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
     harc_segment(r->buffer[1], (int)counts.z, r->buffer[2], (int)counts.w, s_f, s_b, l, &c, &transmittance);
     *color = (float4)(c, 1.0f - transmittance);
     return 1;
+}
+
+#endif
+
+#ifndef CLVR_PROJTET_FRAGMENT
+
+/* The fused path's tiles: PROJTET_TILE x PROJTET_TILE pixels (host/render/tet/projtet.h kProjtetTile). */
+#define PROJTET_TILE_LOG2 2
+
+/* The fused path ("path": "fused", host/render/tet/projtet.cpp): the cells, back to front, binned to tiles by
+ * their boxes of pixel centres (tile_start: each tile's first entry, CSR; tile_cells: cell ids, in visibility
+ * order within a tile; boxes[cell] = (x0, y0, x1, y1), inclusive, empty when x0 > x1). One work-item per pixel
+ * walks its tile's cells and, for each whose box holds the pixel, does the fragment program's work above — its
+ * own ray against the cell's four planes, the segment by partial pre-integration — and blends it ONE,
+ * ONE_MINUS_SRC_ALPHA as the raster stage would, in private memory. out = I + (1 - A) background, A;
+ * segments[pixel] = the segments integrated (the rays that meet a cell with l > 0). */
+kernel void projtet_fused(global float4* out, global uint* segments, global const uint* tile_start,
+                          global const uint* tile_cells, global const short4* boxes, global const float* cells,
+                          global const float* tf, global const float* psi, const ClProjtetFusedParams p)
+{
+    CLVR_GUARD_2D(p.size.x, p.size.y);
+    const int x = (int)get_global_id(0), y = (int)get_global_id(1);
+    const int tile = (y >> PROJTET_TILE_LOG2) * p.size.z + (x >> PROJTET_TILE_LOG2);
+    float3 e, d;
+    clvr_ray_unit(clvr_ray_window_offset(clvr_ray_pixel_centre(x, y), (float2)((float)p.size.x, (float)p.size.y),
+                                         p.camera),
+                  p.camera, &e, &d);
+    float3 dst = (float3)(0.0f);
+    float dst_alpha = 0.0f;
+    uint n = 0;
+    const uint end = tile_start[tile + 1];
+    for (uint k = tile_start[tile]; k < end; ++k) {
+        const uint t = tile_cells[k];
+        const short4 b = boxes[t];
+        if (x < b.x || y < b.y || x > b.z || y > b.w)
+            continue;
+        global const float* tet = cells + (size_t)t * (4 * PROJTET_TET_FLOAT4S);
+        const float4 p0 = vload4(0, tet), p1 = vload4(1, tet), p2 = vload4(2, tet), grad = vload4(3, tet);
+        const float4 p3 = (float4)(-(p0.xyz + p1.xyz + p2.xyz), 1.0f - (p0.w + p1.w + p2.w));
+        float lambda_in = 0.0f, lambda_out = INFINITY;
+        const float4 planes[4] = {p0, p1, p2, p3};
+        int miss = 0;
+        for (int i = 0; i < 4; ++i) {
+            const float hd = dot(planes[i].xyz, d);
+            const float bi = dot(planes[i].xyz, e) + planes[i].w;
+            if (hd > 0.0f)
+                lambda_in = fmax(lambda_in, -bi / hd);
+            else if (hd < 0.0f)
+                lambda_out = fmin(lambda_out, bi / -hd);
+            else if (bi < 0.0f)
+                miss = 1;
+        }
+        const float l = lambda_out - lambda_in;
+        if (miss || !(l > 0.0f))
+            continue;
+        const float s_f = dot(grad.xyz, e + lambda_in * d) + grad.w;
+        const float s_b = dot(grad.xyz, e + lambda_out * d) + grad.w;
+        float3 c = (float3)(0.0f);
+        float transmittance = 1.0f;
+        harc_segment(tf, p.counts.x, psi, p.counts.y, s_f, s_b, l, &c, &transmittance);
+        const float src_alpha = 1.0f - transmittance;
+        dst = c + (1.0f - src_alpha) * dst;
+        dst_alpha = src_alpha + (1.0f - src_alpha) * dst_alpha;
+        ++n;
+    }
+    const size_t i = (size_t)y * (size_t)p.size.x + (size_t)x;
+    out[i] = (float4)(dst + (1.0f - dst_alpha) * p.background.xyz, dst_alpha);
+    segments[i] = n;
 }
 
 #endif

@@ -660,7 +660,7 @@ TEST(ProjtetCeiling, DrawsLikeTheRendererAndMatchesTheExactIntegral)
         clvr::checkMesh(mesh);
         const clvr::TetTopology topology = clvr::buildTopology(mesh);
         const clvr::TransferFunction tf = clvr::test::rampTransferFunction();
-        const clvr::Scene scene = clvr::test::meshScene("projtet", c.camera, tf, 40);
+        const clvr::Scene scene = clvr::test::meshScene("projtet", c.camera, tf, 40, {{"path", "raster"}});
         clvr::FrameStats stats, harcStats;
         const clvr::Image4f kernel = clvr::makeMeshRenderer(clvr::test::device(), scene, mesh)->render(stats);
         clvr::makeHarcRenderer(clvr::test::device(), clvr::test::meshScene("harc", c.camera, tf, 40), mesh, topology)

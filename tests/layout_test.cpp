@@ -12,6 +12,7 @@
 #include "kernels/iso3d_params.h"
 #include "kernels/pixel_transfer_params.h"
 #include "kernels/planes_params.h"
+#include "kernels/projtet_params.h"
 #include "kernels/ray.h"
 #include "kernels/slice3d_params.h"
 #include "kernels/spherical_params.h"
@@ -131,6 +132,7 @@ TEST(Layout, EveryParamsStructFitsTheKernelArgumentSpace)
         {"tetslice_composite", sizeof(ClTetsliceCompositeParams) + 4 * sizeof(void*)},
         {"tetiso_weights", sizeof(ClTetisoParams) + 3 * sizeof(void*)},
         {"cubefan_fused", sizeof(ClCubefanFusedParams) + 7 * sizeof(void*)},
+        {"projtet_fused", sizeof(ClProjtetFusedParams) + 8 * sizeof(void*)},
     };
     for (const auto& [kernel, bytes] : argumentBytes) {
         EXPECT_LE(bytes, limit) << kernel;
@@ -150,6 +152,7 @@ TEST(Layout, EveryParamsStructFitsTheKernelArgumentSpace)
     EXPECT_EQ(sizeof(ClIso3dFinishParams), 48u);
     EXPECT_EQ(sizeof(ClIso3dFusedParams), 240u);
     EXPECT_EQ(sizeof(ClCubefanFusedParams), 192u);
+    EXPECT_EQ(sizeof(ClProjtetFusedParams), 128u);
     EXPECT_EQ(sizeof(ClStack2dIsoFinishParams), 32u);
     EXPECT_EQ(sizeof(ClStack2dFusedParams), 384u);
     EXPECT_EQ(sizeof(ClPixelTransfer), 128u);

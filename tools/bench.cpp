@@ -337,7 +337,7 @@ nlohmann::json benchMeshScene(Device& device, const fs::path& scenePath, const S
     if (ceiling)
         ceilingResult = ceiling->render(threads);  // warms its caches
     // projtet's ceiling loop (tools/ceiling_projtet.h): the projection and the draw, set beside the renderer's
-    // passes that do that work (kProjtetDrawPasses), not its visibility sort.
+    // passes that do that work (kProjtetDrawPasses: the raster path's or the fused path's), not its visibility sort.
     std::unique_ptr<ProjtetCeiling> projtetCeiling;
     ProjtetCeilingResult projtetResult;
     if (scene.technique == projtetTechnique().name) {
@@ -346,7 +346,8 @@ nlohmann::json benchMeshScene(Device& device, const fs::path& scenePath, const S
         projtetResult = projtetCeiling->render(threads);
     }
     static const char* const kProjtetDrawPasses[] = {"projtet: projection and classification (host)",
-                                                     "projtet: raster set-up and binning (host)", "raster: fragments"};
+                                                     "projtet: raster set-up and binning (host)", "raster: fragments",
+                                                     "projtet: cell boxes and tile lists (host)", "projtet: fused"};
     std::vector<double> drawMs;
 
     std::vector<double> ms, statsMs, walkMs, ceilingMs;
@@ -482,7 +483,7 @@ nlohmann::json benchMeshScene(Device& device, const fs::path& scenePath, const S
         std::cout << "  ceiling      projection and draw " << fixed(c.median, 1) << " ms (" << threads
                   << " threads, interleaved with clvr's; " << si(static_cast<double>(projtetResult.segments))
                   << " segments of " << si(static_cast<double>(projtetResult.pixelsTested))
-                  << " pixels tested); clvr's projection, set-up and fragments " << fixed(w.median, 1) << " ms: "
+                  << " pixels tested); clvr's projection and draw " << fixed(w.median, 1) << " ms: "
                   << fixed(100.0 * c.median / w.median, 1) << "% of its speed; image |diff| max " << fixed(d.max, 4)
                   << ", mean " << fixed(d.mean, 5) << '\n'
                   << std::flush;

@@ -23,11 +23,6 @@ glm::vec3 projtetVec3(const cl_float4& v)
     return {v.s[0], v.s[1], v.s[2]};
 }
 
-// A cell's pixels: x0..x1, y0..y1 inclusive (empty when x0 > x1 or y0 > y1).
-struct PixelBox {
-    int x0, x1, y0, y1;
-};
-
 }  // namespace
 
 ProjtetCeiling::ProjtetCeiling(const TetMesh& mesh, const TetTopology& topology, const TransferFunction& tf,
@@ -47,17 +42,9 @@ ProjtetCeilingResult ProjtetCeiling::render(int threads) const
 {
     if (threads <= 0)
         threads = threadBudget();
-    // The renderer's projection (ProjtetRenderer::render): each point in float NDC, a cell with a point at or
-    // behind the near plane covering the whole image; then each cell's box of pixel centres, by cell in order.
-    const glm::dvec3 forward = camera_.forward();
-    double depthMax = 0.0;
-    for (const glm::dvec3& p : points_)
-        depthMax = std::max(depthMax, glm::dot(p - camera_.position, forward));
-    const double nearZ = 1e-4 * depthMax + 1e-9, farZ = 2.0 * depthMax + 1.0;
-    const glm::dmat4 viewProjection = camera_.projectionMatrix(width_, height_, nearZ, farZ) * camera_.viewMatrix();
-    std::vector<glm::vec2> window(points_.size());  // pixel coordinates, row 0 at the top
-    std::vector<std::uint8_t> inFront(points_.size());
-    std::vector<PixelBox> boxes(order_.size());
+    // The cells' boxes of pixel centres, as the renderer's fused path takes them (projtetCellBoxes: the raster
+    // path's projection, a cell at the near plane covering the whole image).
+    const std::vector<ProjtetBox> boxes = projtetCellBoxes(points_, tets_, camera_, width_, height_);
     auto parallel = [&](const auto& work) {
         std::vector<std::thread> pool;
         for (int t = 0; t < threads; ++t)
@@ -65,37 +52,6 @@ ProjtetCeilingResult ProjtetCeiling::render(int threads) const
         for (std::thread& th : pool)
             th.join();
     };
-    parallel([&](int t) {
-        const std::size_t n = points_.size(), begin = n * t / threads, end = n * (t + 1) / threads;
-        for (std::size_t p = begin; p < end; ++p) {
-            const glm::dvec4 c = viewProjection * glm::dvec4(points_[p], 1.0);
-            inFront[p] = camera_.parallel || c.w > nearZ;
-            const glm::vec2 ndc(static_cast<float>(c.x / c.w), static_cast<float>(c.y / c.w));
-            window[p] = glm::vec2((ndc.x + 1.0f) * 0.5f * static_cast<float>(width_),
-                                  (1.0f - ndc.y) * 0.5f * static_cast<float>(height_));
-        }
-    });
-    parallel([&](int t) {
-        constexpr float kMargin = 1.0f / 16.0f;  // the renderer grows each silhouette by this much
-        const std::size_t n = order_.size(), begin = n * t / threads, end = n * (t + 1) / threads;
-        for (std::size_t i = begin; i < end; ++i) {
-            const glm::uvec4 tet = tets_[order_[i]];
-            if (!(inFront[tet[0]] && inFront[tet[1]] && inFront[tet[2]] && inFront[tet[3]])) {
-                boxes[i] = {0, width_ - 1, 0, height_ - 1};
-                continue;
-            }
-            glm::vec2 lo = window[tet[0]], hi = lo;
-            for (int v = 1; v < 4; ++v) {
-                lo = glm::min(lo, window[tet[v]]);
-                hi = glm::max(hi, window[tet[v]]);
-            }
-            // the pixel centres x + 0.5 in [lo - margin, hi + margin]
-            boxes[i] = {std::max(static_cast<int>(std::ceil(lo.x - kMargin - 0.5f)), 0),
-                        std::min(static_cast<int>(std::floor(hi.x + kMargin - 0.5f)), width_ - 1),
-                        std::max(static_cast<int>(std::ceil(lo.y - kMargin - 0.5f)), 0),
-                        std::min(static_cast<int>(std::floor(hi.y + kMargin - 0.5f)), height_ - 1)};
-        }
-    });
 
     // The draw: every thread walks every cell in order over the rows it owns.
     std::vector<glm::vec4> fb(static_cast<std::size_t>(width_) * height_, glm::vec4(0.0f));
@@ -108,8 +64,8 @@ ProjtetCeilingResult ProjtetCeiling::render(int threads) const
     parallel([&](int thread) {
         std::uint64_t pixelsTested = 0, segmentCount = 0;
         for (std::size_t i = 0; i < order_.size(); ++i) {
-            const PixelBox& box = boxes[i];
-            if (box.x0 > box.x1)
+            const ProjtetBox& box = boxes[order_[i]];
+            if (box.x0 > box.x1 || box.y0 > box.y1)
                 continue;
             const glm::vec4* cell = cells_.data() + static_cast<std::size_t>(order_[i]) * 5;
             const glm::vec4 planes[4] = {cell[0], cell[1], cell[2],

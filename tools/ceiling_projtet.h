@@ -2,8 +2,9 @@
 // the cells' points projected, and per cell in visibility order every pixel its silhouette covers, each running
 // kernels/projtet.cl's fragment — the pixel's own ray against the cell's four planes, the segment (s_f, s_b, l)
 // integrated by kernels/segment_integral.h's pieces — blended ONE, ONE_MINUS_SRC_ALPHA, then the background) as
-// a plain C++ loop on std::threads. Coverage is each cell's pixel box, the exact ray–cell test deciding (what the
-// fragment program decides inside the grown silhouette the raster stage draws). The threads own interleaved blocks
+// a plain C++ loop on std::threads. Coverage is each cell's pixel box (projtetCellBoxes, the fused path's), the
+// exact ray–cell test deciding (what the fragment program decides inside the grown silhouette the raster stage
+// draws). The threads own interleaved blocks
 // of rows and each walks every cell in the same order, so each pixel's segments blend in that order. The cells are
 // sorted once, by the renderer's VisibilitySorter (a host pass clvr times on its own). Not part of the library;
 // tests/bench_test.cpp checks its image and its segments against clvr's projtet.

@@ -611,6 +611,22 @@ private:
     OverBackground overBackground_;
     std::vector<raster::Vertex> vertices_;  // the frame's triangles, 3 vertices each
     std::uint64_t residentBytes_ = 0;
+    // The fused path: its kernel, its per-pixel outputs, and the frame's boxes and tile lists (grown as needed).
+    struct Staging {
+        cl::Buffer buffer;
+        std::size_t bytes = 0;
+    };
+    cl::Kernel fused_;
+    cl::Buffer fusedOut_, fusedSegments_;
+    Staging boxes_, tileStart_, tileCells_;
+
+    // The fused path's frame after the sort (ProjtetOptions::Path::Fused).
+    Image4f renderFused(const VisibilitySorter::Result& sorted, std::vector<PassTime> hostPasses, const FrameClock& clock,
+                        FrameStats& stats);
+    // Writes `bytes` of `data` into `staging`, which grows to hold them.
+    void stage(Staging& staging, std::string_view what, const void* data, std::size_t bytes);
+    // The stats both paths report: the order and the sort, the counts, the integration.
+    void reportOrder(const VisibilitySorter::Result& sorted, double boundaryMs, double sortMs, FrameStats& stats) const;
 };
 
 ProjtetRenderer::ProjtetRenderer(Device& device, const Scene& scene, const TetMesh& mesh, const TetTopology& topology)
@@ -637,6 +653,118 @@ ProjtetRenderer::ProjtetRenderer(Device& device, const Scene& scene, const TetMe
     program_.attributes = 1;  // the cell id
     program_.buffers[0] = cells_;
     program_.buffers[2] = psi_;
+    if (options_.path == ProjtetOptions::Path::Fused) {
+        if (image_.width > 16384 || image_.height > 16384)
+            throw InputError("projtet: \"path\": \"fused\" takes images of at most 16384 pixels a side, got " +
+                             std::to_string(image_.width) + "x" + std::to_string(image_.height));
+        fused_ = device_.kernel("projtet.cl", "projtet_fused");
+        const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
+        fusedOut_ = device_.buffer("projtet fused image", pixels * sizeof(cl_float4));
+        fusedSegments_ = device_.buffer("projtet fused segments per pixel", pixels * sizeof(cl_uint));
+        residentBytes_ += pixels * (sizeof(cl_float4) + sizeof(cl_uint));
+    }
+}
+
+void ProjtetRenderer::stage(Staging& staging, std::string_view what, const void* data, std::size_t bytes)
+{
+    const std::size_t need = std::max<std::size_t>(bytes, 16);
+    if (!staging.buffer() || staging.bytes < need) {
+        residentBytes_ -= staging.bytes;
+        staging.bytes = std::max(need, 2 * staging.bytes);
+        staging.buffer = device_.buffer(what, staging.bytes, CL_MEM_READ_ONLY);
+        residentBytes_ += staging.bytes;
+    }
+    if (bytes > 0)
+        device_.queue().enqueueWriteBuffer(staging.buffer, CL_TRUE, 0, bytes, data);
+}
+
+// The fused path: the cells' boxes of pixel centres (projtetCellBoxes), the cells binned to tiles of kProjtetTile²
+// pixels in visibility order — a stable counting sort by chunks of the order on the host's threads (each chunk
+// counts its cells' tiles, the counts become each chunk's offsets within each tile, each chunk writes its cells)
+// —, then kernels/projtet.cl's projtet_fused over the image.
+Image4f ProjtetRenderer::renderFused(const VisibilitySorter::Result& sorted, std::vector<PassTime> hostPasses,
+                                     const FrameClock& clock, FrameStats& stats)
+{
+    auto t0 = std::chrono::steady_clock::now();
+    const int width = image_.width, height = image_.height;
+    const std::vector<ProjtetBox> boxes = projtetCellBoxes(points_, tets_, camera_, width, height);
+    const int tilesX = (width + kProjtetTile - 1) / kProjtetTile, tilesY = (height + kProjtetTile - 1) / kProjtetTile;
+    const std::size_t tiles = static_cast<std::size_t>(tilesX) * tilesY;
+    const std::vector<std::uint32_t>& order = sorted.order;
+    constexpr std::size_t kChunk = 16384;
+    const std::size_t chunks = (order.size() + kChunk - 1) / kChunk;
+    std::vector<cl_uint> offset(chunks * tiles, 0);  // chunk c's count, then its first entry, in tile t at c * tiles + t
+    auto forTiles = [&](const ProjtetBox& b, const auto& visit) {
+        if (b.x0 > b.x1 || b.y0 > b.y1)
+            return;
+        for (int ty = b.y0 / kProjtetTile; ty <= b.y1 / kProjtetTile; ++ty)
+            for (int tx = b.x0 / kProjtetTile; tx <= b.x1 / kProjtetTile; ++tx)
+                visit(static_cast<std::size_t>(ty) * tilesX + tx);
+    };
+    auto overChunks = [&](const auto& work) {
+        std::atomic<std::size_t> next{0};
+        runOnThreads(0, static_cast<int>(chunks), [&] {
+            for (std::size_t c; (c = next.fetch_add(1)) < chunks;)
+                work(c, c * kChunk, std::min((c + 1) * kChunk, order.size()));
+        });
+    };
+    overChunks([&](std::size_t c, std::size_t begin, std::size_t end) {
+        cl_uint* count = offset.data() + c * tiles;
+        for (std::size_t i = begin; i < end; ++i)
+            forTiles(boxes[order[i]], [&](std::size_t tile) { ++count[tile]; });
+    });
+    std::vector<cl_uint> tileStart(tiles + 1);
+    std::uint64_t entries = 0;
+    for (std::size_t t = 0; t < tiles; ++t) {
+        tileStart[t] = static_cast<cl_uint>(entries);
+        for (std::size_t c = 0; c < chunks; ++c) {
+            const cl_uint n = offset[c * tiles + t];
+            offset[c * tiles + t] = static_cast<cl_uint>(entries);
+            entries += n;
+        }
+    }
+    if (entries > 0xffffffffu)
+        throw InputError("projtet: \"path\": \"fused\": the cells' tile lists have more than 2^32 entries; "
+                         "use \"path\": \"raster\" or a smaller image");
+    tileStart[tiles] = static_cast<cl_uint>(entries);
+    std::vector<cl_uint> tileCells(entries);
+    overChunks([&](std::size_t c, std::size_t begin, std::size_t end) {
+        cl_uint* next = offset.data() + c * tiles;
+        for (std::size_t i = begin; i < end; ++i)
+            forTiles(boxes[order[i]], [&](std::size_t tile) { tileCells[next[tile]++] = order[i]; });
+    });
+    static_assert(sizeof(ProjtetBox) == sizeof(cl_short4));
+    stage(boxes_, "projtet fused cell boxes", boxes.data(), boxes.size() * sizeof(ProjtetBox));
+    stage(tileStart_, "projtet fused tile starts", tileStart.data(), tileStart.size() * sizeof(cl_uint));
+    stage(tileCells_, "projtet fused tile cells", tileCells.data(), tileCells.size() * sizeof(cl_uint));
+    hostPasses.push_back({"projtet: cell boxes and tile lists (host)", msSince(t0)});
+
+    ClProjtetFusedParams p{};
+    p.camera = toClCamera(camera_, width, height, shift_);
+    p.background = toCl4(image_.background, 0.0);
+    p.size = cl_int4{{width, height, tilesX, 0}};
+    p.counts = cl_int4{{static_cast<cl_int>(tf_.count()), static_cast<cl_int>(psiTable().size), 0, 0}};
+    int a = 0;
+    fused_.setArg(a++, fusedOut_);
+    fused_.setArg(a++, fusedSegments_);
+    fused_.setArg(a++, tileStart_.buffer);
+    fused_.setArg(a++, tileCells_.buffer);
+    fused_.setArg(a++, boxes_.buffer);
+    fused_.setArg(a++, cells_);
+    fused_.setArg(a++, tf_.buffer());
+    fused_.setArg(a++, psi_);
+    fused_.setArg(a++, p);
+    device_.launch("projtet: fused", fused_, static_cast<std::size_t>(width), static_cast<std::size_t>(height),
+                   kProjtetTile, kProjtetTile);
+    Image4f image = readImage(device_, fusedOut_, width, height);
+    const std::uint64_t segments = sumCounts(device_, fusedSegments_, static_cast<std::size_t>(width) * height);
+
+    finishFrame(device_, clock, stats, std::move(hostPasses));
+    stats.extra["path"] = "fused";
+    stats.extra["steps"] = segments;  // the segments integrated: rays that meet a cell
+    stats.extra["tile_entries"] = entries;
+    stats.extra["tile_size"] = kProjtetTile;
+    return image;
 }
 
 Image4f ProjtetRenderer::render(FrameStats& stats)
@@ -646,6 +774,15 @@ Image4f ProjtetRenderer::render(FrameStats& stats)
     const VisibilitySorter::Result sorted = sorter_.sort(camera_, options_.order, image_.width, image_.height);
     const double boundaryMs = sorted.boundary.ms;
     const double sortMs = msSince(t0) - boundaryMs;
+    std::vector<PassTime> hostPasses;
+    if (options_.order == ProjtetOptions::Order::MpvoncBoundary)
+        hostPasses.push_back({"projtet: boundary overlaps (host)", boundaryMs});
+    hostPasses.push_back({"projtet: visibility sort (host)", sortMs});
+    if (options_.path == ProjtetOptions::Path::Fused) {
+        Image4f image = renderFused(sorted, std::move(hostPasses), clock, stats);
+        reportOrder(sorted, boundaryMs, sortMs, stats);
+        return image;
+    }
 
     // Projection: every point to normalized device coordinates (double, then float as the raster stage
     // gets them, so neighbouring cells share their silhouette edges bit for bit). A cell with a point at
@@ -803,13 +940,24 @@ Image4f ProjtetRenderer::render(FrameStats& stats)
     Image4f image = readImage(device_, fb_.color(), image_.width, image_.height);
     const raster::DrawStats drawn = rasterizer_.takeStats();
 
-    std::vector<PassTime> hostPasses;
-    if (options_.order == ProjtetOptions::Order::MpvoncBoundary)
-        hostPasses.push_back({"projtet: boundary overlaps (host)", boundaryMs});
-    hostPasses.insert(hostPasses.end(), {{"projtet: visibility sort (host)", sortMs},
-                                        {"projtet: projection and classification (host)", projectMs},
+    hostPasses.insert(hostPasses.end(), {{"projtet: projection and classification (host)", projectMs},
                                         {"projtet: raster set-up and binning (host)", setUpMs}});
     finishFrame(device_, clock, stats, std::move(hostPasses));
+    reportOrder(sorted, boundaryMs, sortMs, stats);
+    stats.extra["path"] = "raster";
+    stats.extra["projection_ms"] = projectMs;
+    stats.extra["cells_class1"] = class1.load();
+    stats.extra["cells_class2"] = class2.load();
+    stats.extra["cells_degenerate_projection"] = degenerate.load();
+    stats.extra["cells_near_plane"] = nearCells.load();
+    stats.extra["raster_triangles"] = drawn.triangles;
+    stats.extra["raster_fragments"] = drawn.fragments;
+    return image;
+}
+
+void ProjtetRenderer::reportOrder(const VisibilitySorter::Result& sorted, double boundaryMs, double sortMs,
+                                  FrameStats& stats) const
+{
     counts_.report(stats);
     stats.extra["resident_bytes"] = residentBytes_;
     stats.extra["bytes_per_tet"] = static_cast<double>(residentBytes_) / static_cast<double>(tets_.size());
@@ -826,19 +974,72 @@ Image4f ProjtetRenderer::render(FrameStats& stats)
         stats.extra["boundary_pairs_tested"] = sorted.boundary.pairsTested;
         stats.extra["boundary_relations"] = sorted.boundary.relations;
     }
-    stats.extra["projection_ms"] = projectMs;
-    stats.extra["cells_class1"] = class1.load();
-    stats.extra["cells_class2"] = class2.load();
-    stats.extra["cells_degenerate_projection"] = degenerate.load();
-    stats.extra["cells_near_plane"] = nearCells.load();
-    stats.extra["raster_triangles"] = drawn.triangles;
-    stats.extra["raster_fragments"] = drawn.fragments;
     stats.extra["integration"] = "partial";  // harc's partial pre-integration, per fragment
     stats.extra["psi_table"] = std::to_string(psiTable().size) + "x" + std::to_string(psiTable().size);
-    return image;
 }
 
 }  // namespace
+
+std::vector<ProjtetBox> projtetCellBoxes(const std::vector<glm::dvec3>& points, const std::vector<glm::uvec4>& tets,
+                                         const Camera& camera, int width, int height)
+{
+    // ProjtetRenderer::render's projection: the same near plane, each point through float NDC to pixels.
+    const glm::dvec3 forward = camera.forward();
+    double depthMax = 0.0;
+    for (const glm::dvec3& p : points)
+        depthMax = std::max(depthMax, glm::dot(p - camera.position, forward));
+    const double nearZ = 1e-4 * depthMax + 1e-9, farZ = 2.0 * depthMax + 1.0;
+    const glm::dmat4 viewProjection = camera.projectionMatrix(width, height, nearZ, farZ) * camera.viewMatrix();
+    std::vector<glm::vec2> window(points.size());  // pixel coordinates, row 0 at the top
+    std::vector<std::uint8_t> inFront(points.size());
+    std::vector<ProjtetBox> boxes(tets.size());
+    constexpr std::size_t kChunk = 8192;
+    const int threads = threadsToUse(0, static_cast<int>(std::max(points.size(), tets.size()) / kChunk + 1));
+    auto inChunks = [&](std::size_t n, const auto& work) {
+        std::atomic<std::size_t> next{0};
+        runOnThreads(threads, threads, [&] {
+            for (std::size_t begin; (begin = next.fetch_add(kChunk)) < n;)
+                work(begin, std::min(begin + kChunk, n));
+        });
+    };
+    inChunks(points.size(), [&](std::size_t begin, std::size_t end) {
+        for (std::size_t p = begin; p < end; ++p) {
+            const glm::dvec4 c = viewProjection * glm::dvec4(points[p], 1.0);
+            inFront[p] = camera.parallel || c.w > nearZ;
+            const glm::vec2 ndc(static_cast<float>(c.x / c.w), static_cast<float>(c.y / c.w));
+            window[p] = glm::vec2((ndc.x + 1.0f) * 0.5f * static_cast<float>(width),
+                                  (1.0f - ndc.y) * 0.5f * static_cast<float>(height));
+        }
+    });
+    const auto margin = static_cast<float>(kGrowPixels);
+    const ProjtetBox whole{0, 0, static_cast<std::int16_t>(width - 1), static_cast<std::int16_t>(height - 1)};
+    inChunks(tets.size(), [&](std::size_t begin, std::size_t end) {
+        for (std::size_t t = begin; t < end; ++t) {
+            const glm::uvec4 tet = tets[t];
+            if (!(inFront[tet[0]] && inFront[tet[1]] && inFront[tet[2]] && inFront[tet[3]])) {
+                boxes[t] = whole;
+                continue;
+            }
+            glm::vec2 lo = window[tet[0]], hi = lo;
+            for (int v = 1; v < 4; ++v) {
+                lo = glm::min(lo, window[tet[v]]);
+                hi = glm::max(hi, window[tet[v]]);
+            }
+            // the pixel centres x + 0.5 in [lo - margin, hi + margin], clamped to the image (and to int16)
+            const auto clampTo = [](float v, int last) {
+                return static_cast<std::int16_t>(std::clamp(v, -1.0f, static_cast<float>(last) + 1.0f));
+            };
+            ProjtetBox b{clampTo(std::ceil(lo.x - margin - 0.5f), width - 1), clampTo(std::ceil(lo.y - margin - 0.5f), height - 1),
+                         clampTo(std::floor(hi.x + margin - 0.5f), width - 1), clampTo(std::floor(hi.y + margin - 0.5f), height - 1)};
+            b.x0 = std::max<std::int16_t>(b.x0, 0);
+            b.y0 = std::max<std::int16_t>(b.y0, 0);
+            b.x1 = std::min<std::int16_t>(b.x1, static_cast<std::int16_t>(width - 1));
+            b.y1 = std::min<std::int16_t>(b.y1, static_cast<std::int16_t>(height - 1));
+            boxes[t] = b;
+        }
+    });
+    return boxes;
+}
 
 const char* orderName(ProjtetOptions::Order order)
 {
@@ -860,6 +1061,9 @@ TechniqueInfo projtetTechnique()
         {"order", "mpvonc-boundary", "",
          "visibility order: \"mpvonc-boundary\" (adjacency and overlapping boundary faces, exact without cycles), "
          "\"mpvonc\" (adjacency only, Williams 1992: exact on convex meshes) or \"centroid\" (centre distance)"},
+        {"path", "fused", "",
+         "\"fused\" (cells binned to 4x4-pixel tiles, one kernel walks each pixel's cells in order) or \"raster\" "
+         "(each cell's silhouette as 3-4 triangles through the raster stage, the paper's method; the same frame)"},
     };
     t.makeForMesh = [](Device& device, const Scene& scene, const TetMesh& mesh) -> std::unique_ptr<Renderer> {
         return makeProjtetRenderer(device, scene, mesh, buildTopology(mesh));
@@ -882,6 +1086,14 @@ ProjtetOptions parseProjtetOptions(const nlohmann::json& options)
                 o.order = ProjtetOptions::Order::Centroid;
             else
                 badOption(key, "must be \"mpvonc-boundary\", \"mpvonc\" or \"centroid\", got " + value.dump());
+        } else if (key == "path") {
+            const std::string s = value.is_string() ? value.get<std::string>() : "";
+            if (s == "raster")
+                o.path = ProjtetOptions::Path::Raster;
+            else if (s == "fused")
+                o.path = ProjtetOptions::Path::Fused;
+            else
+                badOption(key, "must be \"raster\" or \"fused\", got " + value.dump());
         } else {
             unparsedOption(info, key);
         }

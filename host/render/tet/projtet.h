@@ -29,7 +29,31 @@ struct ProjtetOptions {
     // sorted by distance from the eye (depth along the view for parallel cameras).
     enum class Order { MpvoncBoundary, Mpvonc, Centroid };
     Order order = Order::MpvoncBoundary;
+    // "fused" (the default): the cells binned to tiles of kProjtetTile² pixels by their pixel boxes
+    // (projtetCellBoxes), one work-item per pixel walking its tile's cells in visibility order with the fragment
+    // program's work and the blend in one kernel (kernels/projtet.cl projtet_fused). "raster": each cell's
+    // silhouette as 3 or 4 triangles drawn through the raster stage (the paper's method), the fragment program
+    // integrating the pixel's segment: the same frame, the same segments in the same order.
+    enum class Path { Raster, Fused };
+    Path path = Path::Fused;
 };
+
+// The fused path's tiles: kProjtetTile x kProjtetTile pixels (kernels/projtet.cl PROJTET_TILE_LOG2).
+inline constexpr int kProjtetTile = 4;
+
+// A cell's box of pixel centres (x0, y0)-(x1, y1), inclusive; empty when x0 > x1 or y0 > y1. The fused path
+// uploads them as short4.
+struct ProjtetBox {
+    std::int16_t x0, y0, x1, y1;
+};
+
+// Every cell's box for `camera` on a width x height image (at most 16,384 on a side), as the fused path and
+// tools/ceiling_projtet.h take them: the points projected as the raster path projects them (through float NDC),
+// the box of a cell's four corners grown by the raster path's 1/16 pixel and clipped to the image; the whole image
+// for a cell with a point at or behind the near plane (the raster path draws its back faces). On the host's
+// threads.
+std::vector<ProjtetBox> projtetCellBoxes(const std::vector<glm::dvec3>& points, const std::vector<glm::uvec4>& tets,
+                                         const Camera& camera, int width, int height);
 
 // The option's value for `order` ("mpvonc-boundary", "mpvonc", "centroid").
 const char* orderName(ProjtetOptions::Order order);
@@ -37,7 +61,8 @@ const char* orderName(ProjtetOptions::Order order);
 // Its registry entry (host/render/renderer.h).
 TechniqueInfo projtetTechnique();
 
-// Reads the scene's "options" for projtet: "order" ("mpvonc-boundary" | "mpvonc" | "centroid").
+// Reads the scene's "options" for projtet: "order" ("mpvonc-boundary" | "mpvonc" | "centroid"), "path"
+// ("raster" | "fused").
 // InputError naming the key for unknown keys, wrong types and values.
 ProjtetOptions parseProjtetOptions(const nlohmann::json& options);
 
