@@ -437,7 +437,8 @@ Camera combCamera(bool parallel)
 // cells entered but those a ray only grazes (measured: up to 0.23 % fewer), fewer than the raster path's fragments
 // (its grown silhouettes) —, within the exact integral's tolerance. A convex grid (perspective, parallel), boxes with a gap along the view, a non-convex L,
 // the camera inside the mesh (cells at the near plane cover the whole image), and the interleaved combs (the
-// boundary relations), each on an image whose size is no multiple of the 4-pixel tiles.
+// boundary relations), each on an image whose size is no multiple of the 8x4-pixel tiles; with ray packets (8 pixels
+// of a row per work-item, float8 lanes) and without, bit for bit.
 TEST(ProjtetFused, DrawsTheRasterPathsFrame)
 {
     const glm::dvec3 gradient(0.3, 0.5, 0.2);
@@ -469,6 +470,14 @@ TEST(ProjtetFused, DrawsTheRasterPathsFrame)
         FrameStats rasterStats, fusedStats, harcStats;
         const Image4f want = renderProjtet(raster, mesh, &rasterStats);
         const Image4f got = renderProjtet(fused, mesh, &fusedStats);
+        // packets (8 pixels a work-item, on this CPU the default) and one pixel a work-item: the same bits
+        FrameStats onePixelStats;
+        const Image4f onePixel =
+            renderProjtet(test::meshScene("projtet", c.camera, c.tf, 61, json{{"packets", false}}), mesh, &onePixelStats);
+        EXPECT_TRUE(fusedStats.extra["packets"].get<bool>()) << c.what;
+        EXPECT_FALSE(onePixelStats.extra["packets"].get<bool>()) << c.what;
+        EXPECT_TRUE(test::sameBits(got, onePixel)) << c.what;
+        EXPECT_EQ(fusedStats.extra["steps"], onePixelStats.extra["steps"]) << c.what;
         makeHarcRenderer(test::device(), test::meshScene("harc", c.camera, c.tf, 61), mesh, buildTopology(mesh))
             ->render(harcStats);
         const std::uint64_t segments = fusedStats.extra["steps"].get<std::uint64_t>();

@@ -617,6 +617,7 @@ private:
         std::size_t bytes = 0;
     };
     cl::Kernel fused_;
+    bool packet_ = false;  // fused_ is projtet_fused_packet
     cl::Buffer fusedOut_, fusedSegments_;
     Staging boxes_, tileStart_, tileCells_;
 
@@ -657,7 +658,8 @@ ProjtetRenderer::ProjtetRenderer(Device& device, const Scene& scene, const TetMe
         if (image_.width > 16384 || image_.height > 16384)
             throw InputError("projtet: \"path\": \"fused\" takes images of at most 16384 pixels a side, got " +
                              std::to_string(image_.width) + "x" + std::to_string(image_.height));
-        fused_ = device_.kernel("projtet.cl", "projtet_fused");
+        packet_ = packetsOnDevice(options_.packets, device_.listing().type);
+        fused_ = device_.kernel("projtet.cl", packet_ ? "projtet_fused_packet" : "projtet_fused");
         const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
         fusedOut_ = device_.buffer("projtet fused image", pixels * sizeof(cl_float4));
         fusedSegments_ = device_.buffer("projtet fused segments per pixel", pixels * sizeof(cl_uint));
@@ -678,8 +680,8 @@ void ProjtetRenderer::stage(Staging& staging, std::string_view what, const void*
         device_.queue().enqueueWriteBuffer(staging.buffer, CL_TRUE, 0, bytes, data);
 }
 
-// The fused path: the cells' boxes of pixel centres (projtetCellBoxes), the cells binned to tiles of kProjtetTile²
-// pixels in visibility order — a stable counting sort by chunks of the order on the host's threads (each chunk
+// The fused path: the cells' boxes of pixel centres (projtetCellBoxes), the cells binned to tiles of kProjtetTileW x
+// kProjtetTileH pixels in visibility order — a stable counting sort by chunks of the order on the host's threads (each chunk
 // counts its cells' tiles, the counts become each chunk's offsets within each tile, each chunk writes its cells)
 // —, then kernels/projtet.cl's projtet_fused over the image.
 Image4f ProjtetRenderer::renderFused(const VisibilitySorter::Result& sorted, std::vector<PassTime> hostPasses,
@@ -688,7 +690,7 @@ Image4f ProjtetRenderer::renderFused(const VisibilitySorter::Result& sorted, std
     auto t0 = std::chrono::steady_clock::now();
     const int width = image_.width, height = image_.height;
     const std::vector<ProjtetBox> boxes = projtetCellBoxes(points_, tets_, camera_, width, height);
-    const int tilesX = (width + kProjtetTile - 1) / kProjtetTile, tilesY = (height + kProjtetTile - 1) / kProjtetTile;
+    const int tilesX = (width + kProjtetTileW - 1) / kProjtetTileW, tilesY = (height + kProjtetTileH - 1) / kProjtetTileH;
     const std::size_t tiles = static_cast<std::size_t>(tilesX) * tilesY;
     const std::vector<std::uint32_t>& order = sorted.order;
     constexpr std::size_t kChunk = 16384;
@@ -697,8 +699,8 @@ Image4f ProjtetRenderer::renderFused(const VisibilitySorter::Result& sorted, std
     auto forTiles = [&](const ProjtetBox& b, const auto& visit) {
         if (b.x0 > b.x1 || b.y0 > b.y1)
             return;
-        for (int ty = b.y0 / kProjtetTile; ty <= b.y1 / kProjtetTile; ++ty)
-            for (int tx = b.x0 / kProjtetTile; tx <= b.x1 / kProjtetTile; ++tx)
+        for (int ty = b.y0 / kProjtetTileH; ty <= b.y1 / kProjtetTileH; ++ty)
+            for (int tx = b.x0 / kProjtetTileW; tx <= b.x1 / kProjtetTileW; ++tx)
                 visit(static_cast<std::size_t>(ty) * tilesX + tx);
     };
     auto overChunks = [&](const auto& work) {
@@ -754,8 +756,12 @@ Image4f ProjtetRenderer::renderFused(const VisibilitySorter::Result& sorted, std
     fused_.setArg(a++, tf_.buffer());
     fused_.setArg(a++, psi_);
     fused_.setArg(a++, p);
-    device_.launch("projtet: fused", fused_, static_cast<std::size_t>(width), static_cast<std::size_t>(height),
-                   kProjtetTile, kProjtetTile);
+    if (packet_)  // a work-item per 8 pixels of a row: a tile's row
+        device_.launch("projtet: fused", fused_, static_cast<std::size_t>(tilesX), static_cast<std::size_t>(height), 1,
+                       kProjtetTileH);
+    else
+        device_.launch("projtet: fused", fused_, static_cast<std::size_t>(width), static_cast<std::size_t>(height),
+                       kProjtetTileW, kProjtetTileH);
     Image4f image = readImage(device_, fusedOut_, width, height);
     const std::uint64_t segments = sumCounts(device_, fusedSegments_, static_cast<std::size_t>(width) * height);
 
@@ -763,7 +769,8 @@ Image4f ProjtetRenderer::renderFused(const VisibilitySorter::Result& sorted, std
     stats.extra["path"] = "fused";
     stats.extra["steps"] = segments;  // the segments integrated: rays that meet a cell
     stats.extra["tile_entries"] = entries;
-    stats.extra["tile_size"] = kProjtetTile;
+    stats.extra["tile_size"] = {kProjtetTileW, kProjtetTileH};
+    stats.extra["packets"] = packet_;
     return image;
 }
 
@@ -1061,8 +1068,9 @@ TechniqueInfo projtetTechnique()
         {"order", "mpvonc-boundary", "",
          "visibility order: \"mpvonc-boundary\" (adjacency and overlapping boundary faces, exact without cycles), "
          "\"mpvonc\" (adjacency only, Williams 1992: exact on convex meshes) or \"centroid\" (centre distance)"},
+        packetsInfo(),
         {"path", "fused", "",
-         "\"fused\" (cells binned to 4x4-pixel tiles, one kernel walks each pixel's cells in order) or \"raster\" "
+         "\"fused\" (cells binned to 8x4-pixel tiles, one kernel walks each pixel's cells in order) or \"raster\" "
          "(each cell's silhouette as 3-4 triangles through the raster stage, the paper's method; the same frame)"},
     };
     t.makeForMesh = [](Device& device, const Scene& scene, const TetMesh& mesh) -> std::unique_ptr<Renderer> {
@@ -1086,6 +1094,8 @@ ProjtetOptions parseProjtetOptions(const nlohmann::json& options)
                 o.order = ProjtetOptions::Order::Centroid;
             else
                 badOption(key, "must be \"mpvonc-boundary\", \"mpvonc\" or \"centroid\", got " + value.dump());
+        } else if (key == "packets") {
+            o.packets = packetsOption(key, value);
         } else if (key == "path") {
             const std::string s = value.is_string() ? value.get<std::string>() : "";
             if (s == "raster")

@@ -18,6 +18,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 namespace clvr {
@@ -29,17 +30,21 @@ struct ProjtetOptions {
     // sorted by distance from the eye (depth along the view for parallel cameras).
     enum class Order { MpvoncBoundary, Mpvonc, Centroid };
     Order order = Order::MpvoncBoundary;
-    // "fused" (the default): the cells binned to tiles of kProjtetTile² pixels by their pixel boxes
+    // "fused" (the default): the cells binned to tiles of kProjtetTileW x kProjtetTileH pixels by their pixel boxes
     // (projtetCellBoxes), one work-item per pixel walking its tile's cells in visibility order with the fragment
     // program's work and the blend in one kernel (kernels/projtet.cl projtet_fused). "raster": each cell's
     // silhouette as 3 or 4 triangles drawn through the raster stage (the paper's method), the fragment program
     // integrating the pixel's segment: the same frame, the same segments in the same order.
     enum class Path { Raster, Fused };
     Path path = Path::Fused;
+    // Fused path: 8 neighbouring pixels of a row per work-item, one per float8 lane (kernels/projtet.cl's
+    // projtet_fused_packet; the same bits as one pixel per work-item). Unset: on CPU devices only.
+    std::optional<bool> packets;
 };
 
-// The fused path's tiles: kProjtetTile x kProjtetTile pixels (kernels/projtet.cl PROJTET_TILE_LOG2).
-inline constexpr int kProjtetTile = 4;
+// The fused path's tiles: kProjtetTileW x kProjtetTileH pixels (kernels/projtet.cl PROJTET_TILE_W_LOG2, _H_LOG2);
+// 8 wide, so that a packet's 8 pixels share a tile.
+inline constexpr int kProjtetTileW = 8, kProjtetTileH = 4;
 
 // A cell's box of pixel centres (x0, y0)-(x1, y1), inclusive; empty when x0 > x1 or y0 > y1. The fused path
 // uploads them as short4.
@@ -62,7 +67,7 @@ const char* orderName(ProjtetOptions::Order order);
 TechniqueInfo projtetTechnique();
 
 // Reads the scene's "options" for projtet: "order" ("mpvonc-boundary" | "mpvonc" | "centroid"), "path"
-// ("raster" | "fused").
+// ("fused" | "raster"), "packets" (true, false or null).
 // InputError naming the key for unknown keys, wrong types and values.
 ProjtetOptions parseProjtetOptions(const nlohmann::json& options);
 
