@@ -568,6 +568,23 @@ namespace {
 constexpr double kGrowPixels = 1.0 / 16.0;
 constexpr double kMaxMiterPixels = 1.0;
 
+// The per-frame host loops over points and cells run in chunks of kHostChunk taken from a shared counter: the
+// threads worth it for n items (the thread budget, one per chunk at most), and the loop itself, work(begin, end).
+constexpr std::size_t kHostChunk = 8192;
+int hostChunkThreads(std::size_t n)
+{
+    return threadsToUse(0, static_cast<int>(n / kHostChunk + 1));
+}
+template <typename Work>
+void forHostChunks(int threads, std::size_t n, const Work& work)
+{
+    std::atomic<std::size_t> next{0};
+    runOnThreads(threads, threads, [&] {
+        for (std::size_t begin; (begin = next.fetch_add(kHostChunk)) < n;)
+            work(begin, std::min(begin + kHostChunk, n));
+    });
+}
+
 std::string projtetFragmentSource()
 {
     return "#define CLVR_PROJTET_FRAGMENT 1\n" + std::string(embeddedKernelSource("projtet.cl"));
@@ -812,15 +829,8 @@ Image4f ProjtetRenderer::render(FrameStats& stats)
     // On the host's threads, in chunks of cells taken from a shared counter: the points, then each cell's
     // vertex count, then (at offsets from their prefix sum, so the triangles stay in visibility order, the same
     // vertices as one thread writes) the vertices themselves.
-    constexpr std::size_t kChunk = 8192;
-    const int threads = threadsToUse(0, static_cast<int>(std::max(points_.size(), cellCount) / kChunk + 1));
-    auto inChunks = [&](std::size_t n, const auto& work) {
-        std::atomic<std::size_t> next{0};
-        runOnThreads(threads, threads, [&] {
-            for (std::size_t begin; (begin = next.fetch_add(kChunk)) < n;)
-                work(begin, std::min(begin + kChunk, n));
-        });
-    };
+    const int threads = hostChunkThreads(std::max(points_.size(), cellCount));
+    auto inChunks = [&](std::size_t n, const auto& work) { forHostChunks(threads, n, work); };
     inChunks(points_.size(), [&](std::size_t begin, std::size_t end) {
         for (std::size_t p = begin; p < end; ++p) {
             const glm::dvec4 c = viewProjection * glm::dvec4(points_[p], 1.0);
@@ -1000,15 +1010,8 @@ std::vector<ProjtetBox> projtetCellBoxes(const std::vector<glm::dvec3>& points, 
     std::vector<glm::vec2> window(points.size());  // pixel coordinates, row 0 at the top
     std::vector<std::uint8_t> inFront(points.size());
     std::vector<ProjtetBox> boxes(tets.size());
-    constexpr std::size_t kChunk = 8192;
-    const int threads = threadsToUse(0, static_cast<int>(std::max(points.size(), tets.size()) / kChunk + 1));
-    auto inChunks = [&](std::size_t n, const auto& work) {
-        std::atomic<std::size_t> next{0};
-        runOnThreads(threads, threads, [&] {
-            for (std::size_t begin; (begin = next.fetch_add(kChunk)) < n;)
-                work(begin, std::min(begin + kChunk, n));
-        });
-    };
+    const int threads = hostChunkThreads(std::max(points.size(), tets.size()));
+    auto inChunks = [&](std::size_t n, const auto& work) { forHostChunks(threads, n, work); };
     inChunks(points.size(), [&](std::size_t begin, std::size_t end) {
         for (std::size_t p = begin; p < end; ++p) {
             const glm::dvec4 c = viewProjection * glm::dvec4(points[p], 1.0);
