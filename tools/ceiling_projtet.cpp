@@ -8,7 +8,6 @@
 #include "host/runtime/parallel.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <limits>
 #include <thread>
