@@ -438,7 +438,8 @@ Camera combCamera(bool parallel)
 // (its grown silhouettes) —, within the exact integral's tolerance. A convex grid (perspective, parallel), boxes with a gap along the view, a non-convex L,
 // the camera inside the mesh (cells at the near plane cover the whole image), and the interleaved combs (the
 // boundary relations), each on an image whose size is no multiple of the 8x4-pixel tiles; with ray packets (8 pixels
-// of a row per work-item, float8 lanes) and without, bit for bit.
+// of a row per work-item, float8 lanes) and without, bit for bit. With the camera inside, the cells at the near plane
+// are binned by their part beyond it only.
 TEST(ProjtetFused, DrawsTheRasterPathsFrame)
 {
     const glm::dvec3 gradient(0.3, 0.5, 0.2);
@@ -500,6 +501,16 @@ TEST(ProjtetFused, DrawsTheRasterPathsFrame)
         EXPECT_LE(segments, steps) << c.what;  // harc also enters cells a ray only grazes (length 0)
         EXPECT_GE(static_cast<double>(segments), 0.995 * static_cast<double>(steps)) << c.what;
         EXPECT_LE(segments, fragments) << c.what;
+        // A cell at the near plane is binned by its part beyond it, a cell wholly behind the eye not at all: far
+        // fewer tile entries than if each covered the image (8 x 16 tiles of 8x4 pixels at 61²).
+        const std::uint64_t nearCells = rasterStats.extra["cells_near_plane"].get<std::uint64_t>();
+        const std::uint64_t entries = fusedStats.extra["tile_entries"].get<std::uint64_t>();
+        if (c.what == "camera inside") {
+            std::printf("camera inside: %llu cells at the near plane, %llu tile entries\n",
+                        static_cast<unsigned long long>(nearCells), static_cast<unsigned long long>(entries));
+            EXPECT_GT(nearCells, 0u);
+            EXPECT_LT(entries, nearCells * 128u / 2u);
+        }
     }
 }
 

@@ -1007,33 +1007,46 @@ std::vector<ProjtetBox> projtetCellBoxes(const std::vector<glm::dvec3>& points, 
         depthMax = std::max(depthMax, glm::dot(p - camera.position, forward));
     const double nearZ = 1e-4 * depthMax + 1e-9, farZ = 2.0 * depthMax + 1.0;
     const glm::dmat4 viewProjection = camera.projectionMatrix(width, height, nearZ, farZ) * camera.viewMatrix();
+    std::vector<glm::dvec4> clip(points.size());
     std::vector<glm::vec2> window(points.size());  // pixel coordinates, row 0 at the top
     std::vector<std::uint8_t> inFront(points.size());
     std::vector<ProjtetBox> boxes(tets.size());
     const int threads = hostChunkThreads(std::max(points.size(), tets.size()));
     auto inChunks = [&](std::size_t n, const auto& work) { forHostChunks(threads, n, work); };
+    auto toWindow = [&](const glm::dvec4& c) {
+        const glm::vec2 ndc(static_cast<float>(c.x / c.w), static_cast<float>(c.y / c.w));
+        return glm::vec2((ndc.x + 1.0f) * 0.5f * static_cast<float>(width), (1.0f - ndc.y) * 0.5f * static_cast<float>(height));
+    };
     inChunks(points.size(), [&](std::size_t begin, std::size_t end) {
         for (std::size_t p = begin; p < end; ++p) {
-            const glm::dvec4 c = viewProjection * glm::dvec4(points[p], 1.0);
-            inFront[p] = camera.parallel || c.w > nearZ;
-            const glm::vec2 ndc(static_cast<float>(c.x / c.w), static_cast<float>(c.y / c.w));
-            window[p] = glm::vec2((ndc.x + 1.0f) * 0.5f * static_cast<float>(width),
-                                  (1.0f - ndc.y) * 0.5f * static_cast<float>(height));
+            clip[p] = viewProjection * glm::dvec4(points[p], 1.0);
+            inFront[p] = camera.parallel || clip[p].w > nearZ;
+            window[p] = toWindow(clip[p]);
         }
     });
     const auto margin = static_cast<float>(kGrowPixels);
-    const ProjtetBox whole{0, 0, static_cast<std::int16_t>(width - 1), static_cast<std::int16_t>(height - 1)};
     inChunks(tets.size(), [&](std::size_t begin, std::size_t end) {
         for (std::size_t t = begin; t < end; ++t) {
             const glm::uvec4 tet = tets[t];
-            if (!(inFront[tet[0]] && inFront[tet[1]] && inFront[tet[2]] && inFront[tet[3]])) {
-                boxes[t] = whole;
+            // The part of the cell beyond the near plane (the raster path clips there): its points in front and
+            // where its edges cross the plane; nothing for a cell wholly nearer (behind the eye, say).
+            glm::vec2 lo(std::numeric_limits<float>::infinity()), hi(-std::numeric_limits<float>::infinity());
+            for (int v = 0; v < 4; ++v)
+                if (inFront[tet[v]]) {
+                    lo = glm::min(lo, window[tet[v]]);
+                    hi = glm::max(hi, window[tet[v]]);
+                }
+            for (int a = 0; a < 4; ++a)
+                for (int b = a + 1; b < 4; ++b)
+                    if (inFront[tet[a]] != inFront[tet[b]]) {
+                        const glm::dvec4 &ca = clip[tet[a]], &cb = clip[tet[b]];
+                        const glm::vec2 w = toWindow(ca + (nearZ - ca.w) / (cb.w - ca.w) * (cb - ca));
+                        lo = glm::min(lo, w);
+                        hi = glm::max(hi, w);
+                    }
+            if (!(lo.x <= hi.x)) {
+                boxes[t] = ProjtetBox{0, 0, -1, -1};
                 continue;
-            }
-            glm::vec2 lo = window[tet[0]], hi = lo;
-            for (int v = 1; v < 4; ++v) {
-                lo = glm::min(lo, window[tet[v]]);
-                hi = glm::max(hi, window[tet[v]]);
             }
             // the pixel centres x + 0.5 in [lo - margin, hi + margin], clamped to the image (and to int16)
             const auto clampTo = [](float v, int last) {

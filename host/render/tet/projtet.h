@@ -54,9 +54,10 @@ struct ProjtetBox {
 
 // Every cell's box for `camera` on a width x height image (at most 16,384 on a side), as the fused path and
 // tools/ceiling_projtet.h take them: the points projected as the raster path projects them (through float NDC),
-// the box of a cell's four corners grown by the raster path's 1/16 pixel and clipped to the image; the whole image
-// for a cell with a point at or behind the near plane (the raster path draws its back faces). On the host's
-// threads.
+// the box of a cell's four corners grown by the raster path's 1/16 pixel and clipped to the image. A cell with a point
+// at or behind the near plane (the eye in the mesh) is boxed by its part beyond the plane — its points in front and
+// its edges' crossings with the plane —, as the raster path clips its back faces there; a cell wholly nearer has an
+// empty box. On the host's threads.
 std::vector<ProjtetBox> projtetCellBoxes(const std::vector<glm::dvec3>& points, const std::vector<glm::uvec4>& tets,
                                          const Camera& camera, int width, int height);
 
