@@ -71,6 +71,24 @@ VisibilitySorter::VisibilitySorter(const TetMesh& mesh, const TetTopology& topol
 
 namespace {
 
+// The per-frame host loops over points, cells and faces run in chunks of `chunk` items taken from a shared
+// counter: the threads worth it for n items (the thread budget, one per chunk at most), and the loop itself,
+// work(begin, end); begin / chunk numbers the chunk, for loops that keep their outputs in order.
+constexpr std::size_t kHostChunk = 8192;
+int hostChunkThreads(std::size_t n, std::size_t chunk = kHostChunk)
+{
+    return threadsToUse(0, static_cast<int>(n / chunk + 1));
+}
+template <typename Work>
+void forHostChunks(int threads, std::size_t n, const Work& work, std::size_t chunk = kHostChunk)
+{
+    std::atomic<std::size_t> next{0};
+    runOnThreads(threads, threads, [&] {
+        for (std::size_t begin; (begin = next.fetch_add(chunk)) < n;)
+            work(begin, std::min(begin + chunk, n));
+    });
+}
+
 // Every cell, the largest key (the farthest) first; equal keys by cell number.
 std::vector<std::uint32_t> farthestFirst(const std::vector<double>& key)
 {
@@ -378,56 +396,68 @@ std::vector<VisibilitySorter::Behind> VisibilitySorter::boundaryOrder(const Came
         window = scale * glm::dvec2(width / full, 1.0) + glm::dvec2(4.0 * scale / full);
     }
 
-    // Every boundary face the rays enter or leave the mesh by, projected.
+    // Every boundary face the rays enter or leave the mesh by, projected: in chunks on the host's threads, each
+    // chunk's faces in its own lists, joined in the faces' order.
+    const std::size_t faceChunks = (boundary_.size() + kHostChunk - 1) / kHostChunk;
+    std::vector<std::vector<ScreenFace>> chunkExits(faceChunks), chunkEntries(faceChunks);
+    forHostChunks(hostChunkThreads(boundary_.size()), boundary_.size(), [&](std::size_t begin, std::size_t end) {
+        std::vector<ScreenFace>& chunkExit = chunkExits[begin / kHostChunk];
+        std::vector<ScreenFace>& chunkEntry = chunkEntries[begin / kHostChunk];
+        for (std::size_t faceIndex = begin; faceIndex < end; ++faceIndex) {
+            const OuterFace& face = boundary_[faceIndex];
+            const double side = parallel ? -glm::dot(face.normal, forward) : glm::dot(face.normal, eye) - face.offset;
+            if (side == 0.0 || !std::isfinite(side))
+                continue;  // seen edge-on
+            Convex<glm::dvec3> solid;
+            for (const glm::dvec3& p : face.points)
+                solid.p[solid.n++] = toCamera(p);
+            if (!parallel)
+                solid = clipConvex(solid, [&](const glm::dvec3& p) { return p.z - zNear; });
+            if (windowed)  // |x| <= window.x (times z, perspective), |y| <= window.y: four planes in 3D
+                for (int axis = 0; axis < 2; ++axis)
+                    for (const double sign : {1.0, -1.0})
+                        solid = clipConvex(solid, [&](const glm::dvec3& p) {
+                            return window[axis] * (parallel ? 1.0 : p.z) - sign * p[axis];
+                        });
+            if (solid.n < 3)
+                continue;
+            ScreenFace s;
+            s.cell = face.cell;
+            s.zMin = std::numeric_limits<double>::infinity();
+            s.zMax = -s.zMin;
+            for (int i = 0; i < solid.n; ++i) {
+                const glm::dvec3& p = solid.p[i];
+                s.shape.p[i] = parallel ? glm::dvec2(p.x, p.y) : glm::dvec2(p.x / p.z, p.y / p.z);
+                s.zMin = std::min(s.zMin, p.z);
+                s.zMax = std::max(s.zMax, p.z);
+            }
+            s.shape.n = solid.n;
+            const double area = signedArea(s.shape);
+            if (!(std::abs(area) > 0.0))
+                continue;
+            if (area < 0.0)
+                std::reverse(s.shape.p.begin(), s.shape.p.begin() + s.shape.n);
+            s.lo = s.hi = s.shape.p[0];
+            for (int i = 1; i < s.shape.n; ++i) {
+                s.lo = glm::min(s.lo, s.shape.p[i]);
+                s.hi = glm::max(s.hi, s.shape.p[i]);
+            }
+            s.normal =
+                glm::dvec3(glm::dot(face.normal, right), glm::dot(face.normal, up), glm::dot(face.normal, forward));
+            s.offset = face.offset - glm::dot(face.normal, eye);
+            (side < 0.0 ? chunkExit : chunkEntry).push_back(s);
+        }
+    });
     std::vector<ScreenFace> exits, entries;
-    for (const OuterFace& face : boundary_) {
-        const double side = parallel ? -glm::dot(face.normal, forward) : glm::dot(face.normal, eye) - face.offset;
-        if (side == 0.0 || !std::isfinite(side))
-            continue;  // seen edge-on
-        Convex<glm::dvec3> solid;
-        for (const glm::dvec3& p : face.points)
-            solid.p[solid.n++] = toCamera(p);
-        if (!parallel)
-            solid = clipConvex(solid, [&](const glm::dvec3& p) { return p.z - zNear; });
-        if (windowed)  // |x| <= window.x (times z, perspective), |y| <= window.y: four planes in 3D
-            for (int axis = 0; axis < 2; ++axis)
-                for (const double sign : {1.0, -1.0})
-                    solid = clipConvex(solid, [&](const glm::dvec3& p) {
-                        return window[axis] * (parallel ? 1.0 : p.z) - sign * p[axis];
-                    });
-        if (solid.n < 3)
-            continue;
-        ScreenFace s;
-        s.cell = face.cell;
-        s.zMin = std::numeric_limits<double>::infinity();
-        s.zMax = -s.zMin;
-        for (int i = 0; i < solid.n; ++i) {
-            const glm::dvec3& p = solid.p[i];
-            s.shape.p[i] = parallel ? glm::dvec2(p.x, p.y) : glm::dvec2(p.x / p.z, p.y / p.z);
-            s.zMin = std::min(s.zMin, p.z);
-            s.zMax = std::max(s.zMax, p.z);
-        }
-        s.shape.n = solid.n;
-        const double area = signedArea(s.shape);
-        if (!(std::abs(area) > 0.0))
-            continue;
-        if (area < 0.0)
-            std::reverse(s.shape.p.begin(), s.shape.p.begin() + s.shape.n);
-        s.lo = s.hi = s.shape.p[0];
-        for (int i = 1; i < s.shape.n; ++i) {
-            s.lo = glm::min(s.lo, s.shape.p[i]);
-            s.hi = glm::max(s.hi, s.shape.p[i]);
-        }
-        s.normal = glm::dvec3(glm::dot(face.normal, right), glm::dot(face.normal, up), glm::dot(face.normal, forward));
-        s.offset = face.offset - glm::dot(face.normal, eye);
-        (side < 0.0 ? exits : entries).push_back(s);
+    for (std::size_t c = 0; c < faceChunks; ++c) {
+        exits.insert(exits.end(), chunkExits[c].begin(), chunkExits[c].end());
+        entries.insert(entries.end(), chunkEntries[c].begin(), chunkEntries[c].end());
     }
     stats.exitFaces = exits.size();
     stats.entryFaces = entries.size();
-    std::vector<Behind> relations;
     if (exits.empty() || entries.empty()) {
         stats.ms = msSince(t0);
-        return relations;
+        return {};
     }
 
     // The exit faces binned on a grid over their bounds, about one face per bin.
@@ -463,40 +493,59 @@ std::vector<VisibilitySorter::Behind> VisibilitySorter::boundaryOrder(const Came
 
     const double minArea = 1e-12 * std::max(extent.x, extent.y) * std::max(extent.x, extent.y);
     const double depthTolerance = 1e-9 * depthScale;
-    for (const ScreenFace& entry : entries) {
-        if (entry.hi.x < lo.x || entry.hi.y < lo.y || entry.lo.x > hi.x || entry.lo.y > hi.y)
-            continue;
-        forBins(entry, [&](std::size_t b) {
-            for (std::uint32_t k = start[b]; k < start[b + 1]; ++k) {
-                const ScreenFace& exit = exits[members[k]];
-                const glm::dvec2 overlapLo = glm::max(entry.lo, exit.lo), overlapHi = glm::min(entry.hi, exit.hi);
-                if (overlapLo.x >= overlapHi.x || overlapLo.y >= overlapHi.y || exit.cell == entry.cell)
-                    continue;
-                // Each pair once: in the bin of its bounds' overlap's low corner.
-                if (static_cast<std::size_t>(bin(overlapLo.y, lo.y, extent.y)) * bins + bin(overlapLo.x, lo.x, extent.x) != b)
-                    continue;
-                if (entry.zMax < exit.zMin - depthTolerance)
-                    continue;  // the entry face is in front of the exit face wherever they overlap
-                ++stats.pairsTested;
-                Convex<glm::dvec2> overlap = entry.shape;
-                for (int e = 0; e < exit.shape.n && overlap.n >= 3; ++e) {
-                    const glm::dvec2 a = exit.shape.p[e], d = exit.shape.p[(e + 1) % exit.shape.n] - a;
-                    overlap = clipConvex(overlap, [&](const glm::dvec2& p) { return d.x * (p.y - a.y) - d.y * (p.x - a.x); });
+    // The entry faces in chunks on the host's threads, each chunk's relations in its own list, joined in order.
+    constexpr std::size_t kEntryChunk = 512;
+    const std::size_t entryChunks = (entries.size() + kEntryChunk - 1) / kEntryChunk;
+    std::vector<std::vector<Behind>> chunkRelations(entryChunks);
+    std::vector<std::uint64_t> chunkPairs(entryChunks, 0);
+    const int entryThreads = hostChunkThreads(entries.size(), kEntryChunk);
+    forHostChunks(entryThreads, entries.size(), [&](std::size_t begin, std::size_t end) {
+        std::vector<Behind>& relations = chunkRelations[begin / kEntryChunk];
+        std::uint64_t& pairsTested = chunkPairs[begin / kEntryChunk];
+        for (std::size_t entryIndex = begin; entryIndex < end; ++entryIndex) {
+            const ScreenFace& entry = entries[entryIndex];
+            if (entry.hi.x < lo.x || entry.hi.y < lo.y || entry.lo.x > hi.x || entry.lo.y > hi.y)
+                continue;
+            forBins(entry, [&](std::size_t b) {
+                for (std::uint32_t k = start[b]; k < start[b + 1]; ++k) {
+                    const ScreenFace& exit = exits[members[k]];
+                    const glm::dvec2 overlapLo = glm::max(entry.lo, exit.lo), overlapHi = glm::min(entry.hi, exit.hi);
+                    if (overlapLo.x >= overlapHi.x || overlapLo.y >= overlapHi.y || exit.cell == entry.cell)
+                        continue;
+                    // Each pair once: in the bin of its bounds' overlap's low corner.
+                    const std::size_t lowCorner = static_cast<std::size_t>(bin(overlapLo.y, lo.y, extent.y)) * bins +
+                                                  static_cast<std::size_t>(bin(overlapLo.x, lo.x, extent.x));
+                    if (lowCorner != b)
+                        continue;
+                    if (entry.zMax < exit.zMin - depthTolerance)
+                        continue;  // the entry face is in front of the exit face wherever they overlap
+                    ++pairsTested;
+                    Convex<glm::dvec2> overlap = entry.shape;
+                    for (int e = 0; e < exit.shape.n && overlap.n >= 3; ++e) {
+                        const glm::dvec2 a = exit.shape.p[e], d = exit.shape.p[(e + 1) % exit.shape.n] - a;
+                        const auto left = [&](const glm::dvec2& p) { return d.x * (p.y - a.y) - d.y * (p.x - a.x); };
+                        overlap = clipConvex(overlap, left);
+                    }
+                    if (overlap.n < 3 || !(signedArea(overlap) > minArea))
+                        continue;
+                    glm::dvec2 inside(0.0);
+                    for (int i = 0; i < overlap.n; ++i)
+                        inside += overlap.p[i];
+                    inside /= static_cast<double>(overlap.n);
+                    // The faces cross no ray at the same point except where they coincide (two parts of the
+                    // mesh that touch without sharing points): there the ray leaves one and enters the other.
+                    if (entry.zMin >= exit.zMax ||
+                        depthAt(entry, inside, parallel) >= depthAt(exit, inside, parallel) - depthTolerance) {
+                        relations.push_back({entry.cell, exit.cell});
+                    }
                 }
-                if (overlap.n < 3 || !(signedArea(overlap) > minArea))
-                    continue;
-                glm::dvec2 inside(0.0);
-                for (int i = 0; i < overlap.n; ++i)
-                    inside += overlap.p[i];
-                inside /= static_cast<double>(overlap.n);
-                // The faces cross no ray at the same point except where they coincide (two parts of the
-                // mesh that touch without sharing points): there the ray leaves one and enters the other.
-                if (entry.zMin >= exit.zMax ||
-                    depthAt(entry, inside, parallel) >= depthAt(exit, inside, parallel) - depthTolerance) {
-                    relations.push_back({entry.cell, exit.cell});
-                }
-            }
-        });
+            });
+        }
+    }, kEntryChunk);
+    std::vector<Behind> relations;
+    for (std::size_t c = 0; c < entryChunks; ++c) {
+        relations.insert(relations.end(), chunkRelations[c].begin(), chunkRelations[c].end());
+        stats.pairsTested += chunkPairs[c];
     }
     stats.relations = relations.size();
     stats.ms = msSince(t0);
@@ -568,22 +617,6 @@ namespace {
 constexpr double kGrowPixels = 1.0 / 16.0;
 constexpr double kMaxMiterPixels = 1.0;
 
-// The per-frame host loops over points and cells run in chunks of kHostChunk taken from a shared counter: the
-// threads worth it for n items (the thread budget, one per chunk at most), and the loop itself, work(begin, end).
-constexpr std::size_t kHostChunk = 8192;
-int hostChunkThreads(std::size_t n)
-{
-    return threadsToUse(0, static_cast<int>(n / kHostChunk + 1));
-}
-template <typename Work>
-void forHostChunks(int threads, std::size_t n, const Work& work)
-{
-    std::atomic<std::size_t> next{0};
-    runOnThreads(threads, threads, [&] {
-        for (std::size_t begin; (begin = next.fetch_add(kHostChunk)) < n;)
-            work(begin, std::min(begin + kHostChunk, n));
-    });
-}
 
 std::string projtetFragmentSource()
 {
@@ -639,8 +672,8 @@ private:
     Staging boxes_, tileStart_, tileCells_;
 
     // The fused path's frame after the sort (ProjtetOptions::Path::Fused).
-    Image4f renderFused(const VisibilitySorter::Result& sorted, std::vector<PassTime> hostPasses, const FrameClock& clock,
-                        FrameStats& stats);
+    Image4f renderFused(const VisibilitySorter::Result& sorted, std::vector<PassTime> hostPasses,
+                        const FrameClock& clock, FrameStats& stats);
     // Writes `bytes` of `data` into `staging`, which grows to hold them.
     void stage(Staging& staging, std::string_view what, const void* data, std::size_t bytes);
     // The stats both paths report: the order and the sort, the counts, the integration.
@@ -697,22 +730,24 @@ void ProjtetRenderer::stage(Staging& staging, std::string_view what, const void*
         device_.queue().enqueueWriteBuffer(staging.buffer, CL_TRUE, 0, bytes, data);
 }
 
-// The fused path: the cells' boxes of pixel centres (projtetCellBoxes), the cells binned to tiles of kProjtetTileW x
-// kProjtetTileH pixels in visibility order — a stable counting sort by chunks of the order on the host's threads (each chunk
-// counts its cells' tiles, the counts become each chunk's offsets within each tile, each chunk writes its cells)
-// —, then kernels/projtet.cl's projtet_fused over the image.
+// The fused path: the cells' boxes of pixel centres (projtetCellBoxes), the cells binned to tiles of
+// kProjtetTileW x kProjtetTileH pixels in visibility order — a stable counting sort by chunks of the order on the
+// host's threads (each chunk counts its cells' tiles, the counts become each chunk's offsets within each tile,
+// each chunk writes its cells) —, then kernels/projtet.cl's projtet_fused (or its packets) over the image.
 Image4f ProjtetRenderer::renderFused(const VisibilitySorter::Result& sorted, std::vector<PassTime> hostPasses,
                                      const FrameClock& clock, FrameStats& stats)
 {
     auto t0 = std::chrono::steady_clock::now();
     const int width = image_.width, height = image_.height;
     const std::vector<ProjtetBox> boxes = projtetCellBoxes(points_, tets_, camera_, width, height);
-    const int tilesX = (width + kProjtetTileW - 1) / kProjtetTileW, tilesY = (height + kProjtetTileH - 1) / kProjtetTileH;
+    const int tilesX = (width + kProjtetTileW - 1) / kProjtetTileW;
+    const int tilesY = (height + kProjtetTileH - 1) / kProjtetTileH;
     const std::size_t tiles = static_cast<std::size_t>(tilesX) * tilesY;
     const std::vector<std::uint32_t>& order = sorted.order;
     constexpr std::size_t kChunk = 16384;
     const std::size_t chunks = (order.size() + kChunk - 1) / kChunk;
-    std::vector<cl_uint> offset(chunks * tiles, 0);  // chunk c's count, then its first entry, in tile t at c * tiles + t
+    // chunk c's count, then its first entry, in tile t: offset[c * tiles + t]
+    std::vector<cl_uint> offset(chunks * tiles, 0);
     auto forTiles = [&](const ProjtetBox& b, const auto& visit) {
         if (b.x0 > b.x1 || b.y0 > b.y1)
             return;
@@ -1015,7 +1050,8 @@ std::vector<ProjtetBox> projtetCellBoxes(const std::vector<glm::dvec3>& points, 
     auto inChunks = [&](std::size_t n, const auto& work) { forHostChunks(threads, n, work); };
     auto toWindow = [&](const glm::dvec4& c) {
         const glm::vec2 ndc(static_cast<float>(c.x / c.w), static_cast<float>(c.y / c.w));
-        return glm::vec2((ndc.x + 1.0f) * 0.5f * static_cast<float>(width), (1.0f - ndc.y) * 0.5f * static_cast<float>(height));
+        return glm::vec2((ndc.x + 1.0f) * 0.5f * static_cast<float>(width),
+                         (1.0f - ndc.y) * 0.5f * static_cast<float>(height));
     };
     inChunks(points.size(), [&](std::size_t begin, std::size_t end) {
         for (std::size_t p = begin; p < end; ++p) {
@@ -1052,8 +1088,10 @@ std::vector<ProjtetBox> projtetCellBoxes(const std::vector<glm::dvec3>& points, 
             const auto clampTo = [](float v, int last) {
                 return static_cast<std::int16_t>(std::clamp(v, -1.0f, static_cast<float>(last) + 1.0f));
             };
-            ProjtetBox b{clampTo(std::ceil(lo.x - margin - 0.5f), width - 1), clampTo(std::ceil(lo.y - margin - 0.5f), height - 1),
-                         clampTo(std::floor(hi.x + margin - 0.5f), width - 1), clampTo(std::floor(hi.y + margin - 0.5f), height - 1)};
+            ProjtetBox b{clampTo(std::ceil(lo.x - margin - 0.5f), width - 1),
+                         clampTo(std::ceil(lo.y - margin - 0.5f), height - 1),
+                         clampTo(std::floor(hi.x + margin - 0.5f), width - 1),
+                         clampTo(std::floor(hi.y + margin - 0.5f), height - 1)};
             b.x0 = std::max<std::int16_t>(b.x0, 0);
             b.y0 = std::max<std::int16_t>(b.y0, 0);
             b.x1 = std::min<std::int16_t>(b.x1, static_cast<std::int16_t>(width - 1));
