@@ -305,6 +305,22 @@ TEST(CubefanCeiling, DoesTheFusedKernelsWork)
         }
 }
 
+// An iso3d scene rendered by clvr and by the ceiling loop (which must fit it), on 2 threads.
+struct Iso3dCeilingRun {
+    clvr::Image4f kernel;
+    clvr::FrameStats stats;
+    clvr::tools::CeilingResult ceiling;
+};
+Iso3dCeilingRun runIso3dCeiling(const clvr::Volume& volume, const clvr::Scene& scene)
+{
+    Iso3dCeilingRun run;
+    run.kernel = clvr::test::renderScene(scene, volume, &run.stats);
+    const clvr::Iso3dOptions options = clvr::parseIso3dOptions(scene.options);
+    EXPECT_TRUE(clvr::tools::iso3dCeilingFits(options, *scene.iso)) << scene.options.dump();
+    run.ceiling = clvr::tools::Iso3dCeiling(volume, scene, *scene.camera, options).render(2);
+    return run;
+}
+
 // The iso3d scene both iso3d ceiling tests render: Marschner–Lobb's surface at 0.55 on 56x48, with these options.
 clvr::Scene iso3dCeilingScene(const clvr::Camera& camera, clvr::IsoSpec::Shading shading, nlohmann::json options)
 {
@@ -335,12 +351,10 @@ TEST(Iso3dCeiling, DoesTheFusedPathsWork)
                     iso3dCeilingScene(camera, shading, {{"slices", 90}, {"empty_space_skipping", skip}});
                 const std::string what = std::string(shading == clvr::IsoSpec::Shading::None ? "unshaded" : "shaded") +
                                          (skip ? ", skipping" : "") + (camera.parallel ? ", parallel" : "");
-                clvr::FrameStats stats;
-                const clvr::Image4f kernel = clvr::test::renderScene(scene, volume, &stats);
-                const clvr::Iso3dOptions options = clvr::parseIso3dOptions(scene.options);
-                ASSERT_TRUE(clvr::tools::iso3dCeilingFits(options, *scene.iso));
-                const clvr::tools::Iso3dCeiling ceiling(volume, scene, *scene.camera, options);
-                const clvr::tools::CeilingResult result = ceiling.render(2);
+                const Iso3dCeilingRun run = runIso3dCeiling(volume, scene);
+                const clvr::Image4f& kernel = run.kernel;
+                const clvr::FrameStats& stats = run.stats;
+                const clvr::tools::CeilingResult& result = run.ceiling;
                 std::size_t differ = 0;
                 for (std::size_t p = 0; p < kernel.pixelCount(); ++p) {
                     const glm::vec4 d = glm::abs(kernel.pixels()[p] - result.image.pixels()[p]);
@@ -378,12 +392,10 @@ TEST(Iso3dCeiling, DoesTheRasterPathsWorkBrickedOrNot)
                     scene.options["bricks"] = bricks;
                 const std::string what = std::string(shading == clvr::IsoSpec::Shading::None ? "unshaded" : "shaded") +
                                          (bricks.is_null() ? "" : ", bricks") + (camera.parallel ? ", parallel" : "");
-                clvr::FrameStats stats;
-                const clvr::Image4f kernel = clvr::test::renderScene(scene, volume, &stats);
-                const clvr::Iso3dOptions options = clvr::parseIso3dOptions(scene.options);
-                ASSERT_TRUE(clvr::tools::iso3dCeilingFits(options, *scene.iso));
-                const clvr::tools::Iso3dCeiling ceiling(volume, scene, *scene.camera, options);
-                const clvr::tools::CeilingResult result = ceiling.render(2);
+                const Iso3dCeilingRun run = runIso3dCeiling(volume, scene);
+                const clvr::Image4f& kernel = run.kernel;
+                const clvr::FrameStats& stats = run.stats;
+                const clvr::tools::CeilingResult& result = run.ceiling;
                 const PixelsApart d = pixelsApart(kernel, result.image, 2e-3f);
                 std::size_t hits = 0;
                 for (const glm::vec4& p : kernel.pixels())
