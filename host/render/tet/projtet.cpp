@@ -617,6 +617,21 @@ namespace {
 constexpr double kGrowPixels = 1.0 / 16.0;
 constexpr double kMaxMiterPixels = 1.0;
 
+// Both paths' projection of the cells' points: the near plane in front of every cell but those at the eye (a
+// 10,000th of the farthest point's eye depth), the far plane beyond the mesh.
+struct CellProjection {
+    CellProjection(const std::vector<glm::dvec3>& points, const Camera& camera, int width, int height)
+    {
+        const glm::dvec3 forward = camera.forward();
+        double depthMax = 0.0;
+        for (const glm::dvec3& p : points)
+            depthMax = std::max(depthMax, glm::dot(p - camera.position, forward));
+        nearZ = 1e-4 * depthMax + 1e-9;
+        viewProjection = camera.projectionMatrix(width, height, nearZ, 2.0 * depthMax + 1.0) * camera.viewMatrix();
+    }
+    double nearZ;
+    glm::dmat4 viewProjection;
+};
 
 std::string projtetFragmentSource()
 {
@@ -755,15 +770,10 @@ Image4f ProjtetRenderer::renderFused(const VisibilitySorter::Result& sorted, std
             for (int tx = b.x0 / kProjtetTileW; tx <= b.x1 / kProjtetTileW; ++tx)
                 visit(static_cast<std::size_t>(ty) * tilesX + tx);
     };
-    auto overChunks = [&](const auto& work) {
-        std::atomic<std::size_t> next{0};
-        runOnThreads(0, static_cast<int>(chunks), [&] {
-            for (std::size_t c; (c = next.fetch_add(1)) < chunks;)
-                work(c, c * kChunk, std::min((c + 1) * kChunk, order.size()));
-        });
-    };
-    overChunks([&](std::size_t c, std::size_t begin, std::size_t end) {
-        cl_uint* count = offset.data() + c * tiles;
+    const int threads = hostChunkThreads(order.size(), kChunk);
+    auto overChunks = [&](const auto& work) { forHostChunks(threads, order.size(), work, kChunk); };
+    overChunks([&](std::size_t begin, std::size_t end) {
+        cl_uint* count = offset.data() + begin / kChunk * tiles;
         for (std::size_t i = begin; i < end; ++i)
             forTiles(boxes[order[i]], [&](std::size_t tile) { ++count[tile]; });
     });
@@ -782,8 +792,8 @@ Image4f ProjtetRenderer::renderFused(const VisibilitySorter::Result& sorted, std
                          "use \"path\": \"raster\" or a smaller image");
     tileStart[tiles] = static_cast<cl_uint>(entries);
     std::vector<cl_uint> tileCells(entries);
-    overChunks([&](std::size_t c, std::size_t begin, std::size_t end) {
-        cl_uint* next = offset.data() + c * tiles;
+    overChunks([&](std::size_t begin, std::size_t end) {
+        cl_uint* next = offset.data() + begin / kChunk * tiles;
         for (std::size_t i = begin; i < end; ++i)
             forTiles(boxes[order[i]], [&](std::size_t tile) { tileCells[next[tile]++] = order[i]; });
     });
@@ -849,14 +859,9 @@ Image4f ProjtetRenderer::render(FrameStats& stats)
     // every ray that meets such a cell in front of the eye leaves it through a back face in front of the
     // eye, also when the eye is inside the cell (which has no front face).
     t0 = std::chrono::steady_clock::now();
-    const glm::dvec3 forward = camera_.forward();
-    double depthMax = 0.0;
-    for (const glm::dvec3& p : points_)
-        depthMax = std::max(depthMax, glm::dot(p - camera_.position, forward));
-    const double nearZ = 1e-4 * depthMax + 1e-9;
-    const double farZ = 2.0 * depthMax + 1.0;
-    const glm::dmat4 viewProjection =
-        camera_.projectionMatrix(image_.width, image_.height, nearZ, farZ) * camera_.viewMatrix();
+    const CellProjection projection(points_, camera_, image_.width, image_.height);
+    const double nearZ = projection.nearZ;
+    const glm::dmat4& viewProjection = projection.viewProjection;
     std::vector<glm::vec4> clip(points_.size());
     std::vector<glm::dvec2> ndc(points_.size());
     std::vector<std::uint8_t> inFront(points_.size());
@@ -1035,13 +1040,10 @@ void ProjtetRenderer::reportOrder(const VisibilitySorter::Result& sorted, double
 std::vector<ProjtetBox> projtetCellBoxes(const std::vector<glm::dvec3>& points, const std::vector<glm::uvec4>& tets,
                                          const Camera& camera, int width, int height)
 {
-    // ProjtetRenderer::render's projection: the same near plane, each point through float NDC to pixels.
-    const glm::dvec3 forward = camera.forward();
-    double depthMax = 0.0;
-    for (const glm::dvec3& p : points)
-        depthMax = std::max(depthMax, glm::dot(p - camera.position, forward));
-    const double nearZ = 1e-4 * depthMax + 1e-9, farZ = 2.0 * depthMax + 1.0;
-    const glm::dmat4 viewProjection = camera.projectionMatrix(width, height, nearZ, farZ) * camera.viewMatrix();
+    // The raster path's projection: the same near plane, each point through float NDC to pixels.
+    const CellProjection projection(points, camera, width, height);
+    const double nearZ = projection.nearZ;
+    const glm::dmat4& viewProjection = projection.viewProjection;
     std::vector<glm::dvec4> clip(points.size());
     std::vector<glm::vec2> window(points.size());  // pixel coordinates, row 0 at the top
     std::vector<std::uint8_t> inFront(points.size());
@@ -1084,19 +1086,18 @@ std::vector<ProjtetBox> projtetCellBoxes(const std::vector<glm::dvec3>& points, 
                 boxes[t] = ProjtetBox{0, 0, -1, -1};
                 continue;
             }
-            // the pixel centres x + 0.5 in [lo - margin, hi + margin], clamped to the image (and to int16)
-            const auto clampTo = [](float v, int last) {
-                return static_cast<std::int16_t>(std::clamp(v, -1.0f, static_cast<float>(last) + 1.0f));
+            // the pixel centres x + 0.5 in [lo - margin, hi + margin] that lie in the image: a first centre in
+            // 0 .. last + 1, a last in -1 .. last (first > last: none)
+            const auto firstCentre = [&](float v, int last) {
+                const float limit = static_cast<float>(last) + 1.0f;
+                return static_cast<std::int16_t>(std::clamp(std::ceil(v - margin - 0.5f), 0.0f, limit));
             };
-            ProjtetBox b{clampTo(std::ceil(lo.x - margin - 0.5f), width - 1),
-                         clampTo(std::ceil(lo.y - margin - 0.5f), height - 1),
-                         clampTo(std::floor(hi.x + margin - 0.5f), width - 1),
-                         clampTo(std::floor(hi.y + margin - 0.5f), height - 1)};
-            b.x0 = std::max<std::int16_t>(b.x0, 0);
-            b.y0 = std::max<std::int16_t>(b.y0, 0);
-            b.x1 = std::min<std::int16_t>(b.x1, static_cast<std::int16_t>(width - 1));
-            b.y1 = std::min<std::int16_t>(b.y1, static_cast<std::int16_t>(height - 1));
-            boxes[t] = b;
+            const auto lastCentre = [&](float v, int last) {
+                const float limit = static_cast<float>(last);
+                return static_cast<std::int16_t>(std::clamp(std::floor(v + margin - 0.5f), -1.0f, limit));
+            };
+            boxes[t] = ProjtetBox{firstCentre(lo.x, width - 1), firstCentre(lo.y, height - 1),
+                                  lastCentre(hi.x, width - 1), lastCentre(hi.y, height - 1)};
         }
     });
     return boxes;
@@ -1151,13 +1152,8 @@ ProjtetOptions parseProjtetOptions(const nlohmann::json& options)
         } else if (key == "packets") {
             o.packets = packetsOption(key, value);
         } else if (key == "path") {
-            const std::string s = value.is_string() ? value.get<std::string>() : "";
-            if (s == "raster")
-                o.path = ProjtetOptions::Path::Raster;
-            else if (s == "fused")
-                o.path = ProjtetOptions::Path::Fused;
-            else
-                badOption(key, "must be \"raster\" or \"fused\", got " + value.dump());
+            o.path = choiceOption(key, value, {"fused", "raster"}) == 0 ? ProjtetOptions::Path::Fused
+                                                                       : ProjtetOptions::Path::Raster;
         } else {
             unparsedOption(info, key);
         }
