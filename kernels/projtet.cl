@@ -13,6 +13,37 @@
  * planes (h_i, k_i), the fourth 1 minus their sum, the gradient and scalar term; the adjacency is unused. */
 #define PROJTET_TET_FLOAT4S 5
 
+/* Cell t's segment along the ray e + λ d, λ >= 0: inside, b_i(e + λ d) = b_i(e) + λ dot(h_i, d) >= 0 for all four
+ * planes. Returns whether the ray meets the cell (not where it grazes it, or runs parallel to a face outside it),
+ * and then in *l its length and in *s_f, *s_b the scalar at its front and back (Eq. 6). The dot products are
+ * written out (harc_dot3), as projtet_fused_packet's lanes repeat them. */
+__attribute__((always_inline)) int projtet_cell_segment(global const float* cells, const uint t, const float3 e,
+                                                          const float3 d, float* l, float* s_f, float* s_b)
+{
+    global const float* tet = cells + (size_t)t * (4 * PROJTET_TET_FLOAT4S);
+    const float4 p0 = vload4(0, tet), p1 = vload4(1, tet), p2 = vload4(2, tet), grad = vload4(3, tet);
+    const float4 p3 = (float4)(-(p0.xyz + p1.xyz + p2.xyz), 1.0f - (p0.w + p1.w + p2.w));
+    float lambda_in = 0.0f, lambda_out = INFINITY;
+    const float4 planes[4] = {p0, p1, p2, p3};
+    int miss = 0;
+    for (int i = 0; i < 4; ++i) {
+        const float hd = harc_dot3(planes[i].xyz, d);
+        const float b = harc_dot3(planes[i].xyz, e) + planes[i].w;
+        if (hd > 0.0f)
+            lambda_in = fmax(lambda_in, -b / hd);
+        else if (hd < 0.0f)
+            lambda_out = fmin(lambda_out, b / -hd);
+        else if (b < 0.0f)
+            miss = 1;  /* parallel to face i, outside it */
+    }
+    *l = lambda_out - lambda_in;
+    if (miss || !(*l > 0.0f))
+        return 0;
+    *s_f = harc_dot3(grad.xyz, e + lambda_in * d) + grad.w;
+    *s_b = harc_dot3(grad.xyz, e + lambda_out * d) + grad.w;
+    return 1;
+}
+
 #ifdef CLVR_PROJTET_FRAGMENT
 /* attr[0] = (tet id low 12 bits, tet id high 12 bits, 0, 0), the same at every corner: interpolated
  * constants within a few ulps of integers below 2^12. buffer[0] the tetrahedra, buffer[1] the transfer
@@ -24,32 +55,13 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
     const ClCamera cam = u->camera;
     const float4 counts = u->counts;
     const uint t = (uint)rint(f->attr[0].x) + ((uint)rint(f->attr[0].y) << 12);
-    global const float* tet = r->buffer[0] + (size_t)t * (4 * PROJTET_TET_FLOAT4S);
-    const float4 p0 = vload4(0, tet), p1 = vload4(1, tet), p2 = vload4(2, tet), grad = vload4(3, tet);
-    const float4 p3 = (float4)(-(p0.xyz + p1.xyz + p2.xyz), 1.0f - (p0.w + p1.w + p2.w));
 
     /* The ray through the pixel centre, |d| = 1, as harc's (kernels/ray.h). */
     float3 e, d;
     clvr_ray_unit(clvr_ray_window_offset(f->window, counts.xy, cam), cam, &e, &d);
-
-    /* Inside: b_i(e + λ d) = b_i(e) + λ dot(h_i, d) >= 0 for all four planes. */
-    float lambda_in = 0.0f, lambda_out = INFINITY;
-    const float4 planes[4] = {p0, p1, p2, p3};
-    for (int i = 0; i < 4; ++i) {
-        const float hd = dot(planes[i].xyz, d);
-        const float b = dot(planes[i].xyz, e) + planes[i].w;
-        if (hd > 0.0f)
-            lambda_in = fmax(lambda_in, -b / hd);
-        else if (hd < 0.0f)
-            lambda_out = fmin(lambda_out, b / -hd);
-        else if (b < 0.0f)
-            return 0;  /* parallel to face i, outside it */
-    }
-    const float l = lambda_out - lambda_in;
-    if (!(l > 0.0f))
+    float l, s_f, s_b;
+    if (!projtet_cell_segment(r->buffer[0], t, e, d, &l, &s_f, &s_b))
         return 0;  /* the pixel centre's ray misses (grazes) the cell: no light, no opacity */
-    const float s_f = dot(grad.xyz, e + lambda_in * d) + grad.w;   /* Eq. 6 */
-    const float s_b = dot(grad.xyz, e + lambda_out * d) + grad.w;
     float3 c = (float3)(0.0f);
     float transmittance = 1.0f;
     harc_segment(r->buffer[1], (int)counts.z, r->buffer[2], (int)counts.w, s_f, s_b, l, &c, &transmittance);
@@ -92,27 +104,9 @@ kernel void projtet_fused(global float4* out, global uint* segments, global cons
         const short4 b = boxes[t];
         if (x < b.x || y < b.y || x > b.z || y > b.w)
             continue;
-        global const float* tet = cells + (size_t)t * (4 * PROJTET_TET_FLOAT4S);
-        const float4 p0 = vload4(0, tet), p1 = vload4(1, tet), p2 = vload4(2, tet), grad = vload4(3, tet);
-        const float4 p3 = (float4)(-(p0.xyz + p1.xyz + p2.xyz), 1.0f - (p0.w + p1.w + p2.w));
-        float lambda_in = 0.0f, lambda_out = INFINITY;
-        const float4 planes[4] = {p0, p1, p2, p3};
-        int miss = 0;
-        for (int i = 0; i < 4; ++i) {
-            const float hd = harc_dot3(planes[i].xyz, d);
-            const float bi = harc_dot3(planes[i].xyz, e) + planes[i].w;
-            if (hd > 0.0f)
-                lambda_in = fmax(lambda_in, -bi / hd);
-            else if (hd < 0.0f)
-                lambda_out = fmin(lambda_out, bi / -hd);
-            else if (bi < 0.0f)
-                miss = 1;
-        }
-        const float l = lambda_out - lambda_in;
-        if (miss || !(l > 0.0f))
+        float l, s_f, s_b;
+        if (!projtet_cell_segment(cells, t, e, d, &l, &s_f, &s_b))
             continue;
-        const float s_f = harc_dot3(grad.xyz, e + lambda_in * d) + grad.w;
-        const float s_b = harc_dot3(grad.xyz, e + lambda_out * d) + grad.w;
         float3 c = (float3)(0.0f);
         float transmittance = 1.0f;
         harc_segment(tf, p.counts.x, psi, p.counts.y, s_f, s_b, l, &c, &transmittance);
