@@ -108,6 +108,7 @@ std::uint64_t Ceiling::renderRow(int y, Image4f& image) const
     const glm::vec3 origin(volume_.origin), invSpacing(1.0 / volume_.spacing);
     const glm::ivec3 n = volume_.dims;
     const glm::vec3 last(n - 1);
+    const glm::vec3 top = gridTop(n);
     const float depth0 = static_cast<float>(plan_.depth(0)), deltaS = static_cast<float>(plan_.deltaS);
     const int sliceCount = plan_.count;
     const bool frontToBack = scene_.options.order == Slice3dOptions::Order::FrontToBack;
@@ -141,24 +142,11 @@ std::uint64_t Ceiling::renderRow(int y, Image4f& image) const
             continue;
         }
 
-        // Depth interval inside the grid bounds, widened by one slice each way.
-        float zin = -std::numeric_limits<float>::infinity(), zout = std::numeric_limits<float>::infinity();
-        for (int a = 0; a < 3; ++a) {
-            if (gd[a] == 0.0f) {
-                if (go[a] < 0.0f || go[a] > last[a])
-                    zout = -std::numeric_limits<float>::infinity();
-                continue;
-            }
-            const float t0 = (0.0f - go[a]) / gd[a], t1 = (last[a] - go[a]) / gd[a];
-            zin = std::max(zin, std::min(t0, t1));
-            zout = std::min(zout, std::max(t0, t1));
-        }
-        int kLo = 0, kHi = -1;
-        if (zin <= zout) {
-            const float cnt = static_cast<float>(sliceCount);
-            kLo = static_cast<int>(std::clamp(std::ceil((zin - depth0) / deltaS) - 1.0f, 0.0f, cnt));
-            kHi = static_cast<int>(std::clamp(std::floor((zout - depth0) / deltaS) + 1.0f, -1.0f, cnt - 1.0f));
-        }
+        // Depth interval inside the grid bounds (the kernel's half-open box), widened by one slice each way.
+        float zin, zout;
+        boxChord(go, gd, top, zin, zout);
+        int kLo, kHi;
+        sliceRange(zin, zout, depth0, deltaS, sliceCount, kLo, kHi);
 
         // The slabs at the box faces (kernels/slice3d.cl's slice3d_slab_log2e): the first slice inside the
         // chord reaches back to its entry (from depth 0 on), the last forward to its exit.
@@ -238,8 +226,7 @@ std::uint64_t Ceiling::preintegratedPixel(int x, int y, const glm::vec3& go, con
     const CeilingSegments& seg = *segments_;
     const glm::ivec3 n = volume_.dims;
     const glm::vec3 last(n - 1);
-    const glm::vec3 top(std::nextafter(last.x, INFINITY), std::nextafter(last.y, INFINITY),
-                        std::nextafter(last.z, INFINITY));  // own_hi: the whole grid, half open above
+    const glm::vec3 top = gridTop(n);  // own_hi: the whole grid, half open above
     const float depth0 = static_cast<float>(plan_.depth(0)), deltaS = static_cast<float>(plan_.deltaS);
     const float ertAlpha = scene_.options.earlyTermination < 1.0 ? static_cast<float>(scene_.options.earlyTermination) : 2.0f;
     auto valueAtDepth = [&](float z) {  // slice3d_value_at_depth: the point clamped into the grid

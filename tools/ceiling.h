@@ -94,6 +94,15 @@ private:
     std::vector<glm::vec4> value_;  // their (r, g, b, tau)
 };
 
+// The kernels' half-open grid box [0, top) of a grid with n points per axis: top the next float above n - 1 (the
+// fused kernels' grid_hi / own_hi for a whole grid).
+inline glm::vec3 gridTop(const glm::ivec3& n)
+{
+    const float inf = std::numeric_limits<float>::infinity();
+    return {std::nextafter(static_cast<float>(n.x - 1), inf), std::nextafter(static_cast<float>(n.y - 1), inf),
+            std::nextafter(static_cast<float>(n.z - 1), inf)};
+}
+
 // kernels/volume_sampling.h's clvr_box_chord for the box [0, hi) (hi per axis the next float above the last grid
 // point): the eye-depth interval [zin, zout] of the ray go + z gd inside it, zin > zout where it misses.
 inline void boxChord(const glm::vec3& go, const glm::vec3& gd, const glm::vec3& hi, float& zin, float& zout)

@@ -96,9 +96,7 @@ std::uint64_t Iso3dCeiling::renderRow(int y, Image4f& image) const
     const float scale = cam.params.s[0], aspect = cam.params.s[1];
     const bool parallel = cam.params.s[2] != 0.0f;
     const glm::ivec3 n = volume_.dims;
-    const glm::vec3 top(std::nextafter(static_cast<float>(n.x - 1), std::numeric_limits<float>::infinity()),
-                        std::nextafter(static_cast<float>(n.y - 1), std::numeric_limits<float>::infinity()),
-                        std::nextafter(static_cast<float>(n.z - 1), std::numeric_limits<float>::infinity()));
+    const glm::vec3 top = gridTop(n);
     const float depth0 = static_cast<float>(plan_.depth(0)), deltaS = static_cast<float>(plan_.deltaS);
     const float* values = volume_.values.data();
     std::uint64_t taken = 0;
