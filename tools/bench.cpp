@@ -217,24 +217,32 @@ std::unique_ptr<VolumeCeiling> makeCeiling(const Scene& scene, const Volume& vol
     return nullptr;
 }
 
+// What every ceiling report holds: the loop's threads and frame times (median, min, max, all), its image written
+// beside clvr's and how far the two are apart.
+nlohmann::json ceilingFrames(int threads, const std::vector<double>& ms, const Image4f& ceilingImage,
+                             const Image4f& clvrImage, const fs::path& imagePath)
+{
+    const Spread s = spread(ms);
+    writeImage(imagePath.string(), ceilingImage);
+    const ImageDiff d = imageDiff(clvrImage, ceilingImage);
+    return {{"threads", threads},
+            {"frame_ms", s.median},
+            {"frame_ms_min", s.min},
+            {"frame_ms_max", s.max},
+            {"frame_ms_all", ms},
+            {"image", imagePath.string()},
+            {"image_diff_vs_clvr", {{"mean", d.mean}, {"max", d.max}}}};
+}
+
 nlohmann::json ceilingReport(const VolumeCeiling& ceiling, int threads, const CeilingResult& result,
                              const std::vector<double>& ms, const Image4f& clvrImage, double clvrSamplesPerS,
                              const fs::path& imagePath)
 {
-    const Spread s = spread(ms);
-    const double samplesPerS = result.samples / (s.median * 1e-3);
-    writeImage(imagePath.string(), result.image);
-    const ImageDiff d = imageDiff(clvrImage, result.image);
-    nlohmann::json r = {{"threads", threads},
-                        {"frame_ms", s.median},
-                        {"frame_ms_min", s.min},
-                        {"frame_ms_max", s.max},
-                        {"frame_ms_all", ms},
-                        {"samples", result.samples},
-                        {"samples_per_s", samplesPerS},
-                        {"clvr_ratio", clvrSamplesPerS / samplesPerS},
-                        {"image", imagePath.string()},
-                        {"image_diff_vs_clvr", {{"mean", d.mean}, {"max", d.max}}}};
+    nlohmann::json r = ceilingFrames(threads, ms, result.image, clvrImage, imagePath);
+    const double samplesPerS = result.samples / (r["frame_ms"].get<double>() * 1e-3);
+    r.update({{"samples", result.samples},
+              {"samples_per_s", samplesPerS},
+              {"clvr_ratio", clvrSamplesPerS / samplesPerS}});
     r.update(ceiling.describe());
     return r;
 }
@@ -435,57 +443,43 @@ nlohmann::json benchMeshScene(Device& device, const fs::path& scenePath, const S
     std::cout << " (last frame)\n" << std::flush;
 
     if (ceiling && !walkMs.empty()) {
-        const Spread c = spread(ceilingMs), w = spread(walkMs);
-        const fs::path png = prefix.string() + ".ceiling.png";
-        writeImage(png.string(), ceilingResult.image);
-        const ImageDiff d = imageDiff(image, ceilingResult.image);
-        const double walkStepsPerS = static_cast<double>(f.steps) / (w.median * 1e-3);
-        const double ceilingStepsPerS = static_cast<double>(ceilingResult.steps) / (c.median * 1e-3);
-        r["ceiling"] = {{"threads", threads},
-                        {"frame_ms", c.median},
-                        {"frame_ms_min", c.min},
-                        {"frame_ms_max", c.max},
-                        {"frame_ms_all", ceilingMs},
-                        {"steps", ceilingResult.steps},
-                        {"pieces", ceilingResult.pieces},
-                        {"steps_per_s", ceilingStepsPerS},
-                        {"clvr_walk_ms", w.median},
-                        {"clvr_walk_ms_all", walkMs},
-                        {"clvr_walk_steps_per_s", walkStepsPerS},
-                        {"clvr_ratio", walkStepsPerS / ceilingStepsPerS},
-                        {"image", png.string()},
-                        {"image_diff_vs_clvr", {{"mean", d.mean}, {"max", d.max}}}};
-        std::cout << "  ceiling      walk " << fixed(c.median, 1) << " ms, " << si(ceilingStepsPerS) << " steps/s ("
-                  << threads << " threads, interleaved with clvr's); clvr's walk pass " << fixed(w.median, 1) << " ms, "
+        nlohmann::json& c = r["ceiling"] =
+            ceilingFrames(threads, ceilingMs, ceilingResult.image, image, prefix.string() + ".ceiling.png");
+        const double loopMs = c["frame_ms"].get<double>(), walk = spread(walkMs).median;
+        const double walkStepsPerS = static_cast<double>(f.steps) / (walk * 1e-3);
+        const double ceilingStepsPerS = static_cast<double>(ceilingResult.steps) / (loopMs * 1e-3);
+        c.update({{"steps", ceilingResult.steps},
+                  {"pieces", ceilingResult.pieces},
+                  {"steps_per_s", ceilingStepsPerS},
+                  {"clvr_walk_ms", walk},
+                  {"clvr_walk_ms_all", walkMs},
+                  {"clvr_walk_steps_per_s", walkStepsPerS},
+                  {"clvr_ratio", walkStepsPerS / ceilingStepsPerS}});
+        std::cout << "  ceiling      walk " << fixed(loopMs, 1) << " ms, " << si(ceilingStepsPerS) << " steps/s ("
+                  << threads << " threads, interleaved with clvr's); clvr's walk pass " << fixed(walk, 1) << " ms, "
                   << si(walkStepsPerS) << " steps/s: " << fixed(100.0 * walkStepsPerS / ceilingStepsPerS, 1)
                   << "% of it; steps " << ceilingResult.steps << " vs " << f.steps << ", image |diff| max "
-                  << fixed(d.max, 4) << ", mean " << fixed(d.mean, 5) << '\n'
+                  << fixed(c["image_diff_vs_clvr"]["max"].get<double>(), 4) << ", mean "
+                  << fixed(c["image_diff_vs_clvr"]["mean"].get<double>(), 5) << '\n'
                   << std::flush;
     }
 
     if (projtetCeiling) {
-        const Spread c = spread(ceilingMs), w = spread(drawMs);
-        const fs::path png = prefix.string() + ".ceiling.png";
-        writeImage(png.string(), projtetResult.image);
-        const ImageDiff d = imageDiff(image, projtetResult.image);
-        r["ceiling"] = {{"threads", threads},
-                        {"frame_ms", c.median},
-                        {"frame_ms_min", c.min},
-                        {"frame_ms_max", c.max},
-                        {"frame_ms_all", ceilingMs},
-                        {"pixels_tested", projtetResult.pixelsTested},
-                        {"segments", projtetResult.segments},
-                        {"clvr_draw_ms", w.median},
-                        {"clvr_draw_ms_all", drawMs},
-                        {"clvr_ratio", c.median / w.median},
-                        {"image", png.string()},
-                        {"image_diff_vs_clvr", {{"mean", d.mean}, {"max", d.max}}}};
-        std::cout << "  ceiling      projection and draw " << fixed(c.median, 1) << " ms (" << threads
+        nlohmann::json& c = r["ceiling"] =
+            ceilingFrames(threads, ceilingMs, projtetResult.image, image, prefix.string() + ".ceiling.png");
+        const double loopMs = c["frame_ms"].get<double>(), draw = spread(drawMs).median;
+        c.update({{"pixels_tested", projtetResult.pixelsTested},
+                  {"segments", projtetResult.segments},
+                  {"clvr_draw_ms", draw},
+                  {"clvr_draw_ms_all", drawMs},
+                  {"clvr_ratio", loopMs / draw}});
+        std::cout << "  ceiling      projection and draw " << fixed(loopMs, 1) << " ms (" << threads
                   << " threads, interleaved with clvr's; " << si(static_cast<double>(projtetResult.segments))
                   << " segments of " << si(static_cast<double>(projtetResult.pixelsTested))
-                  << " pixels tested); clvr's projection and draw " << fixed(w.median, 1) << " ms: "
-                  << fixed(100.0 * c.median / w.median, 1) << "% of its speed; image |diff| max " << fixed(d.max, 4)
-                  << ", mean " << fixed(d.mean, 5) << '\n'
+                  << " pixels tested); clvr's projection and draw " << fixed(draw, 1) << " ms: "
+                  << fixed(100.0 * loopMs / draw, 1) << "% of its speed; image |diff| max "
+                  << fixed(c["image_diff_vs_clvr"]["max"].get<double>(), 4) << ", mean "
+                  << fixed(c["image_diff_vs_clvr"]["mean"].get<double>(), 5) << '\n'
                   << std::flush;
     }
 
