@@ -99,6 +99,10 @@ std::uint64_t Iso3dCeiling::renderRow(int y, Image4f& image) const
     const glm::vec3 top = gridTop(n);
     const float depth0 = static_cast<float>(plan_.depth(0)), deltaS = static_cast<float>(plan_.deltaS);
     const float* values = volume_.values.data();
+    auto onGrid = [&](const glm::vec3& g) {  // kernels/volume_sampling.h's clvr_grid_inside
+        return g.x >= 0.0f && g.y >= 0.0f && g.z >= 0.0f && g.x <= static_cast<float>(n.x - 1) &&
+               g.y <= static_cast<float>(n.y - 1) && g.z <= static_cast<float>(n.z - 1);
+    };
     std::uint64_t taken = 0;
     for (int x = 0; x < width_; ++x) {
         // kernels/ray.h: the pixel's offset and its ray o + z d, z the eye depth
@@ -110,10 +114,6 @@ std::uint64_t Iso3dCeiling::renderRow(int y, Image4f& image) const
         else
             d = forward + sx * right + sy * up;
         const glm::vec3 go = (o - origin_) * invSpacing_, gd = d * invSpacing_;
-        float z0, z1;
-        boxChord(go, gd, top, z0, z1);
-        int kLo, kHi;
-        sliceRange(z0, z1, depth0, deltaS, plan_.count, kLo, kHi);
         glm::vec4 out(background_, 0.0f);
         // The hit's color: iso3d_color, then the shading color matrix and the finish pass's clamp.
         auto shade = [&](const glm::vec4& t) {
@@ -131,8 +131,7 @@ std::uint64_t Iso3dCeiling::renderRow(int y, Image4f& image) const
                     continue;
                 for (int k = dr.kLo; k <= dr.kHi && !hit; ++k) {
                     const glm::vec3 g = go + (depth0 + static_cast<float>(k) * deltaS) * gd;
-                    if (!(g.x >= 0.0f && g.y >= 0.0f && g.z >= 0.0f && g.x <= static_cast<float>(n.x - 1) &&
-                          g.y <= static_cast<float>(n.y - 1) && g.z <= static_cast<float>(n.z - 1)))
+                    if (!onGrid(g))
                         continue;  // not on the slice polygon: no fragment
                     ++taken;
                     if (g.x < b.lo.x || g.y < b.lo.y || g.z < b.lo.z || g.x >= b.end.x || g.y >= b.end.y || g.z >= b.end.z)
@@ -149,10 +148,13 @@ std::uint64_t Iso3dCeiling::renderRow(int y, Image4f& image) const
             image.at(x, y) = out;
             continue;
         }
+        float z0, z1;
+        boxChord(go, gd, top, z0, z1);
+        int kLo, kHi;
+        sliceRange(z0, z1, depth0, deltaS, plan_.count, kLo, kHi);
         for (int k = kLo; k <= kHi; ++k) {
             const glm::vec3 g = go + (depth0 + static_cast<float>(k) * deltaS) * gd;
-            if (!(g.x >= 0.0f && g.y >= 0.0f && g.z >= 0.0f && g.x <= static_cast<float>(n.x - 1) &&
-                  g.y <= static_cast<float>(n.y - 1) && g.z <= static_cast<float>(n.z - 1)))
+            if (!onGrid(g))
                 continue;
             if (skip_) {  // kernels/empty_space.h's clvr_brick and clvr_space: no sample in an empty brick
                 const glm::ivec3 b(std::min(static_cast<int>(g.x), n.x - 2) >> 2, std::min(static_cast<int>(g.y), n.y - 2) >> 2,
