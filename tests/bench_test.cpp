@@ -355,12 +355,9 @@ TEST(Iso3dCeiling, DoesTheFusedPathsWork)
                 const clvr::Image4f& kernel = run.kernel;
                 const clvr::FrameStats& stats = run.stats;
                 const clvr::tools::CeilingResult& result = run.ceiling;
-                std::size_t differ = 0;
-                for (std::size_t p = 0; p < kernel.pixelCount(); ++p) {
-                    const glm::vec4 d = glm::abs(kernel.pixels()[p] - result.image.pixels()[p]);
-                    differ += std::max({d.r, d.g, d.b, d.a}) > 1e-5f ? 1 : 0;
-                    hitPixels += kernel.pixels()[p].a > 0.5f ? 1 : 0;
-                }
+                const std::size_t differ = pixelsApart(kernel, result.image).over;
+                for (const glm::vec4& p : kernel.pixels())
+                    hitPixels += p.a > 0.5f ? 1 : 0;
                 std::printf("[ measured ] iso3d ceiling vs kernel (%s): %zu of %zu pixels over 1e-5; samples %llu vs %llu\n",
                             what.c_str(), differ, kernel.pixelCount(), static_cast<unsigned long long>(result.samples),
                             static_cast<unsigned long long>(stats.samples));
