@@ -30,9 +30,9 @@ __attribute__((always_inline)) int projtet_cell_segment(global const float* cell
         const float hd = harc_dot3(planes[i].xyz, d);
         const float b = harc_dot3(planes[i].xyz, e) + planes[i].w;
         if (hd > 0.0f)
-            lambda_in = fmax(lambda_in, -b / hd);
+            lambda_in = fmax(lambda_in, -(b / hd));
         else if (hd < 0.0f)
-            lambda_out = fmin(lambda_out, b / -hd);
+            lambda_out = fmin(lambda_out, -(b / hd));  /* b / -hd: IEEE division rounds |b| / |hd| either way */
         else if (b < 0.0f)
             miss = 1;  /* parallel to face i, outside it */
     }
@@ -120,93 +120,170 @@ kernel void projtet_fused(global float4* out, global uint* segments, global cons
     segments[i] = n;
 }
 
-/* projtet_fused for the 8 pixels x0 .. x0 + 7 of a row, one per float8 lane (kernels/segment_integral8.h): a tile is
- * 8 pixels wide, so the 8 lanes walk the same cells; each cell's planes are loaded once and met by the 8 rays as
- * vectors, and its segment is integrated for the lanes whose ray meets it. Every lane does projtet_fused's
- * operations (the dot products written out in both), so its pixel is the same bits. */
+/* projtet_fused for one tile (8 x 4 pixels, a work-item each), its segments integrated 8 at a time, one per float8
+ * lane (kernels/segment_integral8.h). Each cell's planes are loaded once and met by the rays of each of the tile's rows
+ * that its box reaches, 8 as vectors; the segments those rays have (l > 0) join a queue in the tile list's order, and
+ * each time 8 are queued they are integrated together — whichever pixels they belong to — and blended into their
+ * pixels in queue order, which keeps each pixel's cells back to front. So the integration, most of the work, runs
+ * with every lane busy where the cells are a few pixels wide (a row's 8 lanes would hold one or two segments).
+ * Every lane does projtet_fused's operations (the dot products written out in both), so its pixel is the same bits. */
+typedef struct {
+    float s_f[16], s_b[16], l[16];  /* a row's ≤ 8 segments join ≤ 7 waiting ones (its 8 lanes written) */
+    int pixel[16];                  /* in the tile: row * 8 + column */
+    int count;
+} ProjtetQueue;
+
+typedef struct {
+    float r[32], g[32], b[32], alpha[32];  /* the raster stage's blend, per pixel of the tile */
+    uint n[32];                            /* segments blended */
+} ProjtetTile;
+
+/* Integrates the first min(count, 8) queued segments as lanes, blends each into its pixel in queue order, and moves
+ * the rest to the queue's front. */
+void projtet_drain8(ProjtetQueue* q, ProjtetTile* acc, global const float* tf, const int n, global const float* psi,
+                    const int psi_n)
+{
+    const int lanes = min(q->count, 8);
+    const int8 m = CLVR_LANE_INDEX < lanes;
+    const float8 s_f = vload8(0, q->s_f), s_b = vload8(0, q->s_b), l = vload8(0, q->l);
+    HarcTfPoint8 front, back;
+    front.s = s_f, front.k = 0, front.r = front.g = front.b = front.w = 0.0f;
+#define PROJTET_FRONT(L)                                                                                               \
+    if (m.s##L) {                                                                                                      \
+        const HarcTfPoint f = harc_tf_point(tf, n, s_f.s##L);                                                          \
+        front.k.s##L = f.k, front.r.s##L = f.c.x, front.g.s##L = f.c.y, front.b.s##L = f.c.z, front.w.s##L = f.c.w;     \
+    }
+    CLVR_EACH_LANE(PROJTET_FRONT)
+#undef PROJTET_FRONT
+    back = front;
+    float8 c_r = 0.0f, c_g = 0.0f, c_b = 0.0f, transmittance = 1.0f;
+    harc_segment_from8(tf, n, psi, psi_n, &front, s_b, l, m, &c_r, &c_g, &c_b, &transmittance, &back);
+    const float8 src_alpha = 1.0f - transmittance;
+    float cr[8], cg[8], cb[8], ca[8];
+    vstore8(c_r, 0, cr), vstore8(c_g, 0, cg), vstore8(c_b, 0, cb), vstore8(src_alpha, 0, ca);
+    for (int i = 0; i < lanes; ++i) {
+        const int at = q->pixel[i];
+        acc->r[at] = cr[i] + (1.0f - ca[i]) * acc->r[at];
+        acc->g[at] = cg[i] + (1.0f - ca[i]) * acc->g[at];
+        acc->b[at] = cb[i] + (1.0f - ca[i]) * acc->b[at];
+        acc->alpha[at] = ca[i] + (1.0f - ca[i]) * acc->alpha[at];
+        ++acc->n[at];
+    }
+    for (int i = lanes; i < q->count; ++i) {
+        q->s_f[i - lanes] = q->s_f[i], q->s_b[i - lanes] = q->s_b[i], q->l[i - lanes] = q->l[i];
+        q->pixel[i - lanes] = q->pixel[i];
+    }
+    q->count -= lanes;
+}
+
+/* How many tile entries ahead the cell data is prefetched. */
+#ifndef PROJTET_AHEAD
+#define PROJTET_AHEAD 4
+#endif
+
 kernel void projtet_fused_packet(global float4* out, global uint* segments, global const uint* tile_start,
                                  global const uint* tile_cells, global const short4* boxes, global const float* cells,
                                  global const float* tf, global const float* psi, const ClProjtetFusedParams p)
 {
-    const int x0 = (int)get_global_id(0) * 8, y = (int)get_global_id(1);
-    if (x0 >= p.size.x || y >= p.size.y)
+    const int tx = (int)get_global_id(0), ty = (int)get_global_id(1);
+    if (tx >= p.size.z || ty >= p.size.w)
         return;
-    const int8 xs = x0 + (int8)(0, 1, 2, 3, 4, 5, 6, 7);
+    const int x0 = tx << PROJTET_TILE_W_LOG2, y0 = ty << PROJTET_TILE_H_LOG2;
+    const int rows = min(1 << PROJTET_TILE_H_LOG2, p.size.y - y0);
+    const int8 xs = x0 + CLVR_LANE_INDEX;
     const int8 valid = xs < p.size.x;
-    const int tile = (y >> PROJTET_TILE_H_LOG2) * p.size.z + (x0 >> PROJTET_TILE_W_LOG2);
     const float2 size = (float2)((float)p.size.x, (float)p.size.y);
-    float8 e_x, e_y, e_z, d_x, d_y, d_z;
+    float8 e_x[4], e_y[4], e_z[4], d_x[4], d_y[4], d_z[4];
+    for (int row = 0; row < rows; ++row) {
 #define PROJTET_RAY(L)                                                                                                 \
-    {                                                                                                                  \
-        float3 e, d;                                                                                                   \
-        clvr_ray_unit(clvr_ray_window_offset(clvr_ray_pixel_centre(min(x0 + L, p.size.x - 1), y), size, p.camera),   \
-                      p.camera, &e, &d);                                                                               \
-        e_x.s##L = e.x, e_y.s##L = e.y, e_z.s##L = e.z, d_x.s##L = d.x, d_y.s##L = d.y, d_z.s##L = d.z;                \
-    }
-    CLVR_EACH_LANE(PROJTET_RAY)
+        {                                                                                                              \
+            float3 e, d;                                                                                               \
+            clvr_ray_unit(clvr_ray_window_offset(clvr_ray_pixel_centre(min(x0 + L, p.size.x - 1), y0 + row), size,     \
+                                                 p.camera),                                                           \
+                          p.camera, &e, &d);                                                                           \
+            e_x[row].s##L = e.x, e_y[row].s##L = e.y, e_z[row].s##L = e.z;                                             \
+            d_x[row].s##L = d.x, d_y[row].s##L = d.y, d_z[row].s##L = d.z;                                             \
+        }
+        CLVR_EACH_LANE(PROJTET_RAY)
 #undef PROJTET_RAY
-    float8 dst_r = 0.0f, dst_g = 0.0f, dst_b = 0.0f, dst_alpha = 0.0f;
-    int8 n = 0;
+    }
+    const int eye = !clvr_ray_parallel(p.camera);  /* every ray from the eye, else every ray along forward */
+    const float3 e0 = (float3)(e_x[0].s0, e_y[0].s0, e_z[0].s0), d0 = (float3)(d_x[0].s0, d_y[0].s0, d_z[0].s0);
+    ProjtetTile acc;
+    for (int i = 0; i < 32; ++i)
+        acc.r[i] = acc.g[i] = acc.b[i] = acc.alpha[i] = 0.0f, acc.n[i] = 0;
+    ProjtetQueue q;
+    for (int i = 0; i < 16; ++i)
+        q.s_f[i] = q.s_b[i] = q.l[i] = 0.0f, q.pixel[i] = 0;
+    q.count = 0;
+    const int tile = ty * p.size.z + tx;
     const uint end = tile_start[tile + 1];
     for (uint k = tile_start[tile]; k < end; ++k) {
         const uint t = tile_cells[k];
+        if (k + PROJTET_AHEAD < end) {  /* the cells are in visibility order, scattered in memory */
+            const uint ahead = tile_cells[k + PROJTET_AHEAD];
+            CLVR_PREFETCH(boxes + ahead, 1);
+            CLVR_PREFETCH(cells + (size_t)ahead * (4 * PROJTET_TET_FLOAT4S), 4 * PROJTET_TET_FLOAT4S);
+        }
         const short4 b = boxes[t];
-        if (y < b.y || y > b.w)
-            continue;
-        int8 m = valid & (xs >= (int)b.x) & (xs <= (int)b.z);
-        if (!any(m))
+        const int row_lo = max((int)b.y - y0, 0), row_hi = min((int)b.w - y0, rows - 1);
+        const int8 columns = valid & (xs >= (int)b.x) & (xs <= (int)b.z);
+        if (row_lo > row_hi || !any(columns))
             continue;
         global const float* tet = cells + (size_t)t * (4 * PROJTET_TET_FLOAT4S);
         const float4 p0 = vload4(0, tet), p1 = vload4(1, tet), p2 = vload4(2, tet), grad = vload4(3, tet);
         const float4 p3 = (float4)(-(p0.xyz + p1.xyz + p2.xyz), 1.0f - (p0.w + p1.w + p2.w));
         const float4 planes[4] = {p0, p1, p2, p3};
-        float8 lambda_in = 0.0f, lambda_out = INFINITY;
-        int8 miss = 0;
-        for (int i = 0; i < 4; ++i) {
-            const float4 h = planes[i];
-            const float8 hd = harc_dot8((float8)(h.x), (float8)(h.y), (float8)(h.z), d_x, d_y, d_z);
-            const float8 bi = harc_dot8((float8)(h.x), (float8)(h.y), (float8)(h.z), e_x, e_y, e_z) + h.w;
-            const int8 enter = isgreater(hd, 0.0f), leave = isless(hd, 0.0f);
-            lambda_in = select(lambda_in, fmax(lambda_in, -bi / hd), enter);
-            lambda_out = select(lambda_out, fmin(lambda_out, bi / -hd), leave);
-            miss |= ~enter & ~leave & isless(bi, 0.0f);
-        }
-        const float8 l = lambda_out - lambda_in;
-        m &= ~miss & isgreater(l, 0.0f);
-        if (!any(m))
-            continue;
         const float8 gx = (float8)(grad.x), gy = (float8)(grad.y), gz = (float8)(grad.z);
-        const float8 s_f = harc_dot8(gx, gy, gz, e_x + lambda_in * d_x, e_y + lambda_in * d_y, e_z + lambda_in * d_z) + grad.w;
-        const float8 s_b = harc_dot8(gx, gy, gz, e_x + lambda_out * d_x, e_y + lambda_out * d_y, e_z + lambda_out * d_z) + grad.w;
-        HarcTfPoint8 front, back;
-        front.s = s_f, front.k = 0, front.r = front.g = front.b = front.w = 0.0f;
-#define PROJTET_FRONT(L)                                                                                               \
-        if (m.s##L) {                                                                                                  \
-            const HarcTfPoint q = harc_tf_point(tf, p.counts.x, s_f.s##L);                                             \
-            front.k.s##L = q.k, front.r.s##L = q.c.x, front.g.s##L = q.c.y, front.b.s##L = q.c.z, front.w.s##L = q.c.w; \
+        /* What the tile's rays share, once per cell: from one eye, b_i(e); along one direction (parallel), dot(h_i, d) */
+        float shared[4];
+        for (int i = 0; i < 4; ++i)
+            shared[i] = eye ? harc_dot3(planes[i].xyz, e0) + planes[i].w : harc_dot3(planes[i].xyz, d0);
+        for (int row = row_lo; row <= row_hi; ++row) {
+            float8 lambda_in = 0.0f, lambda_out = INFINITY;
+            int8 miss = 0;
+            for (int i = 0; i < 4; ++i) {
+                const float4 h = planes[i];
+                const float8 hd = eye ? harc_dot8((float8)(h.x), (float8)(h.y), (float8)(h.z), d_x[row], d_y[row], d_z[row])
+                                      : (float8)(shared[i]);
+                const float8 bi = eye ? (float8)(shared[i])
+                                      : harc_dot8((float8)(h.x), (float8)(h.y), (float8)(h.z), e_x[row], e_y[row], e_z[row]) + h.w;
+                const int8 enter = isgreater(hd, 0.0f), leave = isless(hd, 0.0f);
+                const float8 at = -(bi / hd);  /* -b/h and b/-h alike: IEEE division rounds |b|/|h| either way */
+                lambda_in = select(lambda_in, fmax(lambda_in, at), enter);
+                lambda_out = select(lambda_out, fmin(lambda_out, at), leave);
+                miss |= ~enter & ~leave & isless(bi, 0.0f);
+            }
+            const float8 l = lambda_out - lambda_in;
+            const int8 m = columns & ~miss & isgreater(l, 0.0f);
+            if (!any(m))
+                continue;
+            const float8 s_f = harc_dot8(gx, gy, gz, e_x[row] + lambda_in * d_x[row], e_y[row] + lambda_in * d_y[row],
+                                         e_z[row] + lambda_in * d_z[row]) + grad.w;
+            const float8 s_b = harc_dot8(gx, gy, gz, e_x[row] + lambda_out * d_x[row], e_y[row] + lambda_out * d_y[row],
+                                         e_z[row] + lambda_out * d_z[row]) + grad.w;
+#define PROJTET_QUEUE(L)                                                                                               \
+            if (m.s##L) {                                                                                              \
+                q.s_f[q.count] = s_f.s##L, q.s_b[q.count] = s_b.s##L, q.l[q.count] = l.s##L;                           \
+                q.pixel[q.count++] = row * 8 + L;                                                                      \
+            }
+            CLVR_EACH_LANE(PROJTET_QUEUE)
+#undef PROJTET_QUEUE
+            if (q.count >= 8)
+                projtet_drain8(&q, &acc, tf, p.counts.x, psi, p.counts.y);
         }
-        CLVR_EACH_LANE(PROJTET_FRONT)
-#undef PROJTET_FRONT
-        back = front;
-        float8 c_r = 0.0f, c_g = 0.0f, c_b = 0.0f, transmittance = 1.0f;
-        harc_segment_from8(tf, p.counts.x, psi, p.counts.y, &front, s_b, l, m, &c_r, &c_g, &c_b, &transmittance, &back);
-        const float8 src_alpha = 1.0f - transmittance;
-        dst_r = select(dst_r, c_r + (1.0f - src_alpha) * dst_r, m);
-        dst_g = select(dst_g, c_g + (1.0f - src_alpha) * dst_g, m);
-        dst_b = select(dst_b, c_b + (1.0f - src_alpha) * dst_b, m);
-        dst_alpha = select(dst_alpha, src_alpha + (1.0f - src_alpha) * dst_alpha, m);
-        n -= m;
     }
-    const float8 r = dst_r + (1.0f - dst_alpha) * p.background.x, g = dst_g + (1.0f - dst_alpha) * p.background.y,
-                 bl = dst_b + (1.0f - dst_alpha) * p.background.z;
-    const size_t row = (size_t)y * (size_t)p.size.x;
-#define PROJTET_STORE(L)                                                                                               \
-    if (valid.s##L) {                                                                                                  \
-        out[row + x0 + L] = (float4)(r.s##L, g.s##L, bl.s##L, dst_alpha.s##L);                                         \
-        segments[row + x0 + L] = (uint)n.s##L;                                                                         \
-    }
-    CLVR_EACH_LANE(PROJTET_STORE)
-#undef PROJTET_STORE
+    if (q.count > 0)
+        projtet_drain8(&q, &acc, tf, p.counts.x, psi, p.counts.y);
+    for (int row = 0; row < rows; ++row)
+        for (int c = 0; c < 8 && x0 + c < p.size.x; ++c) {
+            const int at = row * 8 + c;
+            const float a = acc.alpha[at];
+            const size_t i = (size_t)(y0 + row) * (size_t)p.size.x + (size_t)(x0 + c);
+            out[i] = (float4)(acc.r[at] + (1.0f - a) * p.background.x, acc.g[at] + (1.0f - a) * p.background.y,
+                              acc.b[at] + (1.0f - a) * p.background.z, a);
+            segments[i] = acc.n[at];
+        }
 }
 
 #endif

@@ -18,7 +18,7 @@ typedef struct {
 typedef struct {
     ClCamera camera;       /* as ClProjtetUniforms' */
     cl_float4 background;  /* the scene's, w unused */
-    cl_int4 size;          /* (width, height, tiles per row, 0) */
+    cl_int4 size;          /* (width, height, tiles per row, tile rows) */
     cl_int4 counts;        /* (transfer-function control points, ψ table size, 0, 0) */
 } ClProjtetFusedParams;    /* 128 bytes */
 

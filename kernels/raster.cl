@@ -233,12 +233,7 @@ __attribute__((always_inline)) void clvr_shade(global const ClTriangle* t, globa
 /* Triangle records are fetched this many tile-list entries ahead: tile lists jump through the
  * triangle buffer, so without it every entry waits for memory. */
 #define CLVR_PREFETCH_AHEAD 8
-#if defined(__clang__) && defined(__x86_64__)
-/* PoCL's prefetch() does nothing; on x86 fetch the record's first two cache lines (header, attribute 0). */
-#define CLVR_PREFETCH(p, n) __asm__ volatile("prefetcht0 (%0)\n\tprefetcht0 64(%0)" : : "r"(p))
-#else
-#define CLVR_PREFETCH(p, n) prefetch((p), (n))
-#endif
+/* (CLVR_PREFETCH, kernels/clvr_common.h: on x86 the record's first two cache lines, header and attribute 0) */
 
 /* One work-item per item of the pass (ClRasterPass). The item walks its tile's list once, in
  * submission order, and for each triangle the pixels of the triangle's col/row bounds (which include

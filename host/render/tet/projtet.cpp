@@ -806,7 +806,7 @@ Image4f ProjtetRenderer::renderFused(const VisibilitySorter::Result& sorted, std
     ClProjtetFusedParams p{};
     p.camera = toClCamera(camera_, width, height, shift_);
     p.background = toCl4(image_.background, 0.0);
-    p.size = cl_int4{{width, height, tilesX, 0}};
+    p.size = cl_int4{{width, height, tilesX, tilesY}};
     p.counts = cl_int4{{static_cast<cl_int>(tf_.count()), static_cast<cl_int>(psiTable().size), 0, 0}};
     int a = 0;
     fused_.setArg(a++, fusedOut_);
@@ -818,9 +818,8 @@ Image4f ProjtetRenderer::renderFused(const VisibilitySorter::Result& sorted, std
     fused_.setArg(a++, tf_.buffer());
     fused_.setArg(a++, psi_);
     fused_.setArg(a++, p);
-    if (packet_)  // a work-item per 8 pixels of a row: a tile's row
-        device_.launch("projtet: fused", fused_, static_cast<std::size_t>(tilesX), static_cast<std::size_t>(height), 1,
-                       kProjtetTileH);
+    if (packet_)  // a work-item per tile
+        device_.launch("projtet: fused", fused_, static_cast<std::size_t>(tilesX), static_cast<std::size_t>(tilesY), 1, 1);
     else
         device_.launch("projtet: fused", fused_, static_cast<std::size_t>(width), static_cast<std::size_t>(height),
                        kProjtetTileW, kProjtetTileH);
