@@ -128,7 +128,7 @@ kernel void projtet_fused(global float4* out, global uint* segments, global cons
  * with every lane busy where the cells are a few pixels wide (a row's 8 lanes would hold one or two segments).
  * Every lane does projtet_fused's operations (the dot products written out in both), so its pixel is the same bits. */
 typedef struct {
-    float s_f[16], s_b[16], l[16];  /* a row's ≤ 8 segments join ≤ 7 waiting ones (its 8 lanes written) */
+    float s_f[16], s_b[16], l[16];  /* a row's ≤ 8 segments join ≤ 7 waiting ones */
     int pixel[16];                  /* in the tile: row * 8 + column */
     int count;
 } ProjtetQueue;
@@ -176,10 +176,8 @@ void projtet_drain8(ProjtetQueue* q, ProjtetTile* acc, global const float* tf, c
     q->count -= lanes;
 }
 
-/* How many tile entries ahead the cell data is prefetched. */
-#ifndef PROJTET_AHEAD
+/* How many tile entries ahead the cells are prefetched (measured on bluntfin: 2, 4 and 8; BENCHMARKS.md run PF3). */
 #define PROJTET_AHEAD 4
-#endif
 
 kernel void projtet_fused_packet(global float4* out, global uint* segments, global const uint* tile_start,
                                  global const uint* tile_cells, global const short4* boxes, global const float* cells,
