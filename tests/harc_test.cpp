@@ -321,9 +321,10 @@ TEST(HarcLayout, CellOrderPlacesNeighboursNearAndMapsTheAdjacency)
     EXPECT_EQ(harcDeviceCode(4 * 9 + 3, slot), static_cast<std::int32_t>(4 * slot[9] + 3));
 }
 
-// buildHarcEntryLists against every pixel's ray tested against every boundary face (no boxes, no bands): the same
-// test (kernels/harc.cl's walk needs these exact lists: the faces a ray enters through, λ >= 0, margins at the
-// edges), sorted by λ, then code. Perspective from outside and from inside (faces behind the eye clipped), parallel,
+// buildHarcEntryLists against every pixel's ray tested against every boundary face (no boxes, no bands) by the
+// textbook Möller–Trumbore test with its divisions, which buildHarcEntryLists computes as affine functions per face
+// without them (kernels/harc.cl's walk needs these exact lists: the faces a ray enters through, λ >= 0, margins at
+// the edges), sorted by λ, then code. Perspective from outside and from inside (faces behind the eye clipped), parallel,
 // a sort-first band of rows, sizes that are no multiple of the 8-row bands.
 HarcEntryLists bruteForceEntryLists(const TetMesh& mesh, const TetTopology& topology, const Camera& camera, int width,
                                     int height)

@@ -595,9 +595,14 @@ HarcEntryLists buildHarcEntryLists(const TetMesh& mesh, const TetTopology& topol
                                    int width, int height)
 {
     // A boundary face that faces the eye, its pixel box and its entry code.
+    // A boundary face that faces the eye, its pixel box and its entry code, and Möller–Trumbore's quantities for a
+    // ray e + λ d as affine functions of what varies from pixel to pixel, v − anchor: the direction d from one eye
+    // (anchor 0), or the origin e along one direction (parallel; anchor p0). With n = (p1 − p0) × (p2 − p0),
+    // t = e − p0: det = d · (e2 × e1), det·u = t · (d × e2), det·v = d · (t × e1), det·λ = e2 · (t × e1).
     struct FrontFace {
-        std::array<glm::dvec3, 3> p;
-        glm::dvec3 normal;
+        glm::dvec3 anchor;
+        std::array<glm::dvec3, 4> w;  // det, det·u, det·v, det·λ: dot(v − anchor, w[i]) + w0[i]
+        std::array<double, 4> w0;
         int x0, x1, y0, y1;
         std::int32_t code;
     };
@@ -670,8 +675,22 @@ HarcEntryLists buildHarcEntryLists(const TetMesh& mesh, const TetTopology& topol
                 }
                 if (x0 > x1 || y0 > y1)
                     continue;
-                local.push_back({p, normal, static_cast<int>(x0), static_cast<int>(x1), static_cast<int>(y0),
-                                 static_cast<int>(y1), static_cast<std::int32_t>(bf.tet * 4 + bf.face)});
+                FrontFace face{};
+                const glm::dvec3 e1 = p[1] - p[0], e2 = p[2] - p[0];
+                if (camera.parallel) {  // v = e: t = v − p0; d = forward
+                    face.anchor = p[0];
+                    face.w = {glm::dvec3(0.0), glm::cross(f, e2), glm::cross(e1, f), normal};
+                    face.w0 = {-glm::dot(f, normal), 0.0, 0.0, 0.0};
+                } else {  // v = d: t = eye − p0 for every ray
+                    const glm::dvec3 t = camera.position - p[0], q = glm::cross(t, e1);
+                    face.anchor = glm::dvec3(0.0);
+                    face.w = {-normal, glm::cross(e2, t), q, glm::dvec3(0.0)};
+                    face.w0 = {0.0, 0.0, 0.0, glm::dot(e2, q)};
+                }
+                face.x0 = static_cast<int>(x0), face.x1 = static_cast<int>(x1);
+                face.y0 = static_cast<int>(y0), face.y1 = static_cast<int>(y1);
+                face.code = static_cast<std::int32_t>(bf.tet * 4 + bf.face);
+                local.push_back(face);
             }
         }
         const std::lock_guard<std::mutex> lock(merge);
@@ -730,29 +749,23 @@ HarcEntryLists buildHarcEntryLists(const TetMesh& mesh, const TetTopology& topol
             hits.clear();
             for (std::uint32_t k = binStart[band]; k < binStart[band + 1]; ++k) {
                 const FrontFace& face = *bin[k];
-                const std::array<glm::dvec3, 3>& p = face.p;
-                const glm::dvec3 e1 = p[1] - p[0], e2 = p[2] - p[0];
                 for (int y = std::max(face.y0, rowLo); y <= std::min(face.y1, rowHi); ++y)
                     for (int x = face.x0; x <= face.x1; ++x) {
                         const Ray ray =
                             table ? bandRays[static_cast<std::size_t>(y - rowLo) * columns + (x - x0)] : rays.at(x, y);
-                        if (!(glm::dot(face.normal, ray.direction) < 0.0))
-                            continue;  // back face (or edge-on) for this ray
-                        // Möller–Trumbore, edges included with a small margin so that no ray slips between
-                        // two faces that share an edge (a duplicate is skipped by the walk).
-                        const glm::dvec3 pv = glm::cross(ray.direction, e2);
-                        const double det = glm::dot(e1, pv);
-                        if (det == 0.0)
+                        const glm::dvec3 v = (camera.parallel ? ray.origin : ray.direction) - face.anchor;
+                        // Möller–Trumbore without its divisions: det > 0 where the ray enters through the face (a
+                        // back face or edge-on: det <= 0), and the barycentric coordinates u, v and 1 − u − v each
+                        // >= −1e-7, a small margin so that no ray slips between two faces that share an edge (a
+                        // duplicate is skipped by the walk).
+                        const double det = glm::dot(v, face.w[0]) + face.w0[0];
+                        if (!(det > 0.0))
                             continue;
-                        const double inv = 1.0 / det;
-                        const glm::dvec3 tv0 = ray.origin - p[0];
-                        const double bu = glm::dot(tv0, pv) * inv;
-                        const glm::dvec3 qv = glm::cross(tv0, e1);
-                        const double bv = glm::dot(ray.direction, qv) * inv;
                         constexpr double kMargin = 1e-7;
-                        if (bu < -kMargin || bv < -kMargin || bu + bv > 1.0 + kMargin)
+                        const double du = glm::dot(v, face.w[1]), dv = glm::dot(v, face.w[2]);
+                        if (du < -kMargin * det || dv < -kMargin * det || du + dv > (1.0 + kMargin) * det)
                             continue;
-                        const double lambda = glm::dot(e2, qv) * inv;
+                        const double lambda = (glm::dot(v, face.w[3]) + face.w0[3]) / det;
                         if (!(lambda >= 0.0))
                             continue;
                         hits.push_back({static_cast<std::uint32_t>(static_cast<std::size_t>(y) * width + x - firstPixel),
