@@ -143,8 +143,8 @@ int8 harc_segment_from8(global const float* tf, const int n, global const float*
         k -= more & 1;
     }
     global const float* value = tf + ((n + 3) & ~3);
-    float8 tk; /* the control point at each lane's k (clamped), kept for the back end below */
     for (;;) {
+        float8 tk;
         CLVR_GATHER8(tk, tf, clamp(k, 0, n - 1));
         const int8 next = (up & (k < n) & isless(tk, s_b)) | (down & (k >= 0) & isgreater(tk, s_b));
         if (!any(next))
@@ -159,6 +159,8 @@ int8 harc_segment_from8(global const float* tf, const int n, global const float*
         pieces -= next;
         k += select((int8)(0), select((int8)(-1), (int8)(1), up), next);
     }
+    float8 tk;
+    CLVR_GATHER8(tk, tf, clamp(k, 0, n - 1));
     const int8 k_b = select(k + 1, select(k, k + 1, (k < n) & islessequal(tk, s_b)), up);
     const int8 walked = up | down;
     float8 b_r, b_g, b_b, b_w;

@@ -594,14 +594,14 @@ std::vector<cl_float4> packHarcTets(const TetMesh& mesh, const TetTopology& topo
 HarcEntryLists buildHarcEntryLists(const TetMesh& mesh, const TetTopology& topology, const Camera& camera,
                                    int width, int height)
 {
-    // A boundary face that faces the eye, its pixel box and its entry code.
     // A boundary face that faces the eye, its pixel box and its entry code, and Möller–Trumbore's quantities for a
-    // ray e + λ d as affine functions of what varies from pixel to pixel, v − anchor: the direction d from one eye
-    // (anchor 0), or the origin e along one direction (parallel; anchor p0). With n = (p1 − p0) × (p2 − p0),
-    // t = e − p0: det = d · (e2 × e1), det·u = t · (d × e2), det·v = d · (t × e1), det·λ = e2 · (t × e1).
+    // ray e + λ d as affine functions of what varies from pixel to pixel, `vary` − anchor: the direction d from one
+    // eye (anchor 0), or the origin e along one direction (parallel; anchor p0). With e1 = p1 − p0, e2 = p2 − p0,
+    // n = e1 × e2 and t = e − p0: det = d · (e2 × e1) = −d · n, det·u = t · (d × e2) = d · (e2 × t),
+    // det·v = d · (t × e1) = t · (e1 × d), det·λ = e2 · (t × e1) = t · n.
     struct FrontFace {
         glm::dvec3 anchor;
-        std::array<glm::dvec3, 4> w;  // det, det·u, det·v, det·λ: dot(v − anchor, w[i]) + w0[i]
+        std::array<glm::dvec3, 4> w;  // det, det·u, det·v, det·λ: dot(vary − anchor, w[i]) + w0[i]
         std::array<double, 4> w0;
         int x0, x1, y0, y1;
         std::int32_t code;
@@ -753,19 +753,19 @@ HarcEntryLists buildHarcEntryLists(const TetMesh& mesh, const TetTopology& topol
                     for (int x = face.x0; x <= face.x1; ++x) {
                         const Ray ray =
                             table ? bandRays[static_cast<std::size_t>(y - rowLo) * columns + (x - x0)] : rays.at(x, y);
-                        const glm::dvec3 v = (camera.parallel ? ray.origin : ray.direction) - face.anchor;
+                        const glm::dvec3 vary = (camera.parallel ? ray.origin : ray.direction) - face.anchor;
                         // Möller–Trumbore without its divisions: det > 0 where the ray enters through the face (a
                         // back face or edge-on: det <= 0), and the barycentric coordinates u, v and 1 − u − v each
                         // >= −1e-7, a small margin so that no ray slips between two faces that share an edge (a
                         // duplicate is skipped by the walk).
-                        const double det = glm::dot(v, face.w[0]) + face.w0[0];
+                        const double det = glm::dot(vary, face.w[0]) + face.w0[0];
                         if (!(det > 0.0))
                             continue;
                         constexpr double kMargin = 1e-7;
-                        const double du = glm::dot(v, face.w[1]), dv = glm::dot(v, face.w[2]);
+                        const double du = glm::dot(vary, face.w[1]), dv = glm::dot(vary, face.w[2]);
                         if (du < -kMargin * det || dv < -kMargin * det || du + dv > (1.0 + kMargin) * det)
                             continue;
-                        const double lambda = (glm::dot(v, face.w[3]) + face.w0[3]) / det;
+                        const double lambda = (glm::dot(vary, face.w[3]) + face.w0[3]) / det;
                         if (!(lambda >= 0.0))
                             continue;
                         hits.push_back({static_cast<std::uint32_t>(static_cast<std::size_t>(y) * width + x - firstPixel),
