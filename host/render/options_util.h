@@ -5,6 +5,7 @@
 #pragma once
 
 #include "host/model/volume.h"
+#include "host/runtime/device.h"
 #include "host/runtime/errors.h"
 #include "host/render/renderer.h"
 
@@ -14,6 +15,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <initializer_list>
 #include <optional>
 #include <string>
@@ -151,7 +153,7 @@ inline OptionInfo reflectanceMapSizeInfo()
 }
 inline OptionInfo packetsInfo()
 {
-    return {"packets", nullptr, "true on CPU devices, false on others",
+    return {"packets", nullptr, "true on CPU devices without a loop-iteration cap (PoCL), false on others",
             "fused path: 8 neighbouring pixels per work-item as vector lanes (the same image) where the technique's "
             "mode has them (docs/scene-format.md), or false: one pixel per work-item"};
 }
@@ -162,10 +164,19 @@ constexpr int kPacketLanes = 8;
 
 // "packets" left out (or null): packets on CPU devices, where PoCL turns the lanes into SIMD and they took
 // slice3d's kernel from 141-155 to 51-52 ms (run PK1); one pixel per work-item elsewhere: on an NVIDIA H200
-// the packet kernel took 2.7-4.2x the one-pixel kernel's time (0.86 against 0.31 ms, run GPU2).
-inline bool packetsOnDevice(const std::optional<bool>& packets, const std::string& deviceType)
+// the packet kernel took 2.7-4.2x the one-pixel kernel's time (0.86 against 0.31 ms, run GPU2); and on a CPU
+// device that caps a work-item's loop iterations (Mesa's llvmpipe, Device::loopIterationCap), which vectorizes
+// work-items itself: there projtet's packets, a tile's list per work-item, ran past the cap and dropped 1 % of
+// bluntfin's pixels, and took 6x the one-pixel kernel's time (docs/devices.md).
+inline bool packetsByDefault(const std::string& deviceType, std::uint64_t loopIterationCap)
 {
-    return packets.value_or(deviceType == "CPU");
+    return deviceType == "CPU" && loopIterationCap == 0;
+}
+inline bool packetsOnDevice(const std::optional<bool>& packets, Device& device)
+{
+    if (packets)
+        return *packets;
+    return device.listing().type == "CPU" && packetsByDefault("CPU", device.loopIterationCap());  // probes CPUs only
 }
 // "packets": true or false, or null for the device's default.
 inline std::optional<bool> packetsOption(const std::string& key, const nlohmann::json& value)

@@ -327,7 +327,7 @@ CubefanRenderer::CubefanRenderer(Device& device, const Scene& scene, const Volum
         fusedSteps_ = device_.buffer("cubefan cubes crossed per pixel", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
         fusedSkipped_ = device_.buffer("cubefan cubes stepped over per pixel", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
         // Ray packets (docs/cubefan.md): the same walk on 8 pixels at once, its entries indexed in 32 bits.
-        packet_ = packetsOnDevice(options_.packets, device_.listing().type) && entries <= 0xffffffffu;
+        packet_ = packetsOnDevice(options_.packets, device_) && entries <= 0xffffffffu;
         fused_ = device_.kernel("cubefan.cl", packet_ ? "cubefan_fused_packet" : "cubefan_fused");
         return;
     }

@@ -179,7 +179,7 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
     if (options_.path == Slice3dOptions::Path::Fused) {
         // Ray packets (docs/slice3d.md): the same kernel's arithmetic on 8 pixels at once; the pre-integrated
         // slabs keep one pixel per work-item.
-        packet_ = packetsOnDevice(options_.packets, device_.listing().type) && !options_.preintegrated;
+        packet_ = packetsOnDevice(options_.packets, device_) && !options_.preintegrated;
         fused_ = device_.kernel("slice3d.cl", packet_ ? "slice3d_fused_packet" : "slice3d_fused", {}, trilinearOptions);
         out_ = device_.buffer("slice3d image", pixels * sizeof(cl_float4), CL_MEM_WRITE_ONLY);
         samples_ = device_.buffer("slice3d sample counts", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);

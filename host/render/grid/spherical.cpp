@@ -262,7 +262,7 @@ SphericalRenderer::SphericalRenderer(Device& device, const Scene& scene, const V
         shellTable_ = device_.upload("spherical shell table", table);
         residentBytes_ += table.size() * sizeof(glm::vec4);
         // Ray packets (docs/spherical.md): the same kernel's arithmetic on 8 pixels at once.
-        packet_ = packetsOnDevice(options_.packets, device_.listing().type);
+        packet_ = packetsOnDevice(options_.packets, device_);
         fused_ = device_.kernel("spherical.cl", packet_ ? "spherical_fused_packet" : "spherical_fused");
         fusedSamples_ = device_.buffer("spherical fused samples per pixel",
                                        static_cast<std::size_t>(imageSpec_.width) * imageSpec_.height * sizeof(cl_uint),

@@ -325,7 +325,7 @@ void Stack2dRenderer::setUpFused(const Volume& volume)
         noMap_ = device_.upload("stack2d no reflectance map", std::vector<glm::vec4>(1));
     // Ray packets (kernels/stack2d.cl stack2d_fused_packet, the same bits): plain direct volume rendering
     // without a clip texture; shading, iso-surfaces and clip textures keep one pixel per work-item.
-    packet_ = packetsOnDevice(options_.packets, device_.listing().type) && !clipTexture_ && !iso_ && !lighting_.shaded();
+    packet_ = packetsOnDevice(options_.packets, device_) && !clipTexture_ && !iso_ && !lighting_.shaded();
     fused_ = device_.kernel("stack2d.cl", packet_ ? "stack2d_fused_packet" : "stack2d_fused", {},
                             clipTexture_ ? "-DCLVR_STACK2D_CLIP_TEXTURE=1" : "");
     const std::size_t pixels = framebuffer_->pixelCount();

@@ -152,7 +152,7 @@ HarcRenderer::HarcRenderer(Device& device, const Scene& scene, const TetMesh& me
     out_ = device_.buffer("harc image", pixels * sizeof(cl_float4), CL_MEM_WRITE_ONLY);
     stats_ = device_.buffer("harc ray counts", pixels * 3 * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
     // Ray packets (docs/harc.md): a whole mesh (not a sort-last part), 8 pixels' walks per work-item.
-    packet_ = packetsOnDevice(options_.packets, device_.listing().type) && !part_;
+    packet_ = packetsOnDevice(options_.packets, device_) && !part_;
     kernel_ = device_.kernel("harc.cl", packet_ ? "harc_render_packet" : "harc_render");
     if (options_.entry == HarcOptions::Entry::Raster)
         rasterEntries_ = std::make_unique<HarcRasterEntries>(device_, mesh, topology, shift_, tets_, image_.width,

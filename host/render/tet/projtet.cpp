@@ -723,7 +723,7 @@ ProjtetRenderer::ProjtetRenderer(Device& device, const Scene& scene, const TetMe
         if (image_.width > 16384 || image_.height > 16384)
             throw InputError("projtet: \"path\": \"fused\" takes images of at most 16384 pixels a side, got " +
                              std::to_string(image_.width) + "x" + std::to_string(image_.height));
-        packet_ = packetsOnDevice(options_.packets, device_.listing().type);
+        packet_ = packetsOnDevice(options_.packets, device_);
         fused_ = device_.kernel("projtet.cl", packet_ ? "projtet_fused_packet" : "projtet_fused");
         const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
         fusedOut_ = device_.buffer("projtet fused image", pixels * sizeof(cl_float4));
