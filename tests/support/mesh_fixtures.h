@@ -25,19 +25,21 @@ struct Box {
     int n;
 };
 
-inline void addBox(TetMesh& mesh, const Box& box)
+// The box [lo, hi] as a grid of n.x x n.y x n.z cubes, 6 tetrahedra each (Freudenthal's split: the same diagonal in
+// every cube, so neighbours share faces), its points x fastest.
+inline void addGrid(TetMesh& mesh, const glm::dvec3& lo, const glm::dvec3& hi, const glm::ivec3& n)
 {
     const unsigned base = static_cast<unsigned>(mesh.points.size());
-    const int m = box.n + 1;
-    for (int k = 0; k < m; ++k)
-        for (int j = 0; j < m; ++j)
-            for (int i = 0; i < m; ++i)
-                mesh.points.push_back(box.lo + (box.hi - box.lo) * glm::dvec3(i, j, k) / static_cast<double>(box.n));
-    auto id = [&](int i, int j, int k) { return base + static_cast<unsigned>((k * m + j) * m + i); };
+    const glm::ivec3 m = n + 1;
+    for (int k = 0; k < m.z; ++k)
+        for (int j = 0; j < m.y; ++j)
+            for (int i = 0; i < m.x; ++i)
+                mesh.points.push_back(lo + (hi - lo) * glm::dvec3(i, j, k) / glm::dvec3(n));
+    auto id = [&](int i, int j, int k) { return base + static_cast<unsigned>((k * m.y + j) * m.x + i); };
     const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-    for (int k = 0; k < box.n; ++k)
-        for (int j = 0; j < box.n; ++j)
-            for (int i = 0; i < box.n; ++i)
+    for (int k = 0; k < n.z; ++k)
+        for (int j = 0; j < n.y; ++j)
+            for (int i = 0; i < n.x; ++i)
                 for (const auto& perm : perms) {
                     glm::ivec3 c(i, j, k);
                     glm::uvec4 tet;
@@ -48,6 +50,11 @@ inline void addBox(TetMesh& mesh, const Box& box)
                     }
                     mesh.tets.push_back(tet);
                 }
+}
+
+inline void addBox(TetMesh& mesh, const Box& box)
+{
+    addGrid(mesh, box.lo, box.hi, glm::ivec3(box.n));
 }
 
 inline TetMesh boxMesh(const std::vector<Box>& boxes, const glm::dvec3& gradient, double offset)
