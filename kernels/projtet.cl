@@ -13,10 +13,25 @@
  * planes (h_i, k_i), the fourth 1 minus their sum, the gradient and scalar term; the adjacency is unused. */
 #define PROJTET_TET_FLOAT4S 5
 
+/* A ray that runs in a face's plane (the eye in that plane, the pixel centre on its image line) is inside both cells
+ * of the face as far as rounding can tell, and each would add the stretch along the face. So a plane decides nothing
+ * for such a ray, and only the cell whose h_i points to the side of PROJTET_TIE keeps it (the two cells' h_i for
+ * their face point opposite ways): the stretch counts once. "In the plane": dot(h, d) and b = dot(h, e) + w within
+ * 1e-5 of their terms' sizes — the same rays for both cells (h_i of one is the other's times a negative factor),
+ * and far more than float rounding. PROJTET_TIE: a direction no face of a structured grid lies along. */
+#define PROJTET_TIE ((float3)(0.5227f, 0.6381f, 0.5653f))
+
+int projtet_in_plane(const float4 h, const float3 e, const float hd, const float b)
+{
+    return fabs(hd) <= 1e-5f * (fabs(h.x) + fabs(h.y) + fabs(h.z)) &&
+           fabs(b) <= 1e-5f * (fabs(h.x * e.x) + fabs(h.y * e.y) + fabs(h.z * e.z) + fabs(h.w));
+}
+
 /* Cell t's segment along the ray e + λ d, λ >= 0: inside, b_i(e + λ d) = b_i(e) + λ dot(h_i, d) >= 0 for all four
- * planes. Returns whether the ray meets the cell (not where it grazes it, or runs parallel to a face outside it),
- * and then in *l its length and in *s_f, *s_b the scalar at its front and back (Eq. 6). The dot products are
- * written out (harc_dot3), as projtet_fused_packet's lanes repeat them. */
+ * planes. Returns whether the ray meets the cell (not where it grazes it, or runs parallel to a face outside it, or
+ * runs in a face's plane that the other cell of the face keeps), and then in *l its length and in *s_f, *s_b the
+ * scalar at its front and back (Eq. 6). The dot products are written out (harc_dot3), as projtet_fused_packet's
+ * lanes repeat them. */
 __attribute__((always_inline)) int projtet_cell_segment(global const float* cells, const uint t, const float3 e,
                                                           const float3 d, float* l, float* s_f, float* s_b)
 {
@@ -29,6 +44,10 @@ __attribute__((always_inline)) int projtet_cell_segment(global const float* cell
     for (int i = 0; i < 4; ++i) {
         const float hd = harc_dot3(planes[i].xyz, d);
         const float b = harc_dot3(planes[i].xyz, e) + planes[i].w;
+        if (projtet_in_plane(planes[i], e, hd, b)) {
+            miss |= !(harc_dot3(planes[i].xyz, PROJTET_TIE) > 0.0f);
+            continue;
+        }
         if (hd > 0.0f)
             lambda_in = fmax(lambda_in, -(b / hd));
         else if (hd < 0.0f)
@@ -233,10 +252,17 @@ kernel void projtet_fused_packet(global float4* out, global uint* segments, glob
         const float4 p3 = (float4)(-(p0.xyz + p1.xyz + p2.xyz), 1.0f - (p0.w + p1.w + p2.w));
         const float4 planes[4] = {p0, p1, p2, p3};
         const float8 gx = (float8)(grad.x), gy = (float8)(grad.y), gz = (float8)(grad.z);
-        /* What the tile's rays share, once per cell: from one eye, b_i(e); along one direction (parallel), dot(h_i, d) */
+        /* What the tile's rays share, once per cell: from one eye, b_i(e); along one direction (parallel), dot(h_i, d);
+         * and whether that shared value lets a ray lie in plane i at all (projtet_in_plane's test of it): almost never,
+         * so the lanes' test below mostly does not run */
         float shared[4];
-        for (int i = 0; i < 4; ++i)
-            shared[i] = eye ? harc_dot3(planes[i].xyz, e0) + planes[i].w : harc_dot3(planes[i].xyz, d0);
+        int flat_maybe = 0;
+        for (int i = 0; i < 4; ++i) {
+            const float4 h = planes[i];
+            shared[i] = eye ? harc_dot3(h.xyz, e0) + h.w : harc_dot3(h.xyz, d0);
+            flat_maybe |= (eye ? fabs(shared[i]) <= 1e-5f * (fabs(h.x * e0.x) + fabs(h.y * e0.y) + fabs(h.z * e0.z) + fabs(h.w))
+                               : fabs(shared[i]) <= 1e-5f * (fabs(h.x) + fabs(h.y) + fabs(h.z))) << i;
+        }
         for (int row = row_lo; row <= row_hi; ++row) {
             float8 lambda_in = 0.0f, lambda_out = INFINITY;
             int8 miss = 0;
@@ -246,11 +272,19 @@ kernel void projtet_fused_packet(global float4* out, global uint* segments, glob
                                       : (float8)(shared[i]);
                 const float8 bi = eye ? (float8)(shared[i])
                                       : harc_dot8((float8)(h.x), (float8)(h.y), (float8)(h.z), e_x[row], e_y[row], e_z[row]) + h.w;
-                const int8 enter = isgreater(hd, 0.0f), leave = isless(hd, 0.0f);
+                /* projtet_in_plane lane by lane, where the shared value allows it */
+                int8 flat = 0;
+                if (flat_maybe >> i & 1) {
+                    flat = islessequal(fabs(hd), 1e-5f * (fabs(h.x) + fabs(h.y) + fabs(h.z))) &
+                           islessequal(fabs(bi), 1e-5f * (fabs(h.x * e_x[row]) + fabs(h.y * e_y[row]) +
+                                                          fabs(h.z * e_z[row]) + fabs(h.w)));
+                    miss |= flat & (harc_dot3(h.xyz, PROJTET_TIE) > 0.0f ? 0 : -1);
+                }
+                const int8 enter = isgreater(hd, 0.0f) & ~flat, leave = isless(hd, 0.0f) & ~flat;
                 const float8 at = -(bi / hd);  /* -b/h and b/-h alike: IEEE division rounds |b|/|h| either way */
                 lambda_in = select(lambda_in, fmax(lambda_in, at), enter);
                 lambda_out = select(lambda_out, fmin(lambda_out, at), leave);
-                miss |= ~enter & ~leave & isless(bi, 0.0f);
+                miss |= ~flat & ~enter & ~leave & isless(bi, 0.0f);
             }
             const float8 l = lambda_out - lambda_in;
             const int8 m = columns & ~miss & isgreater(l, 0.0f);

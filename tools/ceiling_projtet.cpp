@@ -90,6 +90,14 @@ ProjtetCeilingResult ProjtetCeiling::render(int threads) const
                     for (int f = 0; f < 4; ++f) {
                         const float hd = glm::dot(glm::vec3(planes[f]), d);
                         const float b = glm::dot(glm::vec3(planes[f]), e) + planes[f].w;
+                        const glm::vec4 h = planes[f];
+                        // projtet_in_plane: a ray in the face's plane counts in one cell of the face only
+                        if (std::fabs(hd) <= 1e-5f * (std::fabs(h.x) + std::fabs(h.y) + std::fabs(h.z)) &&
+                            std::fabs(b) <= 1e-5f * (std::fabs(h.x * e.x) + std::fabs(h.y * e.y) + std::fabs(h.z * e.z) +
+                                                     std::fabs(h.w))) {
+                            miss = miss || !(glm::dot(glm::vec3(h), glm::vec3(0.5227f, 0.6381f, 0.5653f)) > 0.0f);
+                            continue;
+                        }
                         if (hd > 0.0f)
                             lambdaIn = std::max(lambdaIn, -b / hd);
                         else if (hd < 0.0f)
