@@ -15,16 +15,40 @@
 
 /* A ray that runs in a face's plane (the eye in that plane, the pixel centre on its image line) is inside both cells
  * of the face as far as rounding can tell, and each would add the stretch along the face. So a plane decides nothing
- * for such a ray, and only the cell whose h_i points to the side of PROJTET_TIE keeps it (the two cells' h_i for
+ * for such a ray, and only the cell whose h_i points to the side of PROJTET_TIE_* keeps it (the two cells' h_i for
  * their face point opposite ways): the stretch counts once. "In the plane": dot(h, d) and b = dot(h, e) + w within
- * 1e-5 of their terms' sizes — the same rays for both cells (h_i of one is the other's times a negative factor),
- * and far more than float rounding. PROJTET_TIE: a direction no face of a structured grid lies along. */
-#define PROJTET_TIE ((float3)(0.5227f, 0.6381f, 0.5653f))
+ * PROJTET_IN_PLANE (kernels/projtet_params.h) of their terms' sizes — the same rays for both cells (h_i of one is
+ * the other's times a negative factor), and far more than float rounding. */
+
+/* The bound on |dot(h, d)| for |d| = 1, and on |b| at e. */
+float projtet_flat_hd(const float4 h)
+{
+    return PROJTET_IN_PLANE * (fabs(h.x) + fabs(h.y) + fabs(h.z));
+}
+
+float projtet_flat_b(const float4 h, const float3 e)
+{
+    return PROJTET_IN_PLANE * (fabs(h.x * e.x) + fabs(h.y * e.y) + fabs(h.z * e.z) + fabs(h.w));
+}
+
+/* Whether this cell keeps a ray that lies in plane h. */
+int projtet_keeps_in_plane(const float4 h)
+{
+    return harc_dot3(h.xyz, (float3)(PROJTET_TIE_X, PROJTET_TIE_Y, PROJTET_TIE_Z)) > 0.0f;
+}
 
 int projtet_in_plane(const float4 h, const float3 e, const float hd, const float b)
 {
-    return fabs(hd) <= 1e-5f * (fabs(h.x) + fabs(h.y) + fabs(h.z)) &&
-           fabs(b) <= 1e-5f * (fabs(h.x * e.x) + fabs(h.y * e.y) + fabs(h.z * e.z) + fabs(h.w));
+    return fabs(hd) <= projtet_flat_hd(h) && fabs(b) <= projtet_flat_b(h, e);
+}
+
+/* Cell t's four barycentric planes (h_i, w_i), the fourth 1 minus the sum of the others, and its gradient. */
+void projtet_cell_planes(global const float* cells, const uint t, float4 planes[4], float4* grad)
+{
+    global const float* tet = cells + (size_t)t * (4 * PROJTET_TET_FLOAT4S);
+    planes[0] = vload4(0, tet), planes[1] = vload4(1, tet), planes[2] = vload4(2, tet);
+    planes[3] = (float4)(-(planes[0].xyz + planes[1].xyz + planes[2].xyz), 1.0f - (planes[0].w + planes[1].w + planes[2].w));
+    *grad = vload4(3, tet);
 }
 
 /* Cell t's segment along the ray e + λ d, λ >= 0: inside, b_i(e + λ d) = b_i(e) + λ dot(h_i, d) >= 0 for all four
@@ -35,17 +59,15 @@ int projtet_in_plane(const float4 h, const float3 e, const float hd, const float
 __attribute__((always_inline)) int projtet_cell_segment(global const float* cells, const uint t, const float3 e,
                                                           const float3 d, float* l, float* s_f, float* s_b)
 {
-    global const float* tet = cells + (size_t)t * (4 * PROJTET_TET_FLOAT4S);
-    const float4 p0 = vload4(0, tet), p1 = vload4(1, tet), p2 = vload4(2, tet), grad = vload4(3, tet);
-    const float4 p3 = (float4)(-(p0.xyz + p1.xyz + p2.xyz), 1.0f - (p0.w + p1.w + p2.w));
+    float4 planes[4], grad;
+    projtet_cell_planes(cells, t, planes, &grad);
     float lambda_in = 0.0f, lambda_out = INFINITY;
-    const float4 planes[4] = {p0, p1, p2, p3};
     int miss = 0;
     for (int i = 0; i < 4; ++i) {
         const float hd = harc_dot3(planes[i].xyz, d);
         const float b = harc_dot3(planes[i].xyz, e) + planes[i].w;
         if (projtet_in_plane(planes[i], e, hd, b)) {
-            miss |= !(harc_dot3(planes[i].xyz, PROJTET_TIE) > 0.0f);
+            miss |= !projtet_keeps_in_plane(planes[i]);
             continue;
         }
         if (hd > 0.0f)
@@ -95,6 +117,11 @@ int clvr_fragment(const ClFragment* f, const ClFragmentResources* r, float4* col
 /* The fused path's tiles: 8 pixels wide (a packet's row), 4 high (host/render/tet/projtet.h kProjtetTileW, H). */
 #define PROJTET_TILE_W_LOG2 3
 #define PROJTET_TILE_H_LOG2 2
+#define PROJTET_TILE_H (1 << PROJTET_TILE_H_LOG2)
+#define PROJTET_TILE_PIXELS (CLVR_LANES * PROJTET_TILE_H) /* projtet_fused_packet: a tile row is a packet's 8 lanes */
+#if (1 << PROJTET_TILE_W_LOG2) != CLVR_LANES
+#error "projtet_fused_packet takes a tile row as one packet"
+#endif
 
 /* The fused path ("path": "fused", host/render/tet/projtet.cpp): the cells, back to front, binned to tiles by
  * their boxes of pixel centres (tile_start: each tile's first entry, CSR; tile_cells: cell ids, in visibility
@@ -147,14 +174,14 @@ kernel void projtet_fused(global float4* out, global uint* segments, global cons
  * with every lane busy where the cells are a few pixels wide (a row's 8 lanes would hold one or two segments).
  * Every lane does projtet_fused's operations (the dot products written out in both), so its pixel is the same bits. */
 typedef struct {
-    float s_f[16], s_b[16], l[16];  /* a row's ≤ 8 segments join ≤ 7 waiting ones */
-    int pixel[16];                  /* in the tile: row * 8 + column */
+    float s_f[2 * CLVR_LANES], s_b[2 * CLVR_LANES], l[2 * CLVR_LANES];  /* a row's ≤ 8 segments join ≤ 7 waiting */
+    int pixel[2 * CLVR_LANES];                                          /* in the tile: row * 8 + column */
     int count;
 } ProjtetQueue;
 
 typedef struct {
-    float r[32], g[32], b[32], alpha[32];  /* the raster stage's blend, per pixel of the tile */
-    uint n[32];                            /* segments blended */
+    float r[PROJTET_TILE_PIXELS], g[PROJTET_TILE_PIXELS], b[PROJTET_TILE_PIXELS], alpha[PROJTET_TILE_PIXELS];
+    uint n[PROJTET_TILE_PIXELS];  /* the raster stage's blend per pixel of the tile, and the segments blended */
 } ProjtetTile;
 
 /* Integrates the first min(count, 8) queued segments as lanes, blends each into its pixel in queue order, and moves
@@ -206,11 +233,12 @@ kernel void projtet_fused_packet(global float4* out, global uint* segments, glob
     if (tx >= p.size.z || ty >= p.size.w)
         return;
     const int x0 = tx << PROJTET_TILE_W_LOG2, y0 = ty << PROJTET_TILE_H_LOG2;
-    const int rows = min(1 << PROJTET_TILE_H_LOG2, p.size.y - y0);
+    const int rows = min(PROJTET_TILE_H, p.size.y - y0);
     const int8 xs = x0 + CLVR_LANE_INDEX;
     const int8 valid = xs < p.size.x;
     const float2 size = (float2)((float)p.size.x, (float)p.size.y);
-    float8 e_x[4], e_y[4], e_z[4], d_x[4], d_y[4], d_z[4];
+    float8 e_x[PROJTET_TILE_H], e_y[PROJTET_TILE_H], e_z[PROJTET_TILE_H], d_x[PROJTET_TILE_H], d_y[PROJTET_TILE_H],
+        d_z[PROJTET_TILE_H];
     for (int row = 0; row < rows; ++row) {
 #define PROJTET_RAY(L)                                                                                                 \
         {                                                                                                              \
@@ -227,10 +255,10 @@ kernel void projtet_fused_packet(global float4* out, global uint* segments, glob
     const int eye = !clvr_ray_parallel(p.camera);  /* every ray from the eye, else every ray along forward */
     const float3 e0 = (float3)(e_x[0].s0, e_y[0].s0, e_z[0].s0), d0 = (float3)(d_x[0].s0, d_y[0].s0, d_z[0].s0);
     ProjtetTile acc;
-    for (int i = 0; i < 32; ++i)
+    for (int i = 0; i < PROJTET_TILE_PIXELS; ++i)
         acc.r[i] = acc.g[i] = acc.b[i] = acc.alpha[i] = 0.0f, acc.n[i] = 0;
     ProjtetQueue q;
-    for (int i = 0; i < 16; ++i)
+    for (int i = 0; i < 2 * CLVR_LANES; ++i)
         q.s_f[i] = q.s_b[i] = q.l[i] = 0.0f, q.pixel[i] = 0;
     q.count = 0;
     const int tile = ty * p.size.z + tx;
@@ -247,10 +275,8 @@ kernel void projtet_fused_packet(global float4* out, global uint* segments, glob
         const int8 columns = valid & (xs >= (int)b.x) & (xs <= (int)b.z);
         if (row_lo > row_hi || !any(columns))
             continue;
-        global const float* tet = cells + (size_t)t * (4 * PROJTET_TET_FLOAT4S);
-        const float4 p0 = vload4(0, tet), p1 = vload4(1, tet), p2 = vload4(2, tet), grad = vload4(3, tet);
-        const float4 p3 = (float4)(-(p0.xyz + p1.xyz + p2.xyz), 1.0f - (p0.w + p1.w + p2.w));
-        const float4 planes[4] = {p0, p1, p2, p3};
+        float4 planes[4], grad;
+        projtet_cell_planes(cells, t, planes, &grad);
         const float8 gx = (float8)(grad.x), gy = (float8)(grad.y), gz = (float8)(grad.z);
         /* What the tile's rays share, once per cell: from one eye, b_i(e); along one direction (parallel), dot(h_i, d);
          * and whether that shared value lets a ray lie in plane i at all (projtet_in_plane's test of it): almost never,
@@ -260,8 +286,7 @@ kernel void projtet_fused_packet(global float4* out, global uint* segments, glob
         for (int i = 0; i < 4; ++i) {
             const float4 h = planes[i];
             shared[i] = eye ? harc_dot3(h.xyz, e0) + h.w : harc_dot3(h.xyz, d0);
-            flat_maybe |= (eye ? fabs(shared[i]) <= 1e-5f * (fabs(h.x * e0.x) + fabs(h.y * e0.y) + fabs(h.z * e0.z) + fabs(h.w))
-                               : fabs(shared[i]) <= 1e-5f * (fabs(h.x) + fabs(h.y) + fabs(h.z))) << i;
+            flat_maybe |= (fabs(shared[i]) <= (eye ? projtet_flat_b(h, e0) : projtet_flat_hd(h))) << i;
         }
         for (int row = row_lo; row <= row_hi; ++row) {
             float8 lambda_in = 0.0f, lambda_out = INFINITY;
@@ -275,10 +300,10 @@ kernel void projtet_fused_packet(global float4* out, global uint* segments, glob
                 /* projtet_in_plane lane by lane, where the shared value allows it */
                 int8 flat = 0;
                 if (flat_maybe >> i & 1) {
-                    flat = islessequal(fabs(hd), 1e-5f * (fabs(h.x) + fabs(h.y) + fabs(h.z))) &
-                           islessequal(fabs(bi), 1e-5f * (fabs(h.x * e_x[row]) + fabs(h.y * e_y[row]) +
-                                                          fabs(h.z * e_z[row]) + fabs(h.w)));
-                    miss |= flat & (harc_dot3(h.xyz, PROJTET_TIE) > 0.0f ? 0 : -1);
+                    flat = islessequal(fabs(hd), projtet_flat_hd(h)) &
+                           islessequal(fabs(bi), PROJTET_IN_PLANE * (fabs(h.x * e_x[row]) + fabs(h.y * e_y[row]) +
+                                                                     fabs(h.z * e_z[row]) + fabs(h.w)));
+                    miss |= flat & (projtet_keeps_in_plane(h) ? 0 : -1);
                 }
                 const int8 enter = isgreater(hd, 0.0f) & ~flat, leave = isless(hd, 0.0f) & ~flat;
                 const float8 at = -(bi / hd);  /* -b/h and b/-h alike: IEEE division rounds |b|/|h| either way */
@@ -297,7 +322,7 @@ kernel void projtet_fused_packet(global float4* out, global uint* segments, glob
 #define PROJTET_QUEUE(L)                                                                                               \
             if (m.s##L) {                                                                                              \
                 q.s_f[q.count] = s_f.s##L, q.s_b[q.count] = s_b.s##L, q.l[q.count] = l.s##L;                           \
-                q.pixel[q.count++] = row * 8 + L;                                                                      \
+                q.pixel[q.count++] = row * CLVR_LANES + L;                                                             \
             }
             CLVR_EACH_LANE(PROJTET_QUEUE)
 #undef PROJTET_QUEUE
@@ -308,8 +333,8 @@ kernel void projtet_fused_packet(global float4* out, global uint* segments, glob
     if (q.count > 0)
         projtet_drain8(&q, &acc, tf, p.counts.x, psi, p.counts.y);
     for (int row = 0; row < rows; ++row)
-        for (int c = 0; c < 8 && x0 + c < p.size.x; ++c) {
-            const int at = row * 8 + c;
+        for (int c = 0; c < CLVR_LANES && x0 + c < p.size.x; ++c) {
+            const int at = row * CLVR_LANES + c;
             const float a = acc.alpha[at];
             const size_t i = (size_t)(y0 + row) * (size_t)p.size.x + (size_t)(x0 + c);
             out[i] = (float4)(acc.r[at] + (1.0f - a) * p.background.x, acc.g[at] + (1.0f - a) * p.background.y,

@@ -14,6 +14,14 @@ typedef struct {
     cl_float4 counts;  /* (width, height, transfer-function control points, ψ table size) */
 } ClProjtetUniforms;   /* 96 bytes */
 
+/* A ray in a face's plane (kernels/projtet.cl projtet_in_plane; tools/ceiling_projtet.cpp repeats it): within
+ * PROJTET_IN_PLANE of its terms' sizes, and kept by the cell of the face whose h points to the side of
+ * (PROJTET_TIE_X, _Y, _Z), a direction no face of a structured grid lies along. */
+#define PROJTET_IN_PLANE 1e-5f
+#define PROJTET_TIE_X 0.5227f
+#define PROJTET_TIE_Y 0.6381f
+#define PROJTET_TIE_Z 0.5653f
+
 /* The fused path's kernel argument (kernels/projtet.cl projtet_fused), by value. */
 typedef struct {
     ClCamera camera;       /* as ClProjtetUniforms' */

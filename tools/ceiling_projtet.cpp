@@ -6,6 +6,7 @@
 #include "host/render/camera_args.h"
 #include "host/render/tet/harc.h"
 #include "host/runtime/parallel.h"
+#include "kernels/projtet_params.h"
 
 #include <algorithm>
 #include <cmath>
@@ -92,10 +93,10 @@ ProjtetCeilingResult ProjtetCeiling::render(int threads) const
                         const float b = glm::dot(glm::vec3(planes[f]), e) + planes[f].w;
                         const glm::vec4 h = planes[f];
                         // projtet_in_plane: a ray in the face's plane counts in one cell of the face only
-                        if (std::fabs(hd) <= 1e-5f * (std::fabs(h.x) + std::fabs(h.y) + std::fabs(h.z)) &&
-                            std::fabs(b) <= 1e-5f * (std::fabs(h.x * e.x) + std::fabs(h.y * e.y) + std::fabs(h.z * e.z) +
-                                                     std::fabs(h.w))) {
-                            miss = miss || !(glm::dot(glm::vec3(h), glm::vec3(0.5227f, 0.6381f, 0.5653f)) > 0.0f);
+                        if (std::fabs(hd) <= PROJTET_IN_PLANE * (std::fabs(h.x) + std::fabs(h.y) + std::fabs(h.z)) &&
+                            std::fabs(b) <= PROJTET_IN_PLANE * (std::fabs(h.x * e.x) + std::fabs(h.y * e.y) +
+                                                                std::fabs(h.z * e.z) + std::fabs(h.w))) {
+                            miss = miss || !(glm::dot(glm::vec3(h), glm::vec3(PROJTET_TIE_X, PROJTET_TIE_Y, PROJTET_TIE_Z)) > 0.0f);
                             continue;
                         }
                         if (hd > 0.0f)

@@ -176,7 +176,8 @@ inline bool packetsOnDevice(const std::optional<bool>& packets, Device& device)
 {
     if (packets)
         return *packets;
-    return device.listing().type == "CPU" && packetsByDefault("CPU", device.loopIterationCap());  // probes CPUs only
+    const std::string& type = device.listing().type;
+    return packetsByDefault(type, type == "CPU" ? device.loopIterationCap() : 0);  // the loop probe runs on CPUs only
 }
 // "packets": true or false, or null for the device's default.
 inline std::optional<bool> packetsOption(const std::string& key, const nlohmann::json& value)
