@@ -215,18 +215,15 @@ static int8 cubefan_next8(const int8 exit, const int8 v, const int8 lo, const in
     return select(select(min(v, along), max(v, along), positive), select(lo - 1, hi, positive), exit);
 }
 
-kernel void cubefan_fused_packet(global float4* out, global uint* steps, global uint* skipped,
-                                 global const uchar* level, global const float* value, global const uchar* space,
-                                 global const float* tf, const ClCubefanFusedParams p)
+/* cubefan_ray lane by lane for the 8 pixels (x0 .. x0 + 7, y) (lanes past the image's width take rays beyond it,
+ * which the kernels do not store): e and d in the selection grid's coordinates, and 1 / d. */
+static void cubefan_ray8(const int x0, const int y, const ClCubefanFusedParams* p, float8* qex, float8* qey, float8* qez,
+                         float8* qdx, float8* qdy, float8* qdz, float8* ix, float8* iy, float8* iz)
 {
-    const int x0 = (int)get_global_id(0) * CLVR_LANES, y = (int)get_global_id(1);
-    if (x0 >= p.width || y >= p.height)
-        return;
-    const int3 box_lo = p.filled_lo.xyz, box_hi = p.filled_hi.xyz;
     /* each lane's ray, cubefan_ray's expressions lane by lane (as slice3d_fused_packet: the row's offset s.y
      * is one scalar, made a vector so that its products fuse into the sums as the float3 expressions' do) */
-    const ClCamera cam = p.camera;
-    const float2 size = (float2)((float)p.width, (float)p.height);
+    const ClCamera cam = p->camera;
+    const float2 size = (float2)((float)p->width, (float)p->height);
     const float8 sy = clvr_ray_window_offset(clvr_ray_pixel_centre(x0, y), size, cam).y;
     const float8 sx = (convert_float8(x0 + CLVR_LANE_INDEX) + 0.5f) / size.x * 2.0f - 1.0f;
     const float8 s_x = sx * cam.params.x * cam.params.y;
@@ -245,13 +242,25 @@ kernel void cubefan_fused_packet(global float4* out, global uint* steps, global 
         const float8 inv_len = 1.0f / sqrt(n2);
         d_x *= inv_len, d_y *= inv_len, d_z *= inv_len;
     }
-    const float8 qex = (e_x - p.field_lo.x) * p.inv_spacing.x, qey = (e_y - p.field_lo.y) * p.inv_spacing.y,
-                 qez = (e_z - p.field_lo.z) * p.inv_spacing.z;
-    float8 qdx = d_x * p.inv_spacing.x, qdy = d_y * p.inv_spacing.y, qdz = d_z * p.inv_spacing.z;
-    qdx = select(qdx, copysign((float8)(1e-30f), qdx), isless(fabs(qdx), (float8)(1e-30f)));
-    qdy = select(qdy, copysign((float8)(1e-30f), qdy), isless(fabs(qdy), (float8)(1e-30f)));
-    qdz = select(qdz, copysign((float8)(1e-30f), qdz), isless(fabs(qdz), (float8)(1e-30f)));
-    const float8 ix = 1.0f / qdx, iy = 1.0f / qdy, iz = 1.0f / qdz;
+    *qex = (e_x - p->field_lo.x) * p->inv_spacing.x, *qey = (e_y - p->field_lo.y) * p->inv_spacing.y,
+    *qez = (e_z - p->field_lo.z) * p->inv_spacing.z;
+    const float8 q_x = d_x * p->inv_spacing.x, q_y = d_y * p->inv_spacing.y, q_z = d_z * p->inv_spacing.z;
+    *qdx = select(q_x, copysign((float8)(1e-30f), q_x), isless(fabs(q_x), (float8)(1e-30f)));
+    *qdy = select(q_y, copysign((float8)(1e-30f), q_y), isless(fabs(q_y), (float8)(1e-30f)));
+    *qdz = select(q_z, copysign((float8)(1e-30f), q_z), isless(fabs(q_z), (float8)(1e-30f)));
+    *ix = 1.0f / *qdx, *iy = 1.0f / *qdy, *iz = 1.0f / *qdz;
+}
+
+kernel void cubefan_fused_packet(global float4* out, global uint* steps, global uint* skipped,
+                                 global const uchar* level, global const float* value, global const uchar* space,
+                                 global const float* tf, const ClCubefanFusedParams p)
+{
+    const int x0 = (int)get_global_id(0) * CLVR_LANES, y = (int)get_global_id(1);
+    if (x0 >= p.width || y >= p.height)
+        return;
+    const int3 box_lo = p.filled_lo.xyz, box_hi = p.filled_hi.xyz;
+    float8 qex, qey, qez, qdx, qdy, qdz, ix, iy, iz;
+    cubefan_ray8(x0, y, &p, &qex, &qey, &qez, &qdx, &qdy, &qdz, &ix, &iy, &iz);
     const float8 t0x = ((float)box_lo.x - qex) * ix, t1x = ((float)box_hi.x - qex) * ix;
     const float8 t0y = ((float)box_lo.y - qey) * iy, t1y = ((float)box_hi.y - qey) * iy;
     const float8 t0z = ((float)box_lo.z - qez) * iz, t1z = ((float)box_hi.z - qez) * iz;

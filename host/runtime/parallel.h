@@ -2,7 +2,9 @@
 // threads (CPU references, harc's face sort, the ceiling loop).
 #pragma once
 
+#include <algorithm>
 #include <atomic>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -35,6 +37,25 @@ int threadsToUse(int threads, int maxUseful);
 // Workers share their work through their own means (an atomic row counter, say). Returns the number
 // of threads it used.
 int runOnThreads(int threads, int maxUseful, const std::function<void()>& worker);
+
+// Loops over n items in chunks of `chunk` taken from a shared counter (the per-frame host loops over points,
+// cells, faces and cubes): hostChunkThreads is the threads worth it for n items (the thread budget, one per chunk
+// at most), and forHostChunks runs work(begin, end) for every chunk on that many; begin / chunk numbers the
+// chunk, for loops that keep their outputs in order.
+inline constexpr std::size_t kHostChunk = 8192;
+inline int hostChunkThreads(std::size_t n, std::size_t chunk = kHostChunk)
+{
+    return threadsToUse(0, static_cast<int>(n / chunk + 1));
+}
+template <typename Work>
+void forHostChunks(int threads, std::size_t n, const Work& work, std::size_t chunk = kHostChunk)
+{
+    std::atomic<std::size_t> next{0};
+    runOnThreads(threads, threads, [&] {
+        for (std::size_t begin; (begin = next.fetch_add(chunk)) < n;)
+            work(begin, std::min(begin + chunk, n));
+    });
+}
 
 // A reusable barrier for a fixed number of threads that yields a short while before it sleeps, for
 // phases of a hundred microseconds or so (projtet's sort waves), where std::barrier's futex wake-up

@@ -8,6 +8,7 @@
 #include "host/render/fragment_uniforms.h"
 #include "host/render/options_util.h"
 #include "host/render/scaffold.h"
+#include "host/render/tile_lists.h"
 #include "host/render/tet/harc.h"
 #include "host/render/transfer_function_upload.h"
 #include "host/runtime/embedded_kernels.h"
@@ -70,24 +71,6 @@ VisibilitySorter::VisibilitySorter(const TetMesh& mesh, const TetTopology& topol
 }
 
 namespace {
-
-// The per-frame host loops over points, cells and faces run in chunks of `chunk` items taken from a shared
-// counter: the threads worth it for n items (the thread budget, one per chunk at most), and the loop itself,
-// work(begin, end); begin / chunk numbers the chunk, for loops that keep their outputs in order.
-constexpr std::size_t kHostChunk = 8192;
-int hostChunkThreads(std::size_t n, std::size_t chunk = kHostChunk)
-{
-    return threadsToUse(0, static_cast<int>(n / chunk + 1));
-}
-template <typename Work>
-void forHostChunks(int threads, std::size_t n, const Work& work, std::size_t chunk = kHostChunk)
-{
-    std::atomic<std::size_t> next{0};
-    runOnThreads(threads, threads, [&] {
-        for (std::size_t begin; (begin = next.fetch_add(chunk)) < n;)
-            work(begin, std::min(begin + chunk, n));
-    });
-}
 
 // Every cell, the largest key (the farthest) first; equal keys by cell number.
 std::vector<std::uint32_t> farthestFirst(const std::vector<double>& key)
@@ -720,8 +703,9 @@ ProjtetRenderer::ProjtetRenderer(Device& device, const Scene& scene, const TetMe
     program_.buffers[0] = cells_;
     program_.buffers[2] = psi_;
     if (options_.path == ProjtetOptions::Path::Fused) {
-        if (image_.width > 16384 || image_.height > 16384)
-            throw InputError("projtet: \"path\": \"fused\" takes images of at most 16384 pixels a side, got " +
+        if (image_.width > kTileImageMax || image_.height > kTileImageMax)
+            throw InputError("projtet: \"path\": \"fused\" takes images of at most " + std::to_string(kTileImageMax) +
+                             " pixels a side, got " +
                              std::to_string(image_.width) + "x" + std::to_string(image_.height));
         packet_ = packetsOnDevice(options_.packets, device_);
         fused_ = device_.kernel("projtet.cl", packet_ ? "projtet_fused_packet" : "projtet_fused");
@@ -746,61 +730,22 @@ void ProjtetRenderer::stage(Staging& staging, std::string_view what, const void*
 }
 
 // The fused path: the cells' boxes of pixel centres (projtetCellBoxes), the cells binned to tiles of
-// kProjtetTileW x kProjtetTileH pixels in visibility order — a stable counting sort by chunks of the order on the
-// host's threads (each chunk counts its cells' tiles, the counts become each chunk's offsets within each tile,
-// each chunk writes its cells) —, then kernels/projtet.cl's projtet_fused (or its packets) over the image.
+// kProjtetTileW x kProjtetTileH pixels in visibility order (binToTiles), then kernels/projtet.cl's projtet_fused (or
+// its packets) over the image.
 Image4f ProjtetRenderer::renderFused(const VisibilitySorter::Result& sorted, std::vector<PassTime> hostPasses,
                                      const FrameClock& clock, FrameStats& stats)
 {
     auto t0 = std::chrono::steady_clock::now();
     const int width = image_.width, height = image_.height;
     const std::vector<ProjtetBox> boxes = projtetCellBoxes(points_, tets_, camera_, width, height);
-    const int tilesX = (width + kProjtetTileW - 1) / kProjtetTileW;
-    const int tilesY = (height + kProjtetTileH - 1) / kProjtetTileH;
-    const std::size_t tiles = static_cast<std::size_t>(tilesX) * tilesY;
-    const std::vector<std::uint32_t>& order = sorted.order;
-    constexpr std::size_t kChunk = 16384;
-    const std::size_t chunks = (order.size() + kChunk - 1) / kChunk;
-    // chunk c's count, then its first entry, in tile t: offset[c * tiles + t]
-    std::vector<cl_uint> offset(chunks * tiles, 0);
-    auto forTiles = [&](const ProjtetBox& b, const auto& visit) {
-        if (b.x0 > b.x1 || b.y0 > b.y1)
-            return;
-        for (int ty = b.y0 / kProjtetTileH; ty <= b.y1 / kProjtetTileH; ++ty)
-            for (int tx = b.x0 / kProjtetTileW; tx <= b.x1 / kProjtetTileW; ++tx)
-                visit(static_cast<std::size_t>(ty) * tilesX + tx);
-    };
-    const int threads = hostChunkThreads(order.size(), kChunk);
-    auto overChunks = [&](const auto& work) { forHostChunks(threads, order.size(), work, kChunk); };
-    overChunks([&](std::size_t begin, std::size_t end) {
-        cl_uint* count = offset.data() + begin / kChunk * tiles;
-        for (std::size_t i = begin; i < end; ++i)
-            forTiles(boxes[order[i]], [&](std::size_t tile) { ++count[tile]; });
-    });
-    std::vector<cl_uint> tileStart(tiles + 1);
-    std::uint64_t entries = 0;
-    for (std::size_t t = 0; t < tiles; ++t) {
-        tileStart[t] = static_cast<cl_uint>(entries);
-        for (std::size_t c = 0; c < chunks; ++c) {
-            const cl_uint n = offset[c * tiles + t];
-            offset[c * tiles + t] = static_cast<cl_uint>(entries);
-            entries += n;
-        }
-    }
-    if (entries > 0xffffffffu)
-        throw InputError("projtet: \"path\": \"fused\": the cells' tile lists have more than 2^32 entries; "
-                         "use \"path\": \"raster\" or a smaller image");
-    tileStart[tiles] = static_cast<cl_uint>(entries);
-    std::vector<cl_uint> tileCells(entries);
-    overChunks([&](std::size_t begin, std::size_t end) {
-        cl_uint* next = offset.data() + begin / kChunk * tiles;
-        for (std::size_t i = begin; i < end; ++i)
-            forTiles(boxes[order[i]], [&](std::size_t tile) { tileCells[next[tile]++] = order[i]; });
-    });
+    const TileLists lists = binToTiles(boxes, sorted.order, width, height, kProjtetTileW, kProjtetTileH,
+                                       "projtet: \"path\": \"fused\"", "use \"path\": \"raster\" or a smaller image");
+    const int tilesX = lists.tilesX, tilesY = lists.tilesY;
+    const std::uint64_t entries = lists.items.size();
     static_assert(sizeof(ProjtetBox) == sizeof(cl_short4));
     stage(boxes_, "projtet fused cell boxes", boxes.data(), boxes.size() * sizeof(ProjtetBox));
-    stage(tileStart_, "projtet fused tile starts", tileStart.data(), tileStart.size() * sizeof(cl_uint));
-    stage(tileCells_, "projtet fused tile cells", tileCells.data(), tileCells.size() * sizeof(cl_uint));
+    stage(tileStart_, "projtet fused tile starts", lists.start.data(), lists.start.size() * sizeof(cl_uint));
+    stage(tileCells_, "projtet fused tile cells", lists.items.data(), lists.items.size() * sizeof(cl_uint));
     hostPasses.push_back({"projtet: cell boxes and tile lists (host)", msSince(t0)});
 
     ClProjtetFusedParams p{};

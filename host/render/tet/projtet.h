@@ -11,6 +11,7 @@
 #include "host/model/camera.h"
 #include "host/model/mesh.h"
 #include "host/render/renderer.h"
+#include "host/render/tile_lists.h"
 
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
@@ -48,9 +49,7 @@ inline constexpr int kProjtetTileW = 8, kProjtetTileH = 4;
 
 // A cell's box of pixel centres (x0, y0)-(x1, y1), inclusive; empty when x0 > x1 or y0 > y1. The fused path
 // uploads them as short4.
-struct ProjtetBox {
-    std::int16_t x0, y0, x1, y1;
-};
+using ProjtetBox = PixelBox;
 
 // Every cell's box for `camera` on a width x height image (at most 16,384 on a side), as the fused path and
 // tools/ceiling_projtet.h take them: the points projected as the raster path projects them (through float NDC),

@@ -1,0 +1,56 @@
+// host/render/tile_lists.cpp — binning items to tiles in order (tile_lists.h).
+#include "host/render/tile_lists.h"
+
+#include "host/runtime/errors.h"
+#include "host/runtime/parallel.h"
+
+namespace clvr {
+
+TileLists binToTiles(const std::vector<PixelBox>& boxes, const std::vector<std::uint32_t>& order, int width, int height,
+                     int tileW, int tileH, const std::string& what, const std::string& remedy)
+{
+    TileLists lists;
+    lists.tilesX = (width + tileW - 1) / tileW;
+    lists.tilesY = (height + tileH - 1) / tileH;
+    const std::size_t tiles = static_cast<std::size_t>(lists.tilesX) * lists.tilesY;
+    constexpr std::size_t kChunk = 16384;
+    const std::size_t chunks = (order.size() + kChunk - 1) / kChunk;
+    // chunk c's count, then its first entry, in tile t: offset[c * tiles + t]
+    std::vector<cl_uint> offset(chunks * tiles, 0);
+    auto forTiles = [&](const PixelBox& b, const auto& visit) {
+        if (b.x0 > b.x1 || b.y0 > b.y1)
+            return;
+        for (int ty = b.y0 / tileH; ty <= b.y1 / tileH; ++ty)
+            for (int tx = b.x0 / tileW; tx <= b.x1 / tileW; ++tx)
+                visit(static_cast<std::size_t>(ty) * lists.tilesX + tx);
+    };
+    const int threads = hostChunkThreads(order.size(), kChunk);
+    auto overChunks = [&](const auto& work) { forHostChunks(threads, order.size(), work, kChunk); };
+    overChunks([&](std::size_t begin, std::size_t end) {
+        cl_uint* count = offset.data() + begin / kChunk * tiles;
+        for (std::size_t i = begin; i < end; ++i)
+            forTiles(boxes[order[i]], [&](std::size_t tile) { ++count[tile]; });
+    });
+    lists.start.resize(tiles + 1);
+    std::uint64_t entries = 0;
+    for (std::size_t t = 0; t < tiles; ++t) {
+        lists.start[t] = static_cast<cl_uint>(entries);
+        for (std::size_t c = 0; c < chunks; ++c) {
+            const cl_uint n = offset[c * tiles + t];
+            offset[c * tiles + t] = static_cast<cl_uint>(entries);
+            entries += n;
+        }
+    }
+    if (entries > 0xffffffffu)
+        throw InputError(what + ": the tile lists have more than 2^32 entries; " + remedy);
+    lists.start[tiles] = static_cast<cl_uint>(entries);
+    lists.items.resize(entries);
+    overChunks([&](std::size_t begin, std::size_t end) {
+        cl_uint* next = offset.data() + begin / kChunk * tiles;
+        for (std::size_t i = begin; i < end; ++i)
+            forTiles(boxes[order[i]], [&](std::size_t tile) { lists.items[next[tile]++] = order[i]; });
+    });
+    return lists;
+}
+
+}  // namespace clvr

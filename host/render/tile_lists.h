@@ -1,0 +1,32 @@
+// host/render/tile_lists.h — items (cells, cubes) binned to tiles of pixels by their boxes of pixel centres, in a
+// given order: the lists the tile kernels walk (kernels/projtet.cl projtet_fused, kernels/cubefan.cl cubefan_tiles).
+#pragma once
+
+#include <CL/opencl.hpp>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace clvr {
+
+// An item's box of pixel centres (x0, y0)-(x1, y1), inclusive; empty when x0 > x1 or y0 > y1. Uploaded as short4.
+struct PixelBox {
+    std::int16_t x0, y0, x1, y1;
+};
+
+// Images the tile kernels take: at most this many pixels a side (PixelBox holds them).
+inline constexpr int kTileImageMax = 16384;
+
+// Per tile (row-major, tilesX per row) the items whose box reaches it, in `order`'s order: tile t's items are
+// items[start[t] .. start[t + 1]). A stable counting sort by chunks of the order on the host's threads (each chunk
+// counts its items' tiles, the counts become each chunk's offsets within each tile, each chunk writes its items).
+struct TileLists {
+    int tilesX = 0, tilesY = 0;
+    std::vector<cl_uint> start, items;
+};
+// InputError "<what>: the tile lists have more than 2^32 entries; <remedy>" where they would.
+TileLists binToTiles(const std::vector<PixelBox>& boxes, const std::vector<std::uint32_t>& order, int width, int height,
+                     int tileW, int tileH, const std::string& what, const std::string& remedy);
+
+}  // namespace clvr
