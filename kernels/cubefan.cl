@@ -351,4 +351,225 @@ kernel void cubefan_fused_packet(global float4* out, global uint* steps, global 
     CLVR_EACH_LANE(CUBEFAN_STORE)
 #undef CUBEFAN_STORE
 }
+
+/* The tile path ("path": "tiles", host/render/grid/cubefan.cpp; docs/cubefan.md): §6's selected cubes projected in
+ * the octree's visibility order, as the fans are, but each cube's pixels found by a tile's rays instead of the raster
+ * stage. The cubes that add color, front to back, binned to tiles of 8 x 4 pixels by their boxes of pixel centres
+ * (tile_start: each tile's first entry, CSR; tile_cubes: cube ids in that order; boxes[cube] = (x0, y0, x1, y1),
+ * inclusive); cubes[3 i] = (low corner, value), cubes[3 i + 1] = (high corner, 0) of cube i in the selection grid's
+ * coordinates (cubefan_ray's q), cubes[3 i + 2] its color and extinction (cubefan_cube_colors). A pixel's ray meets a cube of its tile whose box holds the pixel by the slab test;
+ * its chord [t_in, t_out), t_in >= 0, adds (C alpha, alpha), alpha = 1 - exp(-tau (t_out - t_in)), front to back
+ * under what is in front, as the walk adds its chords (the same expressions), until the opacity reaches
+ * p.ert_alpha. out[pixel] = (rgb + (1 - A) background, A); steps[pixel]: the chords added. tiles_x: tiles per row. */
+#define CUBEFAN_TILE_W_LOG2 3 /* host/render/grid/cubefan.h kCubefanTileW, H */
+#define CUBEFAN_TILE_H_LOG2 2
+#define CUBEFAN_TILE_H (1 << CUBEFAN_TILE_H_LOG2)
+#define CUBEFAN_AHEAD 12 /* how many tile entries ahead cubefan_tiles_packet prefetches its cubes */
+#if (1 << CUBEFAN_TILE_W_LOG2) != CLVR_LANES || CUBEFAN_TILE_H != 4
+#error "cubefan_tiles_packet takes a tile as two pairs of rows of 8"
+#endif
+
+/* Once per selection: each cube's color and extinction, cubes[3 i + 2] = the transfer function at its value (as the
+ * walk evaluates it per chord). n: the cubes. */
+kernel void cubefan_cube_colors(global float4* cubes, global const float* tf, const int tf_count, const uint n)
+{
+    const uint i = (uint)get_global_id(0);
+    if (i >= n)
+        return;
+    cubes[3 * i + 2] = clvr_tf_eval(tf, tf_count, cubes[3 * i].w);
+}
+
+/* Per frame: each cube's box of pixel centres, its eight corners projected (the inverse of kernels/ray.h's rays: the
+ * offset in right and up over the depth along forward, perspective), grown by 0.01 pixel and 1e-5 of its size (far more
+ * than the rays' float rounding reaches past the projection) and clipped to the image; the whole image where a corner
+ * is within 1e-4 of the cube's depth terms of the eye's plane or behind it; (1, 1, 0, 0) when empty. 8 cubes per
+ * work-item, one per lane (PoCL does not vectorize the work-items of this kernel itself): cubes 8 i .. 8 i + 7 of n. */
+kernel void cubefan_cube_boxes(global const float4* cubes, global short4* boxes, const ClCubefanFusedParams p,
+                               const uint n)
+{
+    const uint first = (uint)get_global_id(0) * CLVR_LANES;
+    if (first >= n)
+        return;
+    const ClCamera cam = p.camera;
+    float8 lo_x, lo_y, lo_z, hi_x, hi_y, hi_z;
+#define CUBEFAN_LOAD(L)                                                                                              \
+    {                                                                                                                \
+        const uint i = min(first + L, n - 1);                                                                        \
+        const float4 a = cubes[3 * i], b = cubes[3 * i + 1];                                                         \
+        lo_x.s##L = a.x, lo_y.s##L = a.y, lo_z.s##L = a.z, hi_x.s##L = b.x, hi_y.s##L = b.y, hi_z.s##L = b.z;         \
+    }
+    CLVR_EACH_LANE(CUBEFAN_LOAD)
+#undef CUBEFAN_LOAD
+    /* relative to the eye, in world units */
+    lo_x = p.field_lo.x + lo_x / p.inv_spacing.x - cam.position.x, hi_x = p.field_lo.x + hi_x / p.inv_spacing.x - cam.position.x;
+    lo_y = p.field_lo.y + lo_y / p.inv_spacing.y - cam.position.y, hi_y = p.field_lo.y + hi_y / p.inv_spacing.y - cam.position.y;
+    lo_z = p.field_lo.z + lo_z / p.inv_spacing.z - cam.position.z, hi_z = p.field_lo.z + hi_z / p.inv_spacing.z - cam.position.z;
+    const int parallel = clvr_ray_parallel(cam);
+    float8 min_x = INFINITY, max_x = -INFINITY, min_y = INFINITY, max_y = -INFINITY, min_z = INFINITY, size = 0.0f;
+#define CUBEFAN_CORNER(K)                                                                                            \
+    {                                                                                                                \
+        const float8 x = (K) & 1 ? hi_x : lo_x, y = (K) & 2 ? hi_y : lo_y, z = (K) & 4 ? hi_z : lo_z;                 \
+        const float8 depth = x * cam.forward.x + y * cam.forward.y + z * cam.forward.z;                              \
+        const float8 w = parallel ? (float8)(1.0f) : 1.0f / depth;                                                   \
+        const float8 sx = (x * cam.right.x + y * cam.right.y + z * cam.right.z) * w;                                 \
+        const float8 sy = (x * cam.up.x + y * cam.up.y + z * cam.up.z) * w;                                          \
+        min_x = fmin(min_x, sx), max_x = fmax(max_x, sx), min_y = fmin(min_y, sy), max_y = fmax(max_y, sy);          \
+        min_z = fmin(min_z, depth), size = fmax(size, fabs(depth));                                                  \
+    }
+    CLVR_EACH_LANE(CUBEFAN_CORNER)
+#undef CUBEFAN_CORNER
+    /* window = (ndc + 1) / 2 size; pixel centre x at window x + 0.5; a band's rows start at cam.position.w */
+    const float full_h = cam.forward.w > 0.0f ? cam.forward.w : (float)p.height;
+    const float kx = 0.5f * (float)p.width / (cam.params.x * cam.params.y), ky = 0.5f * full_h / cam.params.x;
+    const float cx = 0.5f * (float)p.width - 0.5f, cy = 0.5f * full_h - 0.5f - cam.position.w;
+    const float8 px0 = min_x * kx + cx, px1 = max_x * kx + cx, py0 = cy - max_y * ky, py1 = cy - min_y * ky;
+    const float8 pad = 0.01f + 1e-5f * fmax(px1 - px0, py1 - py0);
+    const int8 whole = parallel ? (int8)(0) : ~isgreater(min_z, 1e-4f * size);
+    const float w1 = (float)(p.width - 1), h1 = (float)(p.height - 1);
+    const float8 x0 = select(fmax(ceil(px0 - pad), 0.0f), 0.0f, whole), x1 = select(fmin(floor(px1 + pad), w1), w1, whole);
+    const float8 y0 = select(fmax(ceil(py0 - pad), 0.0f), 0.0f, whole), y1 = select(fmin(floor(py1 + pad), h1), h1, whole);
+    const int8 empty = isgreater(x0, x1) | isgreater(y0, y1) | isnan(x0) | isnan(x1) | isnan(y0) | isnan(y1);
+#define CUBEFAN_STORE_BOX(L)                                                                                         \
+    if (first + L < n)                                                                                               \
+        boxes[first + L] = empty.s##L ? (short4)(1, 1, 0, 0)                                                         \
+                                      : (short4)((short)x0.s##L, (short)y0.s##L, (short)x1.s##L, (short)y1.s##L);
+    CLVR_EACH_LANE(CUBEFAN_STORE_BOX)
+#undef CUBEFAN_STORE_BOX
+}
+
+kernel void cubefan_tiles(global float4* out, global uint* steps, global const uint* tile_start,
+                          global const uint* tile_cubes, global const short4* boxes, global const float4* cubes,
+                          const ClCubefanFusedParams p, const int tiles_x)
+{
+    CLVR_GUARD_2D(p.width, p.height);
+    const int x = (int)get_global_id(0), y = (int)get_global_id(1);
+    float3 qe, qd, inv;
+    float t_box, t_box_out;
+    cubefan_ray(clvr_ray_window_offset(clvr_ray_pixel_centre(x, y), (float2)((float)p.width, (float)p.height), p.camera),
+                &p, &qe, &qd, &inv, &t_box, &t_box_out);
+    const int tile = (y >> CUBEFAN_TILE_H_LOG2) * tiles_x + (x >> CUBEFAN_TILE_W_LOG2);
+    float3 c = (float3)(0.0f);
+    float transmittance = 1.0f;
+    uint crossed = 0;
+    const uint end = tile_start[tile + 1];
+    for (uint k = tile_start[tile]; k < end; ++k) {
+        const uint i = tile_cubes[k];
+        const short4 b = boxes[i];
+        if (x < b.x || y < b.y || x > b.z || y > b.w)
+            continue;
+        const float4 lo = cubes[3 * i], hi = cubes[3 * i + 1], ct = cubes[3 * i + 2];
+        const float t0x = (lo.x - qe.x) * inv.x, t1x = (hi.x - qe.x) * inv.x;
+        const float t0y = (lo.y - qe.y) * inv.y, t1y = (hi.y - qe.y) * inv.y;
+        const float t0z = (lo.z - qe.z) * inv.z, t1z = (hi.z - qe.z) * inv.z;
+        const float t_in = fmax(fmax(fmax(fmin(t0x, t1x), fmin(t0y, t1y)), fmin(t0z, t1z)), 0.0f);
+        const float t_out = fmin(fmin(fmax(t0x, t1x), fmax(t0y, t1y)), fmax(t0z, t1z));
+        if (!(t_out > t_in))
+            continue;
+        ++crossed;
+        const float alpha = 1.0f - clvr_exp2(ct.w * ((t_in - t_out) * M_LOG2E_F));
+        c += (transmittance * alpha) * ct.xyz;
+        transmittance *= 1.0f - alpha;
+        if (1.0f - transmittance >= p.ert_alpha)
+            break;
+    }
+    const size_t pixel = (size_t)y * (size_t)p.width + (size_t)x;
+    out[pixel] = (float4)(c + transmittance * p.background.xyz, 1.0f - transmittance);
+    steps[pixel] = crossed;
+}
+
+/* cubefan_tiles for a whole tile per work-item, each row's 8 pixels as the lanes of 8-wide vectors: every cube is
+ * loaded and its color looked up once for the tile, and met by the rows its box reaches. Lane by lane the same
+ * operations as cubefan_tiles (kernels/packet.h's rule): the same bits. */
+/* clvr_exp2 for 16 lanes (kernels/packet.h's clvr_exp2_8, twice as wide): the same polynomial and exponent bits. */
+static float16 cubefan_exp2_16(const float16 x)
+{
+    const float16 n = rint(x);
+    const float16 f = x - n;
+    const float16 r = CLVR_EXP2_POLYNOMIAL(f) * as_float16((convert_int16(n) + 127) << 23);
+    return select((float16)(0.0f), r, isgreaterequal(x, -126.0f));
+}
+
+/* cubefan_tiles for a whole tile per work-item: two rows of 8 pixels as the 16 lanes of one vector (16 floats, one
+ * AVX-512 register), the tile's 4 rows as two such pairs. Each cube of the list is loaded once for the tile and met by
+ * the pairs its box reaches, the lanes outside its box (or past the image) masked, without asking whether any lane
+ * hits (that branch cost more than the work it skipped; BENCHMARKS.md run CT1). Lane by lane the operations of
+ * cubefan_tiles (kernels/packet.h's rule): the same bits. */
+kernel void cubefan_tiles_packet(global float4* out, global uint* steps, global const uint* tile_start,
+                                 global const uint* tile_cubes, global const short4* boxes, global const float4* cubes,
+                                 const ClCubefanFusedParams p, const int tiles_x)
+{
+    const int tx = (int)get_global_id(0), ty = (int)get_global_id(1);
+    if (tx >= tiles_x || ty >= ((p.height + CUBEFAN_TILE_H - 1) >> CUBEFAN_TILE_H_LOG2))
+        return;
+    const int x0 = tx << CUBEFAN_TILE_W_LOG2, y0 = ty << CUBEFAN_TILE_H_LOG2;
+    const int rows = min(CUBEFAN_TILE_H, p.height - y0);
+    const int8 xs8 = x0 + CLVR_LANE_INDEX;
+    const int16 xs = (int16)(xs8, xs8);
+    const int16 lane_row = (int16)((int8)(0), (int8)(1));  /* the lane's row within its pair */
+    float16 qex[2], qey[2], qez[2], ix[2], iy[2], iz[2], c_r[2], c_g[2], c_b[2], transmittance[2];
+    int16 crossed[2], live[2];
+    for (int pair = 0; pair < 2; ++pair) {
+        float8 ex[2], ey[2], ez[2], dx, dy, dz, inx[2], iny[2], inz[2];
+        for (int r = 0; r < 2; ++r)
+            cubefan_ray8(x0, y0 + 2 * pair + r, &p, &ex[r], &ey[r], &ez[r], &dx, &dy, &dz, &inx[r], &iny[r], &inz[r]);
+        qex[pair] = (float16)(ex[0], ex[1]), qey[pair] = (float16)(ey[0], ey[1]), qez[pair] = (float16)(ez[0], ez[1]);
+        ix[pair] = (float16)(inx[0], inx[1]), iy[pair] = (float16)(iny[0], iny[1]), iz[pair] = (float16)(inz[0], inz[1]);
+        c_r[pair] = c_g[pair] = c_b[pair] = 0.0f, transmittance[pair] = 1.0f;
+        crossed[pair] = 0;
+        live[pair] = (xs < p.width) & (2 * pair + lane_row < rows);
+    }
+    /* from one eye (perspective) every ray's e is the same: a cube's corners less e once per cube */
+    const int eye = !clvr_ray_parallel(p.camera);
+    const float e_x = qex[0].s0, e_y = qey[0].s0, e_z = qez[0].s0;
+    const int tile = ty * tiles_x + tx;
+    const uint end = tile_start[tile + 1];
+    for (uint k = tile_start[tile]; k < end; ++k) {
+        const uint i = tile_cubes[k];
+        if (k + CUBEFAN_AHEAD < end) {  /* the cubes come in visibility order, scattered in memory */
+            const uint ahead = tile_cubes[k + CUBEFAN_AHEAD];
+            CLVR_PREFETCH(boxes + ahead, 1);
+            CLVR_PREFETCH(cubes + 3 * (size_t)ahead, 3);
+        }
+        const short4 b = boxes[i];
+        const int16 columns = (xs >= (int)b.x) & (xs <= (int)b.z);
+        const float4 lo = cubes[3 * i], hi = cubes[3 * i + 1], ct = cubes[3 * i + 2];
+        const float a_x = lo.x - e_x, a_y = lo.y - e_y, a_z = lo.z - e_z, b_x = hi.x - e_x, b_y = hi.y - e_y,
+                    b_z = hi.z - e_z;
+        const int pair_lo = max((int)b.y - y0, 0) >> 1, pair_hi = min((int)b.w - y0, 3) >> 1;
+        for (int pair = pair_lo; pair <= pair_hi; ++pair) {
+            const int16 row = y0 + 2 * pair + lane_row;
+            const float16 t0x = (eye ? (float16)(a_x) : lo.x - qex[pair]) * ix[pair];
+            const float16 t1x = (eye ? (float16)(b_x) : hi.x - qex[pair]) * ix[pair];
+            const float16 t0y = (eye ? (float16)(a_y) : lo.y - qey[pair]) * iy[pair];
+            const float16 t1y = (eye ? (float16)(b_y) : hi.y - qey[pair]) * iy[pair];
+            const float16 t0z = (eye ? (float16)(a_z) : lo.z - qez[pair]) * iz[pair];
+            const float16 t1z = (eye ? (float16)(b_z) : hi.z - qez[pair]) * iz[pair];
+            const float16 t_in = fmax(fmax(fmax(fmin(t0x, t1x), fmin(t0y, t1y)), fmin(t0z, t1z)), 0.0f);
+            const float16 t_out = fmin(fmin(fmax(t0x, t1x), fmax(t0y, t1y)), fmax(t0z, t1z));
+            const int16 m = live[pair] & columns & (row >= (int)b.y) & (row <= (int)b.w) & isgreater(t_out, t_in);
+            crossed[pair] -= m;
+            const float16 alpha = 1.0f - cubefan_exp2_16(ct.w * ((t_in - t_out) * M_LOG2E_F));
+            const float16 ta = transmittance[pair] * alpha;
+            c_r[pair] = select(c_r[pair], c_r[pair] + ta * ct.x, m);
+            c_g[pair] = select(c_g[pair], c_g[pair] + ta * ct.y, m);
+            c_b[pair] = select(c_b[pair], c_b[pair] + ta * ct.z, m);
+            transmittance[pair] = select(transmittance[pair], transmittance[pair] * (1.0f - alpha), m);
+            live[pair] &= ~(m & isgreaterequal(1.0f - transmittance[pair], p.ert_alpha));
+        }
+        if (p.ert_alpha <= 1.0f && !any(live[0]) && !any(live[1]))
+            break;  /* early termination: every pixel of the tile is opaque */
+    }
+    for (int row = 0; row < rows; ++row) {
+        float r[16], g[16], bl[16], t[16];
+        int n[16];
+        const int pair = row >> 1, h = (row & 1) * CLVR_LANES;
+        vstore16(c_r[pair], 0, r), vstore16(c_g[pair], 0, g), vstore16(c_b[pair], 0, bl);
+        vstore16(transmittance[pair], 0, t), vstore16(crossed[pair], 0, n);
+        const size_t at = (size_t)(y0 + row) * (size_t)p.width + (size_t)x0;
+        for (int c = 0; c < CLVR_LANES && x0 + c < p.width; ++c) {
+            out[at + c] = (float4)((float3)(r[h + c], g[h + c], bl[h + c]) + t[h + c] * p.background.xyz, 1.0f - t[h + c]);
+            steps[at + c] = (uint)n[h + c];
+        }
+    }
+}
 #endif

@@ -438,6 +438,48 @@ TEST(CubefanOctree, SelectionIsWithinToleranceAndBackToFront)
     EXPECT_EQ(tree.select(1.0, tf, views[0].eye, forward, false).size(), tf(tree.value(tree.levels() - 1, glm::ivec3(0))).a > 0.0 ? 1u : 0u);
 }
 
+// The tile path's selection tree orders the same cubes for each eye as select() does, nearest first: frontToBack is
+// select()'s list reversed, cube for cube, from eyes outside in several octants, inside the volume and on a cube's
+// split planes, and along parallel views (the eye then unused); the tree's stats are select()'s.
+TEST(CubefanOctree, SelectionTreeOrdersTheCubesAsSelect)
+{
+    const Volume v = randomVolume({13, 9, 11}, 7);
+    const CubeOctree octree(v);
+    const TransferFunction tf({{0.0, glm::dvec3(0.0), 0.0}, {0.3, glm::dvec3(0.0), 0.0}, {0.5, glm::dvec3(1.0), 2.0},
+                               {1.0, glm::dvec3(1.0), 3.0}});
+    const glm::dvec3 inside = v.origin + glm::dvec3(4.2, 2.3, 3.1) * v.spacing;
+    const glm::dvec3 onPlanes = v.origin + glm::dvec3(3.5, 3.5, 7.5) * v.spacing;  // on split planes of several levels
+    const glm::dvec3 eyes[] = {{6.0, -3.0, 9.0}, {-4.0, 8.0, -2.0}, {0.1, 0.2, -9.0}, inside, onPlanes};
+    const glm::dvec3 forwards[] = {glm::normalize(glm::dvec3(0.3, 0.8, -0.5)), glm::normalize(glm::dvec3(-0.6, 0.1, 0.7))};
+    int compared = 0;
+    for (const double tolerance : {0.0, 0.2, 0.5, 1.0}) {
+        SelectionStats treeStats;
+        const CubeOctree::SelectionTree tree = octree.selectTree(tolerance, tf, &treeStats);
+        std::vector<std::uint32_t> order;
+        auto check = [&](const glm::dvec3& eye, const glm::dvec3& forward, bool parallel) {
+            SelectionStats stats;
+            const std::vector<Cube> cubes = octree.select(tolerance, tf, eye, forward, parallel, &stats);
+            EXPECT_EQ(treeStats.selected, stats.selected);
+            EXPECT_EQ(treeStats.visited, stats.visited);
+            EXPECT_EQ(treeStats.transparent, stats.transparent);
+            tree.frontToBack(eye, forward, parallel, order);
+            ASSERT_EQ(order.size(), cubes.size());
+            for (std::size_t k = 0; k < cubes.size(); ++k) {
+                const Cube& a = cubes[cubes.size() - 1 - k];
+                const Cube& b = tree.cubes[order[k]];
+                EXPECT_TRUE(a.level == b.level && a.index == b.index && a.value == b.value && a.lo == b.lo && a.hi == b.hi)
+                    << "tolerance " << tolerance << ", cube " << k << " of " << cubes.size();
+            }
+            ++compared;
+        };
+        for (const glm::dvec3& eye : eyes)
+            check(eye, forwards[0], false);
+        for (const glm::dvec3& forward : forwards)
+            check(glm::dvec3(0.0), forward, true);
+    }
+    EXPECT_EQ(compared, 4 * 7);
+}
+
 // The fused path's selection grid holds the same selection as select(): every selected cube's voxels carry
 // its level and value, every other voxel (and the bricks' padding beyond the grid) is marked transparent,
 // and the counts agree. Checked voxel by voxel through selectionGridIndex, which must be a one-to-one map

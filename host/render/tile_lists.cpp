@@ -1,6 +1,9 @@
 // host/render/tile_lists.cpp — binning items to tiles in order (tile_lists.h).
 #include "host/render/tile_lists.h"
 
+#include <algorithm>
+
+#include "host/runtime/device.h"
 #include "host/runtime/errors.h"
 #include "host/runtime/parallel.h"
 
@@ -9,22 +12,32 @@ namespace clvr {
 TileLists binToTiles(const std::vector<PixelBox>& boxes, const std::vector<std::uint32_t>& order, int width, int height,
                      int tileW, int tileH, const std::string& what, const std::string& remedy)
 {
+    // the tile sizes as shifts (a division per box and pass cost more than the rest of the loop)
+    int tileWLog2 = 0, tileHLog2 = 0;
+    while ((1 << tileWLog2) < tileW)
+        ++tileWLog2;
+    while ((1 << tileHLog2) < tileH)
+        ++tileHLog2;
+    if ((1 << tileWLog2) != tileW || (1 << tileHLog2) != tileH)
+        throw InternalError("binToTiles: tile sizes must be powers of two, got " + std::to_string(tileW) + "x" +
+                            std::to_string(tileH));
     TileLists lists;
     lists.tilesX = (width + tileW - 1) / tileW;
     lists.tilesY = (height + tileH - 1) / tileH;
     const std::size_t tiles = static_cast<std::size_t>(lists.tilesX) * lists.tilesY;
-    constexpr std::size_t kChunk = 16384;
+    // One chunk per thread (at least 16,384 items each): the per-chunk counts and their prefix stay small.
+    const int threads = threadsToUse(0, static_cast<int>(order.size() / 16384 + 1));
+    const std::size_t kChunk = std::max<std::size_t>(16384, (order.size() + threads - 1) / threads);
     const std::size_t chunks = (order.size() + kChunk - 1) / kChunk;
     // chunk c's count, then its first entry, in tile t: offset[c * tiles + t]
     std::vector<cl_uint> offset(chunks * tiles, 0);
     auto forTiles = [&](const PixelBox& b, const auto& visit) {
         if (b.x0 > b.x1 || b.y0 > b.y1)
             return;
-        for (int ty = b.y0 / tileH; ty <= b.y1 / tileH; ++ty)
-            for (int tx = b.x0 / tileW; tx <= b.x1 / tileW; ++tx)
+        for (int ty = b.y0 >> tileHLog2; ty <= b.y1 >> tileHLog2; ++ty)
+            for (int tx = b.x0 >> tileWLog2; tx <= b.x1 >> tileWLog2; ++tx)
                 visit(static_cast<std::size_t>(ty) * lists.tilesX + tx);
     };
-    const int threads = hostChunkThreads(order.size(), kChunk);
     auto overChunks = [&](const auto& work) { forHostChunks(threads, order.size(), work, kChunk); };
     overChunks([&](std::size_t begin, std::size_t end) {
         cl_uint* count = offset.data() + begin / kChunk * tiles;
@@ -51,6 +64,20 @@ TileLists binToTiles(const std::vector<PixelBox>& boxes, const std::vector<std::
             forTiles(boxes[order[i]], [&](std::size_t tile) { lists.items[next[tile]++] = order[i]; });
     });
     return lists;
+}
+
+void StagingBuffer::write(Device& device, std::string_view what, const void* data, std::size_t bytes,
+                          std::uint64_t& resident)
+{
+    const std::size_t need = std::max<std::size_t>(bytes, 16);
+    if (!buffer_() || bytes_ < need) {
+        resident -= bytes_;
+        bytes_ = std::max(need, 2 * bytes_);
+        buffer_ = device.buffer(what, bytes_, CL_MEM_READ_ONLY);
+        resident += bytes_;
+    }
+    if (bytes > 0)
+        device.queue().enqueueWriteBuffer(buffer_, CL_TRUE, 0, bytes, data);
 }
 
 }  // namespace clvr

@@ -4,8 +4,11 @@
 
 #include <CL/opencl.hpp>
 
+#include <cstddef>
+
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace clvr {
@@ -25,8 +28,22 @@ struct TileLists {
     int tilesX = 0, tilesY = 0;
     std::vector<cl_uint> start, items;
 };
-// InputError "<what>: the tile lists have more than 2^32 entries; <remedy>" where they would.
+// tileW and tileH: powers of two. InputError "<what>: the tile lists have more than 2^32 entries; <remedy>" where they would.
 TileLists binToTiles(const std::vector<PixelBox>& boxes, const std::vector<std::uint32_t>& order, int width, int height,
                      int tileW, int tileH, const std::string& what, const std::string& remedy);
+
+class Device;
+
+// A read-only device buffer for per-frame uploads (boxes, tile lists), grown as needed (to at least twice its size,
+// so that a frame rarely reallocates); `resident` keeps the renderer's count of device bytes.
+class StagingBuffer {
+public:
+    void write(Device& device, std::string_view what, const void* data, std::size_t bytes, std::uint64_t& resident);
+    const cl::Buffer& buffer() const { return buffer_; }
+
+private:
+    cl::Buffer buffer_;
+    std::size_t bytes_ = 0;
+};
 
 }  // namespace clvr

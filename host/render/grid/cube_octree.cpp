@@ -2,7 +2,8 @@
 // back to front.
 #include "host/render/grid/cube_octree.h"
 
-#include "host/render/transfer_function_upload.h"  // tauZeroOn: also slice3d's empty-brick test
+#include "host/render/transfer_function_upload.h"
+#include "host/runtime/errors.h"  // tauZeroOn: also slice3d's empty-brick test
 
 #include <algorithm>
 #include <cmath>
@@ -195,6 +196,78 @@ CubeOctree::SelectionGrid CubeOctree::selectGrid(double tolerance, const Transfe
     if (stats)
         *stats = s;
     return grid;
+}
+
+CubeOctree::SelectionTree CubeOctree::selectTree(double tolerance, const TransferFunction& tf, SelectionStats* stats) const
+{
+    SelectionTree tree;
+    SelectionStats s;
+    const double allowed = tolerance * range_;
+    // Returns what goes into the parent's child slot.
+    auto visit = [&](auto&& self, int level, const glm::ivec3& i) -> std::int32_t {
+        ++s.visited;
+        const Verdict v = verdict(level, i, allowed, tf);
+        if (v == Verdict::Transparent) {
+            ++s.transparent;
+            return SelectionTree::kNone;
+        }
+        if (v == Verdict::Take) {
+            Cube c;
+            c.level = level;
+            c.index = i;
+            c.value = value(level, i);
+            box(level, i, c.lo, c.hi);
+            s.largestDiagonal = std::max(s.largestDiagonal, glm::length(c.hi - c.lo));
+            tree.cubes.push_back(c);
+            return ~static_cast<std::int32_t>(tree.cubes.size() - 1);
+        }
+        const std::size_t at = tree.nodes.size();
+        tree.nodes.emplace_back();
+        glm::dvec3 lo, hi;
+        box(level - 1, 2 * i, lo, hi);
+        tree.nodes[at].split = hi;
+        const glm::ivec3 childDims = levels_[level - 1].dims;
+        for (int m = 0; m < 8; ++m) {
+            const glm::ivec3 ci = 2 * i + glm::ivec3(m & 1, (m >> 1) & 1, (m >> 2) & 1);
+            const std::int32_t child = glm::all(glm::lessThan(ci, childDims)) ? self(self, level - 1, ci)
+                                                                                : SelectionTree::kNone;
+            tree.nodes[at].child[static_cast<std::size_t>(m)] = child;
+        }
+        return static_cast<std::int32_t>(at);
+    };
+    tree.root = visit(visit, levels() - 1, glm::ivec3(0));
+    if (tree.cubes.size() >= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
+        throw InputError("cubefan: more than 2^31 cubes selected");
+    s.selected = tree.cubes.size();
+    if (stats)
+        *stats = s;
+    return tree;
+}
+
+void CubeOctree::SelectionTree::frontToBack(const glm::dvec3& eye, const glm::dvec3& forward, bool parallel,
+                                            std::vector<std::uint32_t>& order) const
+{
+    order.clear();
+    order.reserve(cubes.size());
+    // Depth first, a node's children nearest first: child nearSide ^ m for m = 0 .. 7 (select()'s order reversed).
+    // Recursion depth is the level count.
+    auto visit = [&](auto&& self, std::int32_t item) -> void {
+        const Node& n = nodes[static_cast<std::size_t>(item)];
+        int nearSide = 0;
+        for (int a = 0; a < 3; ++a)
+            nearSide |= (parallel ? forward[a] < 0.0 : eye[a] > n.split[a]) ? (1 << a) : 0;
+        for (int m = 0; m < 8; ++m) {
+            const std::int32_t child = n.child[static_cast<std::size_t>(nearSide ^ m)];
+            if (child >= 0)
+                self(self, child);
+            else if (child != kNone)
+                order.push_back(static_cast<std::uint32_t>(~child));
+        }
+    };
+    if (root >= 0)
+        visit(visit, root);
+    else if (root != kNone)
+        order.push_back(static_cast<std::uint32_t>(~root));
 }
 
 }  // namespace clvr::cubefan

@@ -10,7 +10,9 @@
 
 #include <glm/glm.hpp>
 
+#include <array>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace clvr::cubefan {
@@ -80,6 +82,25 @@ public:
         std::vector<float> value;
     };
     SelectionGrid selectGrid(double tolerance, const TransferFunction& tf, SelectionStats* stats = nullptr) const;
+
+    // The same selection once more, for orders per view (the tile path, host/render/grid/cubefan.cpp): the cubes
+    // that add color (`cubes`, their index is their id) and the octree's nodes that the selection descends
+    // through, each with its split point and its children — a node (>= 0), a cube (~id) or none (kNone: outside
+    // the grid, or transparent). frontToBack orders the cubes for an eye as select() does, nearest first.
+    struct SelectionTree {
+        static constexpr std::int32_t kNone = std::numeric_limits<std::int32_t>::min();
+        struct Node {
+            glm::dvec3 split;                 // the world coordinates of the planes between the children
+            std::array<std::int32_t, 8> child; // child m at (m & 1, m >> 1 & 1, m >> 2 & 1) of the split
+        };
+        std::vector<Node> nodes;  // nodes[0] the root, when it is split
+        std::vector<Cube> cubes;
+        std::int32_t root = kNone;  // a node, a cube (~id) or none
+        // The cubes' ids, nearest first: the reverse of select()'s back-to-front order for the same eye.
+        void frontToBack(const glm::dvec3& eye, const glm::dvec3& forward, bool parallel,
+                         std::vector<std::uint32_t>& order) const;
+    };
+    SelectionTree selectTree(double tolerance, const TransferFunction& tf, SelectionStats* stats = nullptr) const;
 
 private:
     // The selection's verdict on one cube: drawn whole, transparent (skipped with its subtree), or split.

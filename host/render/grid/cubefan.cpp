@@ -11,6 +11,7 @@
 #include "host/render/grid/slice3d.h"  // emptySpaceRadii
 #include "host/render/options_util.h"
 #include "host/render/scaffold.h"
+#include "host/render/tile_lists.h"
 #include "host/render/transfer_function_upload.h"
 #include "host/runtime/embedded_kernels.h"
 #include "host/runtime/errors.h"
@@ -31,6 +32,19 @@ namespace clvr {
 
 static_assert(sizeof(ClCubefanUniforms) == 112, "float4s only: the fragment program reads it from its uniforms");
 static_assert(sizeof(ClCubefanFusedParams) == 192, "also probed on the device by tests/layout_test.cpp");
+
+const char* pathName(CubefanOptions::Path path)
+{
+    switch (path) {
+    case CubefanOptions::Path::Fused:
+        return "fused";
+    case CubefanOptions::Path::Raster:
+        return "raster";
+    case CubefanOptions::Path::Tiles:
+        return "tiles";
+    }
+    return "fused";
+}
 
 const char* opacityName(CubefanOptions::Opacity opacity)
 {
@@ -223,8 +237,11 @@ public:
     CubefanRenderer(Device& device, const Scene& scene, const Volume& volume);
     Image4f render(FrameStats& stats) override
     {
-        Image4f image = options_.path == CubefanOptions::Path::Fused ? renderFused(stats) : renderRaster(stats);
-        stats.extra["path"] = options_.path == CubefanOptions::Path::Fused ? "fused" : "raster";
+        using Path = CubefanOptions::Path;
+        Image4f image = options_.path == Path::Fused   ? renderFused(stats)
+                        : options_.path == Path::Tiles ? renderTiles(stats)
+                                                       : renderRaster(stats);
+        stats.extra["path"] = pathName(options_.path);
         stats.extra["error"] = options_.error;
         stats.extra["hierarchy_ms"] = hierarchyMs_;
         stats.extra["hierarchy_levels"] = octree_->levels();
@@ -253,6 +270,7 @@ public:
 private:
     Image4f renderRaster(FrameStats& stats);
     Image4f renderFused(FrameStats& stats);
+    Image4f renderTiles(FrameStats& stats);
     void updateTexture(double k);
     double updateSelectionGrid();
 
@@ -282,7 +300,15 @@ private:
     cl::Kernel fused_;
     bool packet_ = false;  // fused_ is cubefan_fused_packet
     cl::Buffer gridLevel_, gridValue_, gridSpace_, fusedSteps_, fusedSkipped_;
-    bool gridCurrent_ = false;
+    bool gridCurrent_ = false;  // the selection grid, or on the tile path the selection tree and its cubes
+    // The tile path: the selection as a tree (the order per view), its cubes on the device (2 float4 each: low
+    // corner and value, high corner, in the selection grid's coordinates), the frame's order, boxes and tile lists.
+    cubefan::CubeOctree::SelectionTree tree_;
+    cl::Buffer tileCubes_, tileBoxesOut_;
+    std::uint64_t tileCubeBytes_ = 0;
+    cl::Kernel cubeColors_, cubeBoxes_;
+    std::vector<std::uint32_t> order_;
+    StagingBuffer tileStart_, tileItems_;
     cubefan::SelectionStats gridStats_;
     std::uint64_t gridEmptyBricks_ = 0;  // bricks of 4^3 voxels with nothing to add
     double gridMs_ = 0.0;                // the last build of the grid (selection, empty space, upload)
@@ -329,6 +355,19 @@ CubefanRenderer::CubefanRenderer(Device& device, const Scene& scene, const Volum
         // Ray packets (docs/cubefan.md): the same walk on 8 pixels at once, its entries indexed in 32 bits.
         packet_ = packetsOnDevice(options_.packets, device_) && entries <= 0xffffffffu;
         fused_ = device_.kernel("cubefan.cl", packet_ ? "cubefan_fused_packet" : "cubefan_fused");
+        return;
+    }
+    if (options_.path == CubefanOptions::Path::Tiles) {
+        if (image_.width > kTileImageMax || image_.height > kTileImageMax)
+            throw InputError("cubefan: \"path\": \"tiles\" takes images of at most " + std::to_string(kTileImageMax) +
+                             " pixels a side, got " + std::to_string(image_.width) + "x" + std::to_string(image_.height));
+        const std::size_t pixels = static_cast<std::size_t>(image_.width) * image_.height;
+        fusedSteps_ = device_.buffer("cubefan chords per pixel", pixels * sizeof(cl_uint), CL_MEM_WRITE_ONLY);
+        residentBytes_ += pixels * sizeof(cl_uint);
+        packet_ = packetsOnDevice(options_.packets, device_);  // a tile per work-item, its rows as vectors
+        fused_ = device_.kernel("cubefan.cl", packet_ ? "cubefan_tiles_packet" : "cubefan_tiles");
+        cubeColors_ = device_.kernel("cubefan.cl", "cubefan_cube_colors");
+        cubeBoxes_ = device_.kernel("cubefan.cl", "cubefan_cube_boxes");
         return;
     }
     overBackground_.emplace(device_);
@@ -421,6 +460,113 @@ Image4f CubefanRenderer::renderFused(FrameStats& stats)
     stats.extra["cubes_crossed"] = crossed;
     stats.extra["cubes_stepped_over"] = steppedOver;
     stats.extra["empty_bricks"] = gridEmptyBricks_;
+    stats.extra["early_termination"] = options_.earlyTermination;
+    return image;
+}
+
+// The tile path: the selection as a tree (when the tolerance or transfer function changed), its cubes ordered front to
+// back for the eye, boxed and binned to tiles on the host's threads, then cubefan_tiles (or its packets) over the image.
+Image4f CubefanRenderer::renderTiles(FrameStats& stats)
+{
+    const FrameClock clock;
+    std::vector<PassTime> hostPasses;
+    double selectionMs = 0.0;  // this frame's
+    if (!gridCurrent_) {
+        const auto t0 = std::chrono::steady_clock::now();
+        tree_ = octree_->selectTree(options_.error, tfHost_, &gridStats_);
+        const std::size_t n = tree_.cubes.size();
+        if (n >= (std::size_t(1) << 30))  // the kernels index 3 float4 per cube in 32 bits
+            throw InputError("cubefan: \"path\": \"tiles\" takes fewer than 2^30 cubes, the selection has " +
+                             std::to_string(n) + "; use \"path\": \"fused\" or a larger error");
+        checkHostMemory("cubefan's tile path (" + std::to_string(n) + " cubes)", n * 3 * sizeof(cl_float4));
+        std::vector<cl_float4> cubes(3 * n);
+        for (std::size_t i = 0; i < n; ++i) {
+            const cubefan::Cube& c = tree_.cubes[i];
+            const glm::ivec3 lo = c.index * (1 << c.level), hi = glm::min(lo + (1 << c.level), dims_);
+            cubes[3 * i] = cl_float4{{static_cast<float>(lo.x), static_cast<float>(lo.y), static_cast<float>(lo.z), c.value}};
+            cubes[3 * i + 1] = cl_float4{{static_cast<float>(hi.x), static_cast<float>(hi.y), static_cast<float>(hi.z), 0.0f}};
+        }
+        residentBytes_ -= tileCubeBytes_;
+        tileCubes_ = device_.upload("cubefan tile path cubes", cubes.empty() ? std::vector<cl_float4>(3) : cubes,
+                                    CL_MEM_READ_WRITE);
+        tileBoxesOut_ = device_.buffer("cubefan tile path cube boxes", std::max<std::size_t>(n, 1) * sizeof(cl_short4));
+        tileCubeBytes_ = std::max<std::size_t>(3 * n, 3) * sizeof(cl_float4) + std::max<std::size_t>(n, 1) * sizeof(cl_short4);
+        residentBytes_ += tileCubeBytes_;
+        if (n > 0) {  // each cube's color (the transfer function on the device, as the walk evaluates it)
+            int a = 0;
+            cubeColors_.setArg(a++, tileCubes_);
+            cubeColors_.setArg(a++, tf_.buffer());
+            cubeColors_.setArg(a++, static_cast<cl_int>(tf_.count()));
+            cubeColors_.setArg(a++, static_cast<cl_uint>(n));
+            device_.launch("cubefan: cube colors", cubeColors_, n);
+        }
+        gridCurrent_ = true;
+        gridMs_ = selectionMs = msSince(t0);
+        hostPasses.push_back({"cubefan: selection tree (host, when the tolerance or transfer function changes)", gridMs_});
+    }
+    const int width = image_.width, height = image_.height;
+    ClCubefanFusedParams p{};
+    p.camera = toClCamera(camera_, width, height, shift_);
+    p.field_lo = toCl4(lo_ - shift_, 0.0);
+    p.inv_spacing = toCl4(1.0 / spacing_, 0.0);
+    p.background = toCl4(glm::dvec3(image_.background), 0.0);
+    p.dims = cl_int4{{dims_.x, dims_.y, dims_.z, 0}};
+    p.width = width;
+    p.height = height;
+    p.tf_count = static_cast<cl_int>(tf_.count());
+    p.ert_alpha = options_.earlyTermination < 1.0 ? static_cast<float>(options_.earlyTermination) : 2.0f;
+    // The cubes' boxes on the device while the host orders the cubes for the eye; then the boxes read back and the
+    // cubes binned to tiles in that order.
+    const std::size_t n = tree_.cubes.size();
+    const auto t1 = std::chrono::steady_clock::now();
+    if (n > 0) {
+        int a = 0;
+        cubeBoxes_.setArg(a++, tileCubes_);
+        cubeBoxes_.setArg(a++, tileBoxesOut_);
+        cubeBoxes_.setArg(a++, p);
+        cubeBoxes_.setArg(a++, static_cast<cl_uint>(n));
+        device_.launch("cubefan: cube boxes", cubeBoxes_, (n + 7) / 8);  // 8 cubes per work-item
+        device_.queue().flush();
+    }
+    tree_.frontToBack(camera_.position, camera_.forward(), camera_.parallel, order_);
+    std::vector<PixelBox> boxes(n);
+    if (n > 0)
+        device_.queue().enqueueReadBuffer(tileBoxesOut_, CL_TRUE, 0, n * sizeof(PixelBox), boxes.data());
+    const TileLists lists = binToTiles(boxes, order_, width, height, kCubefanTileW, kCubefanTileH,
+                                       "cubefan: \"path\": \"tiles\"", "use \"path\": \"fused\" or a smaller image");
+    static_assert(sizeof(PixelBox) == sizeof(cl_short4));
+    tileStart_.write(device_, "cubefan tile starts", lists.start.data(), lists.start.size() * sizeof(cl_uint), residentBytes_);
+    tileItems_.write(device_, "cubefan tile cubes", lists.items.data(), lists.items.size() * sizeof(cl_uint), residentBytes_);
+    hostPasses.push_back({"cubefan: order and tile lists (host, beside the cube boxes)", msSince(t1)});
+
+    int a = 0;
+    fused_.setArg(a++, fb_.color());
+    fused_.setArg(a++, fusedSteps_);
+    fused_.setArg(a++, tileStart_.buffer());
+    fused_.setArg(a++, tileItems_.buffer());
+    fused_.setArg(a++, tileBoxesOut_);
+    fused_.setArg(a++, tileCubes_);
+    fused_.setArg(a++, p);
+    fused_.setArg(a++, static_cast<cl_int>(lists.tilesX));
+    if (packet_)  // a work-item per tile
+        device_.launch("cubefan: tiles", fused_, static_cast<std::size_t>(lists.tilesX),
+                       static_cast<std::size_t>(lists.tilesY), 1, 1);
+    else
+        device_.launch("cubefan: tiles", fused_, static_cast<std::size_t>(width), static_cast<std::size_t>(height),
+                       kCubefanTileW, kCubefanTileH);
+    const std::uint64_t crossed = sumCounts(device_, fusedSteps_, static_cast<std::size_t>(width) * height);
+    Image4f image = readImage(device_, fb_.color(), width, height);
+    finishFrame(device_, clock, stats, std::move(hostPasses));
+    stats.samples = crossed;
+    stats.extra["selection_ms"] = selectionMs;
+    stats.extra["selection_grid_ms"] = gridMs_;
+    stats.extra["selection_visited"] = gridStats_.visited;
+    stats.extra["packets"] = packet_;
+    stats.extra["cubes"] = gridStats_.selected;
+    stats.extra["cubes_transparent"] = gridStats_.transparent;
+    stats.extra["cubes_crossed"] = crossed;
+    stats.extra["tile_entries"] = lists.items.size();
+    stats.extra["tile_size"] = {kCubefanTileW, kCubefanTileH};
     stats.extra["early_termination"] = options_.earlyTermination;
     return image;
 }
@@ -565,9 +711,10 @@ TechniqueInfo cubefanTechnique()
          "\"interpolated\" (at the fans' vertices, across each triangle: seeds/002 §7) or \"exact\" (each "
          "fragment's own chord through its cube, drawn as back faces)"},
         {"path", "fused", "",
-         "\"fused\" (each pixel's ray walks the selected cubes in one kernel, every chord exact) or \"raster\" "
-         "(the paper's triangle fans through the raster stage); opacity, texture_size or thickness other than "
-         "their defaults take \"raster\""},
+         "\"fused\" (each pixel's ray walks the selected cubes in one kernel, every chord exact), \"tiles\" (the "
+         "cubes in the octree's visibility order binned to 8x4-pixel tiles, each tile's rays meeting its cubes in one "
+         "kernel, every chord exact) or \"raster\" (the paper's triangle fans through the raster stage); opacity, "
+         "texture_size or thickness other than their defaults take \"raster\""},
         earlyTerminationInfo(1.0),
         packetsInfo(),
     };
@@ -602,8 +749,9 @@ CubefanOptions parseCubefanOptions(const nlohmann::json& options)
         } else if (key == "texture_size") {
             o.textureSize = integerOption(key, value, 2, 4096);
         } else if (key == "path") {
-            o.path = choiceOption(key, value, {"fused", "raster"}) == 0 ? CubefanOptions::Path::Fused
-                                                                       : CubefanOptions::Path::Raster;
+            const CubefanOptions::Path paths[] = {CubefanOptions::Path::Fused, CubefanOptions::Path::Raster,
+                                                  CubefanOptions::Path::Tiles};
+            o.path = paths[choiceOption(key, value, {"fused", "raster", "tiles"})];
         } else if (key == "early_termination") {
             o.earlyTermination = earlyTerminationOption(value);
         } else if (key == "packets") {
@@ -621,13 +769,14 @@ CubefanOptions parseCubefanOptions(const nlohmann::json& options)
     for (const auto& [key, changed] : fans) {
         if (!changed)
             continue;
-        if (options.contains("path") && o.path == CubefanOptions::Path::Fused)
-            badOption(key, "describes the raster path's triangle fans; the fused path computes every chord exactly: "
-                           "give \"path\": \"raster\" or leave path out");
+        if (options.contains("path") && o.path != CubefanOptions::Path::Raster)
+            badOption(key, std::string("describes the raster path's triangle fans; the ") + pathName(o.path) +
+                               " path computes every chord exactly: give \"path\": \"raster\" or leave path out");
         o.path = CubefanOptions::Path::Raster;
     }
     if (o.earlyTermination < 1.0 && o.path == CubefanOptions::Path::Raster)
-        badOption("early_termination", "is only available on the fused path (the blending stage cannot stop a pixel)");
+        badOption("early_termination",
+                  "is only available on the fused and tile paths (the blending stage cannot stop a pixel)");
     return o;
 }
 

@@ -38,7 +38,10 @@ struct CubefanOptions {
     // image of exact thickness, without fans or the raster stage); "raster": the paper's fans through
     // the raster stage. opacity, texture_size and thickness describe the fans: one of them away from its
     // default, without a path, takes "raster".
-    enum class Path { Fused, Raster };
+    // "tiles": the selected cubes in the octree's visibility order for the eye (as the fans), binned to tiles of
+    // kCubefanTileW x kCubefanTileH pixels by their boxes of pixel centres, each tile's rays meeting its cubes front
+    // to back in one kernel (the chord exact, as the fused path's); early_termination and packets as fused.
+    enum class Path { Fused, Raster, Tiles };
     Path path = Path::Fused;
     double earlyTermination = 1.0;  // fused path: stop a ray once its opacity reaches this (1 = off)
     // Fused path: 8 neighbouring pixels per work-item, one per float8 lane (kernels/cubefan.cl's
@@ -48,12 +51,20 @@ struct CubefanOptions {
 
 const char* opacityName(CubefanOptions::Opacity opacity);
 
+// The option's value for `path` ("fused", "raster", "tiles").
+const char* pathName(CubefanOptions::Path path);
+
+// The tile path's tiles (kernels/cubefan.cl CUBEFAN_TILE_W_LOG2, _H_LOG2): 8 wide, a packet's row.
+inline constexpr int kCubefanTileW = 8, kCubefanTileH = 4;
+
+
 // Its registry entry (host/render/renderer.h).
 TechniqueInfo cubefanTechnique();
 
 // Reads the scene's "options" for cubefan: "error" (a number in [0, 1]), "opacity" ("texture" | "exp" |
 // "linear"), "texture_size" (an integer in [2, 4096]), "thickness" ("interpolated" | "exact"), "path"
-// ("fused" | "raster"), "early_termination" (in (0, 1], fused path), "packets" (true | false | null, fused path). InputError naming the key otherwise.
+// ("fused" | "raster" | "tiles"), "early_termination" (in (0, 1], fused and tile paths), "packets" (true | false |
+// null, fused and tile paths). InputError naming the key otherwise.
 CubefanOptions parseCubefanOptions(const nlohmann::json& options);
 
 // The exp-opacity texture of §7, N x N floats, x fastest: texel (i, j) = 1 - exp(-k u v) with

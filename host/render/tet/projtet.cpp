@@ -660,20 +660,14 @@ private:
     std::vector<raster::Vertex> vertices_;  // the frame's triangles, 3 vertices each
     std::uint64_t residentBytes_ = 0;
     // The fused path: its kernel, its per-pixel outputs, and the frame's boxes and tile lists (grown as needed).
-    struct Staging {
-        cl::Buffer buffer;
-        std::size_t bytes = 0;
-    };
     cl::Kernel fused_;
     bool packet_ = false;  // fused_ is projtet_fused_packet
     cl::Buffer fusedOut_, fusedSegments_;
-    Staging boxes_, tileStart_, tileCells_;
+    StagingBuffer boxes_, tileStart_, tileCells_;
 
     // The fused path's frame after the sort (ProjtetOptions::Path::Fused).
     Image4f renderFused(const VisibilitySorter::Result& sorted, std::vector<PassTime> hostPasses,
                         const FrameClock& clock, FrameStats& stats);
-    // Writes `bytes` of `data` into `staging`, which grows to hold them.
-    void stage(Staging& staging, std::string_view what, const void* data, std::size_t bytes);
     // The stats both paths report: the order and the sort, the counts, the integration.
     void reportOrder(const VisibilitySorter::Result& sorted, double boundaryMs, double sortMs, FrameStats& stats) const;
 };
@@ -716,19 +710,6 @@ ProjtetRenderer::ProjtetRenderer(Device& device, const Scene& scene, const TetMe
     }
 }
 
-void ProjtetRenderer::stage(Staging& staging, std::string_view what, const void* data, std::size_t bytes)
-{
-    const std::size_t need = std::max<std::size_t>(bytes, 16);
-    if (!staging.buffer() || staging.bytes < need) {
-        residentBytes_ -= staging.bytes;
-        staging.bytes = std::max(need, 2 * staging.bytes);
-        staging.buffer = device_.buffer(what, staging.bytes, CL_MEM_READ_ONLY);
-        residentBytes_ += staging.bytes;
-    }
-    if (bytes > 0)
-        device_.queue().enqueueWriteBuffer(staging.buffer, CL_TRUE, 0, bytes, data);
-}
-
 // The fused path: the cells' boxes of pixel centres (projtetCellBoxes), the cells binned to tiles of
 // kProjtetTileW x kProjtetTileH pixels in visibility order (binToTiles), then kernels/projtet.cl's projtet_fused (or
 // its packets) over the image.
@@ -743,9 +724,11 @@ Image4f ProjtetRenderer::renderFused(const VisibilitySorter::Result& sorted, std
     const int tilesX = lists.tilesX, tilesY = lists.tilesY;
     const std::uint64_t entries = lists.items.size();
     static_assert(sizeof(ProjtetBox) == sizeof(cl_short4));
-    stage(boxes_, "projtet fused cell boxes", boxes.data(), boxes.size() * sizeof(ProjtetBox));
-    stage(tileStart_, "projtet fused tile starts", lists.start.data(), lists.start.size() * sizeof(cl_uint));
-    stage(tileCells_, "projtet fused tile cells", lists.items.data(), lists.items.size() * sizeof(cl_uint));
+    boxes_.write(device_, "projtet fused cell boxes", boxes.data(), boxes.size() * sizeof(ProjtetBox), residentBytes_);
+    tileStart_.write(device_, "projtet fused tile starts", lists.start.data(), lists.start.size() * sizeof(cl_uint),
+                     residentBytes_);
+    tileCells_.write(device_, "projtet fused tile cells", lists.items.data(), lists.items.size() * sizeof(cl_uint),
+                     residentBytes_);
     hostPasses.push_back({"projtet: cell boxes and tile lists (host)", msSince(t0)});
 
     ClProjtetFusedParams p{};
@@ -756,9 +739,9 @@ Image4f ProjtetRenderer::renderFused(const VisibilitySorter::Result& sorted, std
     int a = 0;
     fused_.setArg(a++, fusedOut_);
     fused_.setArg(a++, fusedSegments_);
-    fused_.setArg(a++, tileStart_.buffer);
-    fused_.setArg(a++, tileCells_.buffer);
-    fused_.setArg(a++, boxes_.buffer);
+    fused_.setArg(a++, tileStart_.buffer());
+    fused_.setArg(a++, tileCells_.buffer());
+    fused_.setArg(a++, boxes_.buffer());
     fused_.setArg(a++, cells_);
     fused_.setArg(a++, tf_.buffer());
     fused_.setArg(a++, psi_);
