@@ -275,7 +275,8 @@ TEST(CubefanCeiling, DoesTheFusedKernelsWork)
     inside.viewAngle = 70.0;
     const clvr::Camera cameras[] = {clvr::test::obliquePerspectiveCamera(30.0), clvr::test::obliqueParallelCamera(1.3),
                                     inside};
-    const nlohmann::json sets[] = {{{"error", 0.0}}, {{"error", 0.1}}, {{"error", 0.05}, {"early_termination", 0.6}}};
+    const nlohmann::json sets[] = {{{"error", 0.0}}, {{"error", 0.1}, {"path", "fused"}},
+                                   {{"error", 0.05}, {"early_termination", 0.6}, {"path", "fused"}}};
     for (const clvr::Camera& camera : cameras)
         for (const nlohmann::json& set : sets) {
             clvr::Scene scene;
@@ -949,9 +950,9 @@ TEST(BenchCubefan, ScenesShareTheViewAndEachGroupStartsWithItsFullQualityScene)
         present.push_back(file.filename().string());
     std::sort(sorted.begin(), sorted.end());
     EXPECT_EQ(sorted, present);
-    ASSERT_EQ(listed.size(), 13u);
+    ASSERT_EQ(listed.size(), 18u);
     EXPECT_EQ(listed.front(), "cubefan-engine-e0.json");
-    EXPECT_EQ(listed[8], "cubefan-slice3d-1024.json");
+    EXPECT_EQ(listed[11], "cubefan-slice3d-1024.json");
     const clvr::Scene first = clvr::loadScene(files.front().parent_path() / listed.front());
     EXPECT_EQ(first.options["error"].get<double>(), 0.0);
     for (const std::string& name : listed) {
@@ -960,9 +961,12 @@ TEST(BenchCubefan, ScenesShareTheViewAndEachGroupStartsWithItsFullQualityScene)
         EXPECT_EQ(scene.camera->position, first.camera->position) << name;
         EXPECT_EQ(scene.transferFunction.points().size(), first.transferFunction.points().size()) << name;
         EXPECT_EQ(scene.technique, name.starts_with("cubefan-engine-") ? "cubefan" : "slice3d") << name;
-        if (name.starts_with("cubefan-engine-")) {  // e: the paper's fans, x: exact chords on the raster path, f: fused
-            const clvr::CubefanOptions o = clvr::parseCubefanOptions(scene.options);
-            EXPECT_EQ(o.path, name[15] == 'f' ? clvr::CubefanOptions::Path::Fused : clvr::CubefanOptions::Path::Raster) << name;
+        if (name.starts_with("cubefan-engine-")) {  // e: the paper's fans, x: exact chords on the raster path, f: fused,
+            const clvr::CubefanOptions o = clvr::parseCubefanOptions(scene.options);  // t: tiles
+            EXPECT_EQ(o.path, name[15] == 'f'   ? clvr::CubefanOptions::Path::Fused
+                              : name[15] == 't' ? clvr::CubefanOptions::Path::Tiles
+                                                : clvr::CubefanOptions::Path::Raster)
+                << name;
             EXPECT_EQ(o.exactThickness, name[15] == 'x') << name;
         }
     }

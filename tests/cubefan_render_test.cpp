@@ -67,8 +67,14 @@ TEST(CubefanOptions, ParsesAndRejects)
     EXPECT_EQ(parseCubefanOptions({{"opacity", "exp"}}).opacity, CubefanOptions::Opacity::Exp);
     EXPECT_TRUE(parseCubefanOptions({{"thickness", "exact"}}).exactThickness);
     EXPECT_FALSE(parseCubefanOptions({{"thickness", "interpolated"}}).exactThickness);
-    // The fused path by default; the fans' options take the raster path unless fused is asked for.
+    // The fused path by default at error 0, the tile path where cubes merge; the fans' options take the raster path
+    // unless another is asked for.
     EXPECT_EQ(parseCubefanOptions(json::object()).path, CubefanOptions::Path::Fused);
+    EXPECT_EQ(parseCubefanOptions({{"error", 0.0}}).path, CubefanOptions::Path::Fused);
+    EXPECT_EQ(parseCubefanOptions({{"error", 0.01}}).path, CubefanOptions::Path::Tiles);
+    EXPECT_EQ(parseCubefanOptions({{"error", 0.2}, {"path", "fused"}}).path, CubefanOptions::Path::Fused);
+    EXPECT_EQ(parseCubefanOptions({{"path", "tiles"}}).path, CubefanOptions::Path::Tiles);
+    EXPECT_EQ(parseCubefanOptions({{"error", 0.2}, {"thickness", "exact"}}).path, CubefanOptions::Path::Raster);
     EXPECT_EQ(parseCubefanOptions({{"error", 0.2}, {"early_termination", 0.9}}).earlyTermination, 0.9);
     EXPECT_EQ(o.path, CubefanOptions::Path::Raster);
     EXPECT_EQ(parseCubefanOptions({{"thickness", "exact"}}).path, CubefanOptions::Path::Raster);
@@ -77,7 +83,8 @@ TEST(CubefanOptions, ParsesAndRejects)
     for (const json& bad : {json{{"error", -0.1}}, json{{"error", 1.5}}, json{{"error", "0.1"}}, json{{"thickness", 1}},
                             json{{"opacity", "gouraud"}}, json{{"texture_size", 1}}, json{{"texture_size", 1e4}},
                             json{{"path", "fans"}}, json{{"path", "fused"}, {"opacity", "exp"}},
-                            json{{"path", "fused"}, {"thickness", "exact"}}, json{{"early_termination", 0.0}},
+                            json{{"path", "fused"}, {"thickness", "exact"}}, json{{"path", "tiles"}, {"opacity", "exp"}},
+                            json{{"early_termination", 0.0}},
                             json{{"path", "raster"}, {"early_termination", 0.9}}, json{{"opacity", "exp"}, {"early_termination", 0.9}}})
         EXPECT_THROW(parseCubefanOptions(bad), InputError) << bad.dump();
 }
@@ -299,7 +306,8 @@ TEST(CubefanFused, IsTheExactThicknessImageOfTheRasterPath)
         for (const double tolerance : {0.0, 0.1, 0.3}) {
             const std::string what = std::string(view.name) + ", error " + std::to_string(tolerance);
             FrameStats fusedStats, rasterStats;
-            const Image4f fused = render(makeScene(view.camera, tf, 64, {{"error", tolerance}}), volume, &fusedStats);
+            const Image4f fused =
+                render(makeScene(view.camera, tf, 64, {{"error", tolerance}, {"path", "fused"}}), volume, &fusedStats);
             const Image4f raster =
                 render(makeScene(view.camera, tf, 64, {{"error", tolerance}, {"thickness", "exact"}}), volume, &rasterStats);
             EXPECT_EQ(fusedStats.extra["path"], "fused");
@@ -393,7 +401,8 @@ TEST(CubefanFused, PacketsAreBitIdenticalToOnePixelPerWorkItem)
     down.viewUp = {0, 1, 0};
     down.parallelScale = 1.1;
     const Camera cameras[] = {test::obliquePerspectiveCamera(30.0), test::obliqueParallelCamera(1.3), inside, down};
-    const json sets[] = {{{"error", 0.0}}, {{"error", 0.1}}, {{"error", 0.3}}, {{"error", 0.05}, {"early_termination", 0.6}}};
+    const json sets[] = {{{"error", 0.0}}, {{"error", 0.1}, {"path", "fused"}}, {{"error", 0.3}, {"path", "fused"}},
+                         {{"error", 0.05}, {"early_termination", 0.6}, {"path", "fused"}}};
     int compared = 0;
     std::uint64_t steppedOver = 0;
     for (const Camera& camera : cameras)
@@ -426,7 +435,8 @@ TEST(CubefanRenderer, SetCameraEqualsANewRenderer)
     const std::vector<Camera> cameras = {test::obliquePerspectiveCamera(30.0), test::obliqueParallelCamera(1.3), inside};
     Scene scene = makeScene(cameras[0], test::designTransferFunction(), 23);
     for (const json& options : {json{{"error", 0.1}}, json{{"error", 0.1}, {"packets", false}},
-                                json{{"error", 0.1}, {"path", "raster"}}, json{{"thickness", "exact"}}}) {
+                                json{{"error", 0.1}, {"path", "fused"}}, json{{"error", 0.1}, {"path", "raster"}},
+                                json{{"thickness", "exact"}}}) {
         scene.options = options;
         test::expectSetCameraEqualsNewRenderer(scene, volume, cameras, options.dump());
     }

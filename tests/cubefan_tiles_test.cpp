@@ -81,7 +81,8 @@ TEST(CubefanTiles, DrawTheWalksImage)
             FrameStats tileStats, walkStats;
             const Image4f tiles =
                 render(makeScene(view.camera, tf, 61, 43, {{"error", tolerance}, {"path", "tiles"}}), volume, tileStats);
-            const Image4f walk = render(makeScene(view.camera, tf, 61, 43, {{"error", tolerance}}), volume, walkStats);
+            const Image4f walk =
+                render(makeScene(view.camera, tf, 61, 43, {{"error", tolerance}, {"path", "fused"}}), volume, walkStats);
             EXPECT_EQ(tileStats.extra["path"], "tiles");
             EXPECT_EQ(walkStats.extra["path"], "fused");
             EXPECT_EQ(count(tileStats, "cubes"), count(walkStats, "cubes")) << what;

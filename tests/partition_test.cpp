@@ -344,7 +344,7 @@ TEST(SortFirst, GridBandsStackToTheWholeImage)
                                      {"stack2d", nlohmann::json::object()},
                                      {"planes", nlohmann::json::object()},
                                      {"blend", {{"slices", 60}}},
-                                     {"cubefan", {{"error", 0.1}}},
+                                     {"cubefan", {{"error", 0.1}, {"path", "fused"}}},
                                      {"cubefan", {{"error", 0.1}, {"path", "tiles"}}}};
     for (const Case& c : cases)
         for (const Camera& camera : {test::obliquePerspectiveCamera(40.0), test::obliqueParallelCamera(1.8)}) {

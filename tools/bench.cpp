@@ -848,12 +848,14 @@ int bench(const BenchOptions& options)
             std::cout << "  figure 9     error " << fixed(100.0 * e["error"].get<double>(), 0) << " %: "
                       << si(e["cubes"].get<double>()) << " cubes, "
                       << (e.contains("triangles") ? si(e["triangles"].get<double>()) + " triangles"
-                                                  : si(e["cubes_crossed"].get<double>()) + " cube chords (fused)")
+                                                  : si(e["cubes_crossed"].get<double>()) + " cube chords (" +
+                                                        e["path"].get<std::string>() + ")")
                       << ", selection " << fixed(e["selection_ms"].get<double>(), 1) << " ms, rendering "
                       << fixed(s.median - e["selection_ms"].get<double>(), 1) << " ms; hierarchy built in "
                       << fixed(e["hierarchy_ms"].get<double>(), 0) << " ms";
-            if (e.contains("selection_grid_ms"))  // the fused path selects when the tolerance or transfer function changes
-                std::cout << ", selection grid in " << fixed(e["selection_grid_ms"].get<double>(), 0) << " ms";
+            if (e.contains("selection_grid_ms"))  // the fused and tile paths select when the tolerance or TF changes
+                std::cout << ", selection " << (e["path"] == "tiles" ? "tree" : "grid") << " in "
+                          << fixed(e["selection_grid_ms"].get<double>(), 0) << " ms";
             std::cout << '\n';
         }
         std::cout << '\n';

@@ -54,12 +54,12 @@ std::vector<std::string> benchSuiteScenes(const std::string& suite)
     for (const char* technique : {"tetiso", "fused-tetiso", "tetslice", "fused-tetslice", "harc"})
         tetfaces.push_back(std::string("tetfaces-automaton-") + technique + ".json");
     // seeds/002 Figure 9 on the engine (tools/make_cubefan_bench.py): error 0, 18 %, 48 % (the fans), 0 and
-    // 18 % with each fragment's exact chord, the fused path at the three tolerances, then slice3d on the same
-    // view with 1024 slices (its full quality) and fewer.
+    // 18 % with each fragment's exact chord, the fused and tile paths at the three tolerances, then slice3d on the
+    // same view with 1024 slices (its full quality) and fewer (96-100: 18 %'s image error).
     std::vector<std::string> cubefan;
-    for (const char* run : {"e0", "e18", "e48", "x0", "x18", "f0", "f18", "f48"})
+    for (const char* run : {"e0", "e18", "e48", "x0", "x18", "f0", "f18", "f48", "t0", "t18", "t48"})
         cubefan.push_back(std::string("cubefan-engine-") + run + ".json");
-    for (const char* slices : {"1024", "256", "128", "64", "32"})
+    for (const char* slices : {"1024", "256", "128", "100", "96", "64", "32"})
         cubefan.push_back(std::string("cubefan-slice3d-") + slices + ".json");
     // Cell projection beside the ray caster (issue 11 part 5): each projtet scene is its harc twin with only
     // the technique changed.

@@ -13,8 +13,10 @@ and transfer function of data/scenes/engine.json (unshaded):
                                   its triangle fans, "path": "raster")
   cubefan-engine-x0, -x18         the same at 0 % and 18 % with "thickness": "exact" (each fragment's chord)
   cubefan-engine-f0, -f18, -f48   the fused path (each pixel's ray walks the selected cubes) at 0, 18, 48 %
+  cubefan-engine-t0, -t18, -t48   the tile path (the cubes in visibility order binned to 8x4-pixel tiles) at 0, 18,
+                                  48 % (the default path where the error is above 0)
   cubefan-slice3d-1024            slice3d (fused) on the same view with 1024 slices: its full quality
-  cubefan-slice3d-256, -128, -64, -32   slice3d with fewer slices
+  cubefan-slice3d-256, -128, -100, -96, -64, -32   slice3d with fewer slices (96-100: 18 %'s image error)
 clvr bench compares every scene with the first of its group (the name up to its last '-'): the cubefan
 scenes with cubefan-engine-e0, the slice3d ones with cubefan-slice3d-1024.
 """
@@ -47,14 +49,15 @@ def scenes():
     out = []
     for run, error, thickness in [("e0", 0.0, None), ("e18", 0.18, None), ("e48", 0.48, None),
                                   ("x0", 0.0, "exact"), ("x18", 0.18, "exact"),
-                                  ("f0", 0.0, None), ("f18", 0.18, None), ("f48", 0.48, None)]:
+                                  ("f0", 0.0, None), ("f18", 0.18, None), ("f48", 0.48, None),
+                                  ("t0", 0.0, None), ("t18", 0.18, None), ("t48", 0.48, None)]:
         options = {"error": error}
         if thickness:
             options["thickness"] = thickness
-        elif run[0] == "e":
-            options["path"] = "raster"
+        else:
+            options["path"] = {"e": "raster", "f": "fused", "t": "tiles"}[run[0]]
         out.append(("cubefan-engine-" + run + ".json", scene("cubefan", options)))
-    for slices in [1024, 256, 128, 64, 32]:
+    for slices in [1024, 256, 128, 100, 96, 64, 32]:
         out.append(("cubefan-slice3d-%d.json" % slices, scene("slice3d", {"slices": slices})))
     return out
 

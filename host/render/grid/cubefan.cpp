@@ -713,8 +713,8 @@ TechniqueInfo cubefanTechnique()
         {"path", "fused", "",
          "\"fused\" (each pixel's ray walks the selected cubes in one kernel, every chord exact), \"tiles\" (the "
          "cubes in the octree's visibility order binned to 8x4-pixel tiles, each tile's rays meeting its cubes in one "
-         "kernel, every chord exact) or \"raster\" (the paper's triangle fans through the raster stage); opacity, "
-         "texture_size or thickness other than their defaults take \"raster\""},
+         "kernel, every chord exact; the default where error > 0) or \"raster\" (the paper's triangle fans through "
+         "the raster stage); opacity, texture_size or thickness other than their defaults take \"raster\""},
         earlyTerminationInfo(1.0),
         packetsInfo(),
     };
@@ -774,6 +774,10 @@ CubefanOptions parseCubefanOptions(const nlohmann::json& options)
                                " path computes every chord exactly: give \"path\": \"raster\" or leave path out");
         o.path = CubefanOptions::Path::Raster;
     }
+    // Without a path: the tile path where cubes merge (error > 0), the walk for the full-resolution field, where the
+    // tile path's per-frame order and lists of every voxel's cube cost more (BENCHMARKS.md run CT1).
+    if (!options.contains("path") && o.path == CubefanOptions::Path::Fused && o.error > 0.0)
+        o.path = CubefanOptions::Path::Tiles;
     if (o.earlyTermination < 1.0 && o.path == CubefanOptions::Path::Raster)
         badOption("early_termination",
                   "is only available on the fused and tile paths (the blending stage cannot stop a pixel)");

@@ -40,7 +40,8 @@ struct CubefanOptions {
     // default, without a path, takes "raster".
     // "tiles": the selected cubes in the octree's visibility order for the eye (as the fans), binned to tiles of
     // kCubefanTileW x kCubefanTileH pixels by their boxes of pixel centres, each tile's rays meeting its cubes front
-    // to back in one kernel (the chord exact, as the fused path's); early_termination and packets as fused.
+    // to back in one kernel (the chord exact, as the fused path's); early_termination and packets as fused. Without
+    // "path" in the scene: "tiles" where error > 0, else "fused".
     enum class Path { Fused, Raster, Tiles };
     Path path = Path::Fused;
     double earlyTermination = 1.0;  // fused path: stop a ray once its opacity reaches this (1 = off)
