@@ -31,18 +31,22 @@ TileLists binToTiles(const std::vector<PixelBox>& boxes, const std::vector<std::
     const std::size_t chunks = (order.size() + kChunk - 1) / kChunk;
     // chunk c's count, then its first entry, in tile t: offset[c * tiles + t]
     std::vector<cl_uint> offset(chunks * tiles, 0);
-    auto forTiles = [&](const PixelBox& b, const auto& visit) {
-        if (b.x0 > b.x1 || b.y0 > b.y1)
-            return;
-        for (int ty = b.y0 >> tileHLog2; ty <= b.y1 >> tileHLog2; ++ty)
-            for (int tx = b.x0 >> tileWLog2; tx <= b.x1 >> tileWLog2; ++tx)
-                visit(static_cast<std::size_t>(ty) * lists.tilesX + tx);
+    const std::size_t tilesX = static_cast<std::size_t>(lists.tilesX);
+    // visit(i, tile) for each tile of each item of order[begin, end)
+    auto overItems = [&](std::size_t begin, std::size_t end, const auto& visit) {
+        for (std::size_t i = begin; i < end; ++i) {
+            const PixelBox b = boxes[order[i]];
+            if (b.x0 > b.x1 || b.y0 > b.y1)
+                continue;
+            for (int ty = b.y0 >> tileHLog2; ty <= b.y1 >> tileHLog2; ++ty)
+                for (int tx = b.x0 >> tileWLog2; tx <= b.x1 >> tileWLog2; ++tx)
+                    visit(i, static_cast<std::size_t>(ty) * tilesX + static_cast<std::size_t>(tx));
+        }
     };
     auto overChunks = [&](const auto& work) { forHostChunks(threads, order.size(), work, kChunk); };
     overChunks([&](std::size_t begin, std::size_t end) {
         cl_uint* count = offset.data() + begin / kChunk * tiles;
-        for (std::size_t i = begin; i < end; ++i)
-            forTiles(boxes[order[i]], [&](std::size_t tile) { ++count[tile]; });
+        overItems(begin, end, [&](std::size_t, std::size_t tile) { ++count[tile]; });
     });
     lists.start.resize(tiles + 1);
     std::uint64_t entries = 0;
@@ -58,10 +62,10 @@ TileLists binToTiles(const std::vector<PixelBox>& boxes, const std::vector<std::
         throw InputError(what + ": the tile lists have more than 2^32 entries; " + remedy);
     lists.start[tiles] = static_cast<cl_uint>(entries);
     lists.items.resize(entries);
+    cl_uint* items = lists.items.data();
     overChunks([&](std::size_t begin, std::size_t end) {
         cl_uint* next = offset.data() + begin / kChunk * tiles;
-        for (std::size_t i = begin; i < end; ++i)
-            forTiles(boxes[order[i]], [&](std::size_t tile) { lists.items[next[tile]++] = order[i]; });
+        overItems(begin, end, [&](std::size_t i, std::size_t tile) { items[next[tile]++] = order[i]; });
     });
     return lists;
 }
