@@ -38,6 +38,13 @@ float clvr_exp2(const float x)
 #define CLVR_PREFETCH(p, n) prefetch((p), (n))
 #endif
 
+/* Whether the box of pixel centres b = (x0, y0, x1, y1), inclusive, holds pixel (x, y): the tile kernels' test of a
+ * listed cell or cube (host/render/tile_lists.h). */
+int clvr_box_holds(const short4 b, const int x, const int y)
+{
+    return x >= b.x && y >= b.y && x <= b.z && y <= b.w;
+}
+
 /* atan2(y, x) in (-pi, pi], the angle of (x, y): a = min(|x|, |y|) / max(|x|, |y|) in [0, 1], atan(a) =
  * a P(a^2) with P of degree 8 (fitted here: relative error 1.5e-8 in exact arithmetic, 1.3e-7 evaluated in
  * float on [0, 1]), then pi/2 - r where |y| > |x|, pi - r where x < 0, the sign of y. Absolute error below

@@ -455,7 +455,7 @@ kernel void cubefan_tiles(global float4* out, global uint* steps, global const u
     for (uint k = tile_start[tile]; k < end; ++k) {
         const uint i = tile_cubes[k];
         const short4 b = boxes[i];
-        if (x < b.x || y < b.y || x > b.z || y > b.w)
+        if (!clvr_box_holds(b, x, y))
             continue;
         const float4 lo = cubes[3 * i], hi = cubes[3 * i + 1], ct = cubes[3 * i + 2];
         const float t0x = (lo.x - qe.x) * inv.x, t1x = (hi.x - qe.x) * inv.x;

@@ -148,7 +148,7 @@ kernel void projtet_fused(global float4* out, global uint* segments, global cons
     for (uint k = tile_start[tile]; k < end; ++k) {
         const uint t = tile_cells[k];
         const short4 b = boxes[t];
-        if (x < b.x || y < b.y || x > b.z || y > b.w)
+        if (!clvr_box_holds(b, x, y))
             continue;
         float l, s_f, s_b;
         if (!projtet_cell_segment(cells, t, e, d, &l, &s_f, &s_b))

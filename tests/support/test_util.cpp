@@ -113,6 +113,27 @@ void expectSetCameraEqualsNewRenderer(Scene scene, const Volume& volume, const s
         std::move(scene), [&](const Scene& s) { return makeRenderer(device(), s, volume); }, cameras, label);
 }
 
+int expectEarlyTermination(const Image4f& full, const Image4f& early, double threshold)
+{
+    EXPECT_EQ(full.width(), early.width());
+    EXPECT_EQ(full.height(), early.height());
+    int stopped = 0;
+    for (int y = 0; y < full.height() && y < early.height(); ++y)
+        for (int x = 0; x < full.width() && x < early.width(); ++x) {
+            const glm::vec4 a = full.at(x, y), b = early.at(x, y);
+            for (int k = 0; k < 4; ++k)
+                EXPECT_LE(std::abs(a[k] - b[k]), 1.0 - threshold + 1e-5) << x << "," << y;
+            if (a.a > threshold + 0.05) {
+                EXPECT_GE(b.a, threshold - 1e-6) << x << "," << y;
+                EXPECT_LE(b.a, a.a) << x << "," << y;
+                stopped += b.a < a.a - 1e-3 ? 1 : 0;  // what lay behind the stop was left out
+            } else if (a.a < threshold - 1e-3) {
+                EXPECT_EQ(a, b) << x << "," << y;  // never stopped: the same bits
+            }
+        }
+    return stopped;
+}
+
 testing::AssertionResult sameBits(const Image4f& a, const Image4f& b)
 {
     if (a.width() != b.width() || a.height() != b.height())

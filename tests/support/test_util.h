@@ -65,6 +65,12 @@ void expectSetCameraEqualsNewRenderer(Scene scene, const std::function<std::uniq
 void expectSetCameraEqualsNewRenderer(Scene scene, const Volume& volume, const std::vector<Camera>& cameras,
                                       const std::string& label);
 
+// Early termination's promise, pixel by pixel: `early`, rendered stopping each ray at opacity `threshold`, differs
+// from `full` by at most 1 - threshold in every channel; where `full` passes the threshold by 0.05 it reaches the
+// threshold and stays at or below `full`'s opacity; where `full` stays below it, the same bits. Returns the pixels
+// that stopped short of `full`'s opacity (by more than 1e-3).
+int expectEarlyTermination(const Image4f& full, const Image4f& early, double threshold);
+
 // Success when `a` and `b` have the same size and the same bits (memcmp), else the first differing pixel:
 // for kernels that must agree exactly (ray packets against one pixel per work-item).
 testing::AssertionResult sameBits(const Image4f& a, const Image4f& b);

@@ -101,6 +101,17 @@ CubeOctree::Verdict CubeOctree::verdict(int level, const glm::ivec3& i, double a
     return Verdict::Descend;
 }
 
+Cube CubeOctree::take(int level, const glm::ivec3& i, SelectionStats& s) const
+{
+    Cube c;
+    c.level = level;
+    c.index = i;
+    c.value = value(level, i);
+    box(level, i, c.lo, c.hi);
+    s.largestDiagonal = std::max(s.largestDiagonal, glm::length(c.hi - c.lo));
+    return c;
+}
+
 std::vector<Cube> CubeOctree::select(double tolerance, const TransferFunction& tf, const glm::dvec3& eye,
                                      const glm::dvec3& forward, bool parallel, SelectionStats* stats) const
 {
@@ -116,13 +127,7 @@ std::vector<Cube> CubeOctree::select(double tolerance, const TransferFunction& t
             return;
         }
         if (v == Verdict::Take) {
-            Cube c;
-            c.level = level;
-            c.index = i;
-            c.value = value(level, i);
-            box(level, i, c.lo, c.hi);
-            s.largestDiagonal = std::max(s.largestDiagonal, glm::length(c.hi - c.lo));
-            out.push_back(c);
+            out.push_back(take(level, i, s));
             return;
         }
         // The children's split planes; bit a of `near` set when the eye is on the high side of axis a's.
@@ -212,13 +217,7 @@ CubeOctree::SelectionTree CubeOctree::selectTree(double tolerance, const Transfe
             return SelectionTree::kNone;
         }
         if (v == Verdict::Take) {
-            Cube c;
-            c.level = level;
-            c.index = i;
-            c.value = value(level, i);
-            box(level, i, c.lo, c.hi);
-            s.largestDiagonal = std::max(s.largestDiagonal, glm::length(c.hi - c.lo));
-            tree.cubes.push_back(c);
+            tree.cubes.push_back(take(level, i, s));
             return ~static_cast<std::int32_t>(tree.cubes.size() - 1);
         }
         const std::size_t at = tree.nodes.size();

@@ -106,6 +106,8 @@ private:
     // The selection's verdict on one cube: drawn whole, transparent (skipped with its subtree), or split.
     enum class Verdict { Take, Transparent, Descend };
     Verdict verdict(int level, const glm::ivec3& i, double allowed, const TransferFunction& tf) const;
+    // A cube taken whole by a selection (its largest diagonal noted in s).
+    Cube take(int level, const glm::ivec3& i, SelectionStats& s) const;
 
     struct Level {
         glm::ivec3 dims{0};

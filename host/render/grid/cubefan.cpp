@@ -271,6 +271,18 @@ private:
     Image4f renderRaster(FrameStats& stats);
     Image4f renderFused(FrameStats& stats);
     Image4f renderTiles(FrameStats& stats);
+    // What the fused and tile paths report of their selection (built this frame in selectionMs, else 0) and chords.
+    void reportSelection(FrameStats& stats, double selectionMs, std::uint64_t crossed) const
+    {
+        stats.samples = crossed;
+        stats.extra["selection_ms"] = selectionMs;
+        stats.extra["selection_grid_ms"] = gridMs_;
+        stats.extra["selection_visited"] = gridStats_.visited;
+        stats.extra["packets"] = packet_;
+        stats.extra["cubes"] = gridStats_.selected;
+        stats.extra["cubes_transparent"] = gridStats_.transparent;
+        stats.extra["cubes_crossed"] = crossed;
+    }
     void updateTexture(double k);
     double updateSelectionGrid();
 
@@ -450,14 +462,7 @@ Image4f CubefanRenderer::renderFused(FrameStats& stats)
     if (gridMs > 0.0)
         hostPasses.push_back({"cubefan: selection grid (host, when the tolerance or transfer function changes)", gridMs});
     finishFrame(device_, clock, stats, std::move(hostPasses));
-    stats.samples = crossed;
-    stats.extra["selection_ms"] = gridMs;
-    stats.extra["selection_grid_ms"] = gridMs_;
-    stats.extra["selection_visited"] = gridStats_.visited;
-    stats.extra["packets"] = packet_;
-    stats.extra["cubes"] = gridStats_.selected;
-    stats.extra["cubes_transparent"] = gridStats_.transparent;
-    stats.extra["cubes_crossed"] = crossed;
+    reportSelection(stats, gridMs, crossed);
     stats.extra["cubes_stepped_over"] = steppedOver;
     stats.extra["empty_bricks"] = gridEmptyBricks_;
     stats.extra["early_termination"] = options_.earlyTermination;
@@ -557,14 +562,7 @@ Image4f CubefanRenderer::renderTiles(FrameStats& stats)
     const std::uint64_t crossed = sumCounts(device_, fusedSteps_, static_cast<std::size_t>(width) * height);
     Image4f image = readImage(device_, fb_.color(), width, height);
     finishFrame(device_, clock, stats, std::move(hostPasses));
-    stats.samples = crossed;
-    stats.extra["selection_ms"] = selectionMs;
-    stats.extra["selection_grid_ms"] = gridMs_;
-    stats.extra["selection_visited"] = gridStats_.visited;
-    stats.extra["packets"] = packet_;
-    stats.extra["cubes"] = gridStats_.selected;
-    stats.extra["cubes_transparent"] = gridStats_.transparent;
-    stats.extra["cubes_crossed"] = crossed;
+    reportSelection(stats, selectionMs, crossed);
     stats.extra["tile_entries"] = lists.items.size();
     stats.extra["tile_size"] = {kCubefanTileW, kCubefanTileH};
     stats.extra["early_termination"] = options_.earlyTermination;
