@@ -2,10 +2,12 @@
 // back to front.
 #include "host/render/grid/cube_octree.h"
 
-#include "host/render/transfer_function_upload.h"
-#include "host/runtime/errors.h"  // tauZeroOn: also slice3d's empty-brick test
+#include "host/render/transfer_function_upload.h"  // tauZeroOn: also slice3d's empty-brick test
+#include "host/runtime/errors.h"
+#include "host/runtime/parallel.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 namespace clvr::cubefan {
@@ -246,27 +248,57 @@ CubeOctree::SelectionTree CubeOctree::selectTree(double tolerance, const Transfe
 void CubeOctree::SelectionTree::frontToBack(const glm::dvec3& eye, const glm::dvec3& forward, bool parallel,
                                             std::vector<std::uint32_t>& order) const
 {
+    // Depth first, a node's children nearest first: child nearSide ^ m for m = 0 .. 7 (select()'s order reversed).
+    auto nearSide = [&](const Node& n) {
+        int side = 0;
+        for (int a = 0; a < 3; ++a)
+            side |= (parallel ? forward[a] < 0.0 : eye[a] > n.split[a]) ? (1 << a) : 0;
+        return side;
+    };
+    // The top levels expanded in that order into at least kItems subtrees and cubes, then the subtrees walked on the
+    // host's threads, each into its own list (recursion depth: the level count), and the lists joined in order.
+    constexpr std::size_t kItems = 64;
+    std::vector<std::int32_t> items, next;
+    if (root != kNone)
+        items.push_back(root);
+    for (bool expanded = true; expanded && items.size() < kItems;) {
+        expanded = false;
+        next.clear();
+        for (const std::int32_t item : items) {
+            if (item < 0) {
+                next.push_back(item);
+                continue;
+            }
+            expanded = true;
+            const Node& n = nodes[static_cast<std::size_t>(item)];
+            const int side = nearSide(n);
+            for (int m = 0; m < 8; ++m)
+                if (const std::int32_t child = n.child[static_cast<std::size_t>(side ^ m)]; child != kNone)
+                    next.push_back(child);
+        }
+        items.swap(next);
+    }
+    std::vector<std::vector<std::uint32_t>> lists(items.size());
+    auto visit = [&](auto&& self, std::int32_t item, std::vector<std::uint32_t>& out) -> void {
+        if (item < 0) {
+            out.push_back(static_cast<std::uint32_t>(~item));
+            return;
+        }
+        const Node& n = nodes[static_cast<std::size_t>(item)];
+        const int side = nearSide(n);
+        for (int m = 0; m < 8; ++m)
+            if (const std::int32_t child = n.child[static_cast<std::size_t>(side ^ m)]; child != kNone)
+                self(self, child, out);
+    };
+    std::atomic<std::size_t> taken{0};
+    runOnThreads(0, static_cast<int>(std::min<std::size_t>(items.size(), cubes.size() / 16384 + 1)), [&] {
+        for (std::size_t k; (k = taken.fetch_add(1)) < items.size();)
+            visit(visit, items[k], lists[k]);
+    });
     order.clear();
     order.reserve(cubes.size());
-    // Depth first, a node's children nearest first: child nearSide ^ m for m = 0 .. 7 (select()'s order reversed).
-    // Recursion depth is the level count.
-    auto visit = [&](auto&& self, std::int32_t item) -> void {
-        const Node& n = nodes[static_cast<std::size_t>(item)];
-        int nearSide = 0;
-        for (int a = 0; a < 3; ++a)
-            nearSide |= (parallel ? forward[a] < 0.0 : eye[a] > n.split[a]) ? (1 << a) : 0;
-        for (int m = 0; m < 8; ++m) {
-            const std::int32_t child = n.child[static_cast<std::size_t>(nearSide ^ m)];
-            if (child >= 0)
-                self(self, child);
-            else if (child != kNone)
-                order.push_back(static_cast<std::uint32_t>(~child));
-        }
-    };
-    if (root >= 0)
-        visit(visit, root);
-    else if (root != kNone)
-        order.push_back(static_cast<std::uint32_t>(~root));
+    for (const std::vector<std::uint32_t>& list : lists)
+        order.insert(order.end(), list.begin(), list.end());
 }
 
 }  // namespace clvr::cubefan
