@@ -382,7 +382,8 @@ kernel void cubefan_cube_colors(global float4* cubes, global const float* tf, co
 /* Per frame: each cube's box of pixel centres, its eight corners projected (the inverse of kernels/ray.h's rays: the
  * offset in right and up over the depth along forward, perspective), grown by 0.01 pixel and 1e-5 of its size (far more
  * than the rays' float rounding reaches past the projection) and clipped to the image; the whole image where a corner
- * is within 1e-4 of the cube's depth terms of the eye's plane or behind it; (1, 1, 0, 0) when empty. 8 cubes per
+ * is within 1e-4 of the cube's depth terms of the eye's plane or behind it, none for a cube wholly behind that plane;
+ * (1, 1, 0, 0) when empty. 8 cubes per
  * work-item, one per lane (PoCL does not vectorize the work-items of this kernel itself): cubes 8 i .. 8 i + 7 of n. */
 kernel void cubefan_cube_boxes(global const float4* cubes, global short4* boxes, const ClCubefanFusedParams p,
                                const uint n)
@@ -405,7 +406,8 @@ kernel void cubefan_cube_boxes(global const float4* cubes, global short4* boxes,
     lo_y = p.field_lo.y + lo_y / p.inv_spacing.y - cam.position.y, hi_y = p.field_lo.y + hi_y / p.inv_spacing.y - cam.position.y;
     lo_z = p.field_lo.z + lo_z / p.inv_spacing.z - cam.position.z, hi_z = p.field_lo.z + hi_z / p.inv_spacing.z - cam.position.z;
     const int parallel = clvr_ray_parallel(cam);
-    float8 min_x = INFINITY, max_x = -INFINITY, min_y = INFINITY, max_y = -INFINITY, min_z = INFINITY, size = 0.0f;
+    float8 min_x = INFINITY, max_x = -INFINITY, min_y = INFINITY, max_y = -INFINITY, min_z = INFINITY,
+           max_z = -INFINITY, size = 0.0f;
 #define CUBEFAN_CORNER(K)                                                                                            \
     {                                                                                                                \
         const float8 x = (K) & 1 ? hi_x : lo_x, y = (K) & 2 ? hi_y : lo_y, z = (K) & 4 ? hi_z : lo_z;                 \
@@ -414,7 +416,7 @@ kernel void cubefan_cube_boxes(global const float4* cubes, global short4* boxes,
         const float8 sx = (x * cam.right.x + y * cam.right.y + z * cam.right.z) * w;                                 \
         const float8 sy = (x * cam.up.x + y * cam.up.y + z * cam.up.z) * w;                                          \
         min_x = fmin(min_x, sx), max_x = fmax(max_x, sx), min_y = fmin(min_y, sy), max_y = fmax(max_y, sy);          \
-        min_z = fmin(min_z, depth), size = fmax(size, fabs(depth));                                                  \
+        min_z = fmin(min_z, depth), max_z = fmax(max_z, depth), size = fmax(size, fabs(depth));                      \
     }
     CLVR_EACH_LANE(CUBEFAN_CORNER)
 #undef CUBEFAN_CORNER
@@ -428,7 +430,9 @@ kernel void cubefan_cube_boxes(global const float4* cubes, global short4* boxes,
     const float w1 = (float)(p.width - 1), h1 = (float)(p.height - 1);
     const float8 x0 = select(fmax(ceil(px0 - pad), 0.0f), 0.0f, whole), x1 = select(fmin(floor(px1 + pad), w1), w1, whole);
     const float8 y0 = select(fmax(ceil(py0 - pad), 0.0f), 0.0f, whole), y1 = select(fmin(floor(py1 + pad), h1), h1, whole);
-    const int8 empty = isgreater(x0, x1) | isgreater(y0, y1) | isnan(x0) | isnan(x1) | isnan(y0) | isnan(y1);
+    /* a cube wholly behind the eye's plane (perspective) is seen by no ray: no box */
+    const int8 behind = parallel ? (int8)(0) : ~isgreater(max_z, 0.0f);
+    const int8 empty = behind | isgreater(x0, x1) | isgreater(y0, y1) | isnan(x0) | isnan(x1) | isnan(y0) | isnan(y1);
 #define CUBEFAN_STORE_BOX(L)                                                                                         \
     if (first + L < n)                                                                                               \
         boxes[first + L] = empty.s##L ? (short4)(1, 1, 0, 0)                                                         \
