@@ -379,12 +379,35 @@ kernel void cubefan_cube_colors(global float4* cubes, global const float* tf, co
     cubes[3 * i + 2] = clvr_tf_eval(tf, tf_count, cubes[3 * i].w);
 }
 
-/* Per frame: each cube's box of pixel centres, its eight corners projected (the inverse of kernels/ray.h's rays: the
- * offset in right and up over the depth along forward, perspective), grown by 0.01 pixel and 1e-5 of its size (far more
- * than the rays' float rounding reaches past the projection) and clipped to the image; the whole image where a corner
- * is within 1e-4 of the cube's depth terms of the eye's plane or behind it, none for a cube wholly behind that plane;
- * (1, 1, 0, 0) when empty. 8 cubes per
- * work-item, one per lane (PoCL does not vectorize the work-items of this kernel itself): cubes 8 i .. 8 i + 7 of n. */
+/* The extent in image-plane offsets (right and up over the depth along forward) of the part of a box at depth >= z_near,
+ * corner k of it at (x[k], y[k], z[k]) in the eye's frame (right, up, forward): its corners beyond z_near and the
+ * crossings of that plane by its 12 edges. (min x, min y, max x, max y). */
+static float4 cubefan_clipped_extent(const float x[8], const float y[8], const float z[8], const float z_near)
+{
+    float4 e = (float4)(INFINITY, INFINITY, -INFINITY, -INFINITY);
+    for (int k = 0; k < 8; ++k) {
+        if (z[k] >= z_near)
+            e = (float4)(fmin(e.xy, (float2)(x[k], y[k]) / z[k]), fmax(e.zw, (float2)(x[k], y[k]) / z[k]));
+        for (int bit = 1; bit < 8; bit <<= 1) {
+            const int j = k | bit;
+            if ((k & bit) || (z[k] >= z_near) == (z[j] >= z_near))
+                continue;
+            const float f = (z_near - z[k]) / (z[j] - z[k]);
+            const float2 q = (float2)(x[k] + f * (x[j] - x[k]), y[k] + f * (y[j] - y[k])) / z_near;
+            e = (float4)(fmin(e.xy, q), fmax(e.zw, q));
+        }
+    }
+    return e;
+}
+
+/* Per frame: each cube's box of pixel centres, grown by 0.01 pixel and 1e-5 of its size (far more than the rays'
+ * float rounding reaches past the projection) and clipped to the image; (1, 1, 0, 0) when empty. Parallel: its eight
+ * corners projected. Perspective (the inverse of kernels/ray.h's rays): a point the rays reach at depth z along
+ * forward is within z c of the eye, c = |d| / (d . forward) of the image's corner ray; so a cube at distance r from
+ * the eye is seen only in its part at depth >= z_near = r / (2 c), which is projected — its corners there, or where it
+ * crosses that plane its clipped part (cubefan_clipped_extent); a cube holding the eye covers the whole image, one
+ * wholly nearer than z_near none. 8 cubes per work-item, one per lane (PoCL does not vectorize the work-items of
+ * this kernel itself): cubes 8 i .. 8 i + 7 of n. */
 kernel void cubefan_cube_boxes(global const float4* cubes, global short4* boxes, const ClCubefanFusedParams p,
                                const uint n)
 {
@@ -406,33 +429,55 @@ kernel void cubefan_cube_boxes(global const float4* cubes, global short4* boxes,
     lo_y = p.field_lo.y + lo_y / p.inv_spacing.y - cam.position.y, hi_y = p.field_lo.y + hi_y / p.inv_spacing.y - cam.position.y;
     lo_z = p.field_lo.z + lo_z / p.inv_spacing.z - cam.position.z, hi_z = p.field_lo.z + hi_z / p.inv_spacing.z - cam.position.z;
     const int parallel = clvr_ray_parallel(cam);
-    float8 min_x = INFINITY, max_x = -INFINITY, min_y = INFINITY, max_y = -INFINITY, min_z = INFINITY,
-           max_z = -INFINITY, size = 0.0f;
+    /* each corner in the eye's frame, and its extent (over the depth: perspective) */
+    float8 cx[8], cy[8], cz[8];
+    float8 min_x = INFINITY, max_x = -INFINITY, min_y = INFINITY, max_y = -INFINITY, min_z = INFINITY, max_z = -INFINITY;
 #define CUBEFAN_CORNER(K)                                                                                            \
     {                                                                                                                \
         const float8 x = (K) & 1 ? hi_x : lo_x, y = (K) & 2 ? hi_y : lo_y, z = (K) & 4 ? hi_z : lo_z;                 \
-        const float8 depth = x * cam.forward.x + y * cam.forward.y + z * cam.forward.z;                              \
-        const float8 w = parallel ? (float8)(1.0f) : 1.0f / depth;                                                   \
-        const float8 sx = (x * cam.right.x + y * cam.right.y + z * cam.right.z) * w;                                 \
-        const float8 sy = (x * cam.up.x + y * cam.up.y + z * cam.up.z) * w;                                          \
-        min_x = fmin(min_x, sx), max_x = fmax(max_x, sx), min_y = fmin(min_y, sy), max_y = fmax(max_y, sy);          \
-        min_z = fmin(min_z, depth), max_z = fmax(max_z, depth), size = fmax(size, fabs(depth));                      \
+        cz[K] = x * cam.forward.x + y * cam.forward.y + z * cam.forward.z;                                           \
+        cx[K] = x * cam.right.x + y * cam.right.y + z * cam.right.z;                                                 \
+        cy[K] = x * cam.up.x + y * cam.up.y + z * cam.up.z;                                                          \
+        const float8 w = parallel ? (float8)(1.0f) : 1.0f / cz[K];                                                   \
+        min_x = fmin(min_x, cx[K] * w), max_x = fmax(max_x, cx[K] * w);                                              \
+        min_y = fmin(min_y, cy[K] * w), max_y = fmax(max_y, cy[K] * w);                                              \
+        min_z = fmin(min_z, cz[K]), max_z = fmax(max_z, cz[K]);                                                      \
     }
     CLVR_EACH_LANE(CUBEFAN_CORNER)
 #undef CUBEFAN_CORNER
+    int8 whole = 0, empty = 0;
+    if (!parallel) {
+        const float8 gap_x = fmax(fmax(lo_x, -hi_x), 0.0f), gap_y = fmax(fmax(lo_y, -hi_y), 0.0f),
+                     gap_z = fmax(fmax(lo_z, -hi_z), 0.0f);
+        const float8 distance = sqrt(gap_x * gap_x + gap_y * gap_y + gap_z * gap_z);
+        const float c = sqrt(1.0f + cam.params.x * cam.params.x * (1.0f + cam.params.y * cam.params.y));
+        const float8 z_near = distance * (0.5f / c);
+        whole = isequal(distance, 0.0f);
+        empty = ~whole & islessequal(max_z, z_near);
+        const int8 crosses = ~whole & ~empty & isless(min_z, z_near);
+        if (any(crosses)) {
+#define CUBEFAN_CLIP(L)                                                                                              \
+            if (crosses.s##L) {                                                                                      \
+                float x[8], y[8], z[8];                                                                              \
+                for (int k = 0; k < 8; ++k)                                                                          \
+                    x[k] = cx[k].s##L, y[k] = cy[k].s##L, z[k] = cz[k].s##L;                                         \
+                const float4 e = cubefan_clipped_extent(x, y, z, z_near.s##L);                                      \
+                min_x.s##L = e.x, min_y.s##L = e.y, max_x.s##L = e.z, max_y.s##L = e.w;                              \
+            }
+            CLVR_EACH_LANE(CUBEFAN_CLIP)
+#undef CUBEFAN_CLIP
+        }
+    }
     /* window = (ndc + 1) / 2 size; pixel centre x at window x + 0.5; a band's rows start at cam.position.w */
     const float full_h = cam.forward.w > 0.0f ? cam.forward.w : (float)p.height;
     const float kx = 0.5f * (float)p.width / (cam.params.x * cam.params.y), ky = 0.5f * full_h / cam.params.x;
-    const float cx = 0.5f * (float)p.width - 0.5f, cy = 0.5f * full_h - 0.5f - cam.position.w;
-    const float8 px0 = min_x * kx + cx, px1 = max_x * kx + cx, py0 = cy - max_y * ky, py1 = cy - min_y * ky;
-    const float8 pad = 0.01f + 1e-5f * fmax(px1 - px0, py1 - py0);
-    const int8 whole = parallel ? (int8)(0) : ~isgreater(min_z, 1e-4f * size);
+    const float cx0 = 0.5f * (float)p.width - 0.5f, cy0 = 0.5f * full_h - 0.5f - cam.position.w;
+    const float8 px0 = min_x * kx + cx0, px1 = max_x * kx + cx0, py0 = cy0 - max_y * ky, py1 = cy0 - min_y * ky;
+    const float8 pad = 0.01f + 1e-5f * fmin(fmax(px1 - px0, py1 - py0), 1e30f);
     const float w1 = (float)(p.width - 1), h1 = (float)(p.height - 1);
     const float8 x0 = select(fmax(ceil(px0 - pad), 0.0f), 0.0f, whole), x1 = select(fmin(floor(px1 + pad), w1), w1, whole);
     const float8 y0 = select(fmax(ceil(py0 - pad), 0.0f), 0.0f, whole), y1 = select(fmin(floor(py1 + pad), h1), h1, whole);
-    /* a cube wholly behind the eye's plane (perspective) is seen by no ray: no box */
-    const int8 behind = parallel ? (int8)(0) : ~isgreater(max_z, 0.0f);
-    const int8 empty = behind | isgreater(x0, x1) | isgreater(y0, y1) | isnan(x0) | isnan(x1) | isnan(y0) | isnan(y1);
+    empty |= isgreater(x0, x1) | isgreater(y0, y1) | isnan(x0) | isnan(x1) | isnan(y0) | isnan(y1);
 #define CUBEFAN_STORE_BOX(L)                                                                                         \
     if (first + L < n)                                                                                               \
         boxes[first + L] = empty.s##L ? (short4)(1, 1, 0, 0)                                                         \

@@ -97,9 +97,10 @@ TEST(CubefanTiles, DrawTheWalksImage)
                         static_cast<unsigned long long>(count(tileStats, "tile_entries")));
             EXPECT_EQ(e.nanCount, 0u);
             EXPECT_LT(worst(e.maxAbs), 2e-5) << what;
-            // Fewer tile entries than chords on these volumes: no cube is listed where no ray sees it (the cubes behind
-            // an eye inside the volume, boxed as the whole image, had made that case 245 k entries for 61 k chords).
-            EXPECT_LT(static_cast<double>(count(tileStats, "tile_entries")), crossed) << what;
+            // Fewer than half as many tile entries as chords on these volumes (0.05-0.34 measured): no cube is listed
+            // where no ray sees it. With an eye inside the volume, the cubes behind it boxed as the whole image had made
+            // 245 k entries for 61 k chords, and the cubes crossing its plane so boxed 53 k; clipped at z_near, 7 k.
+            EXPECT_LT(static_cast<double>(count(tileStats, "tile_entries")), 0.5 * crossed) << what;
             if (tolerance == 0.0) {
                 const Image4d exact = cubeFieldIntegral(volume, tf, view.camera, makeScene(view.camera, tf, 61, 43, {}).image);
                 EXPECT_TRUE(test::imagesNear(tiles, exact, {.maxAbs = 1e-4, .meanAbs = 1e-6})) << what;
