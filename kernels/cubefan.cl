@@ -379,11 +379,16 @@ kernel void cubefan_cube_colors(global float4* cubes, global const float* tf, co
     cubes[3 * i + 2] = clvr_tf_eval(tf, tf_count, cubes[3 * i].w);
 }
 
-/* The extent in image-plane offsets (right and up over the depth along forward) of the part of a box at depth >= z_near,
- * corner k of it at (x[k], y[k], z[k]) in the eye's frame (right, up, forward): its corners beyond z_near and the
- * crossings of that plane by its 12 edges. (min x, min y, max x, max y). */
-static float4 cubefan_clipped_extent(const float x[8], const float y[8], const float z[8], const float z_near)
+/* The extent in image-plane offsets (right and up over the depth along forward) of the part of the box [lo, hi] (relative
+ * to the eye) at depth >= z_near: its corners beyond z_near and the crossings of that plane by its 12 edges.
+ * (min x, min y, max x, max y). */
+static float4 cubefan_clipped_extent(const float3 lo, const float3 hi, const ClCamera* cam, const float z_near)
 {
+    float x[8], y[8], z[8];
+    for (int k = 0; k < 8; ++k) {
+        const float3 q = (float3)(k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z);
+        x[k] = dot(q, cam->right.xyz), y[k] = dot(q, cam->up.xyz), z[k] = dot(q, cam->forward.xyz);
+    }
     float4 e = (float4)(INFINITY, INFINITY, -INFINITY, -INFINITY);
     for (int k = 0; k < 8; ++k) {
         if (z[k] >= z_near)
@@ -429,19 +434,17 @@ kernel void cubefan_cube_boxes(global const float4* cubes, global short4* boxes,
     lo_y = p.field_lo.y + lo_y / p.inv_spacing.y - cam.position.y, hi_y = p.field_lo.y + hi_y / p.inv_spacing.y - cam.position.y;
     lo_z = p.field_lo.z + lo_z / p.inv_spacing.z - cam.position.z, hi_z = p.field_lo.z + hi_z / p.inv_spacing.z - cam.position.z;
     const int parallel = clvr_ray_parallel(cam);
-    /* each corner in the eye's frame, and its extent (over the depth: perspective) */
-    float8 cx[8], cy[8], cz[8];
+    /* each corner's extent (over its depth: perspective) */
     float8 min_x = INFINITY, max_x = -INFINITY, min_y = INFINITY, max_y = -INFINITY, min_z = INFINITY, max_z = -INFINITY;
 #define CUBEFAN_CORNER(K)                                                                                            \
     {                                                                                                                \
         const float8 x = (K) & 1 ? hi_x : lo_x, y = (K) & 2 ? hi_y : lo_y, z = (K) & 4 ? hi_z : lo_z;                 \
-        cz[K] = x * cam.forward.x + y * cam.forward.y + z * cam.forward.z;                                           \
-        cx[K] = x * cam.right.x + y * cam.right.y + z * cam.right.z;                                                 \
-        cy[K] = x * cam.up.x + y * cam.up.y + z * cam.up.z;                                                          \
-        const float8 w = parallel ? (float8)(1.0f) : 1.0f / cz[K];                                                   \
-        min_x = fmin(min_x, cx[K] * w), max_x = fmax(max_x, cx[K] * w);                                              \
-        min_y = fmin(min_y, cy[K] * w), max_y = fmax(max_y, cy[K] * w);                                              \
-        min_z = fmin(min_z, cz[K]), max_z = fmax(max_z, cz[K]);                                                      \
+        const float8 depth = x * cam.forward.x + y * cam.forward.y + z * cam.forward.z;                              \
+        const float8 w = parallel ? (float8)(1.0f) : 1.0f / depth;                                                   \
+        const float8 sx = (x * cam.right.x + y * cam.right.y + z * cam.right.z) * w;                                 \
+        const float8 sy = (x * cam.up.x + y * cam.up.y + z * cam.up.z) * w;                                          \
+        min_x = fmin(min_x, sx), max_x = fmax(max_x, sx), min_y = fmin(min_y, sy), max_y = fmax(max_y, sy);          \
+        min_z = fmin(min_z, depth), max_z = fmax(max_z, depth);                                                      \
     }
     CLVR_EACH_LANE(CUBEFAN_CORNER)
 #undef CUBEFAN_CORNER
@@ -458,10 +461,8 @@ kernel void cubefan_cube_boxes(global const float4* cubes, global short4* boxes,
         if (any(crosses)) {
 #define CUBEFAN_CLIP(L)                                                                                              \
             if (crosses.s##L) {                                                                                      \
-                float x[8], y[8], z[8];                                                                              \
-                for (int k = 0; k < 8; ++k)                                                                          \
-                    x[k] = cx[k].s##L, y[k] = cy[k].s##L, z[k] = cz[k].s##L;                                         \
-                const float4 e = cubefan_clipped_extent(x, y, z, z_near.s##L);                                      \
+                const float4 e = cubefan_clipped_extent((float3)(lo_x.s##L, lo_y.s##L, lo_z.s##L),                   \
+                                                        (float3)(hi_x.s##L, hi_y.s##L, hi_z.s##L), &cam, z_near.s##L);  \
                 min_x.s##L = e.x, min_y.s##L = e.y, max_x.s##L = e.z, max_y.s##L = e.w;                              \
             }
             CLVR_EACH_LANE(CUBEFAN_CLIP)
