@@ -27,8 +27,8 @@ TileLists binToTiles(const std::vector<PixelBox>& boxes, const std::vector<std::
     const std::size_t tiles = static_cast<std::size_t>(lists.tilesX) * lists.tilesY;
     // One chunk per thread (at least 16,384 items each): the per-chunk counts and their prefix stay small.
     const int threads = threadsToUse(0, static_cast<int>(order.size() / 16384 + 1));
-    const std::size_t kChunk = std::max<std::size_t>(16384, (order.size() + threads - 1) / threads);
-    const std::size_t chunks = (order.size() + kChunk - 1) / kChunk;
+    const std::size_t chunk = std::max<std::size_t>(16384, (order.size() + threads - 1) / threads);
+    const std::size_t chunks = (order.size() + chunk - 1) / chunk;
     // chunk c's count, then its first entry, in tile t: offset[c * tiles + t]
     std::vector<cl_uint> offset(chunks * tiles, 0);
     const std::size_t tilesX = static_cast<std::size_t>(lists.tilesX);
@@ -43,9 +43,9 @@ TileLists binToTiles(const std::vector<PixelBox>& boxes, const std::vector<std::
                     visit(i, static_cast<std::size_t>(ty) * tilesX + static_cast<std::size_t>(tx));
         }
     };
-    auto overChunks = [&](const auto& work) { forHostChunks(threads, order.size(), work, kChunk); };
+    auto overChunks = [&](const auto& work) { forHostChunks(threads, order.size(), work, chunk); };
     overChunks([&](std::size_t begin, std::size_t end) {
-        cl_uint* count = offset.data() + begin / kChunk * tiles;
+        cl_uint* count = offset.data() + begin / chunk * tiles;
         overItems(begin, end, [&](std::size_t, std::size_t tile) { ++count[tile]; });
     });
     lists.start.resize(tiles + 1);
@@ -64,7 +64,7 @@ TileLists binToTiles(const std::vector<PixelBox>& boxes, const std::vector<std::
     lists.items.resize(entries);
     cl_uint* items = lists.items.data();
     overChunks([&](std::size_t begin, std::size_t end) {
-        cl_uint* next = offset.data() + begin / kChunk * tiles;
+        cl_uint* next = offset.data() + begin / chunk * tiles;
         overItems(begin, end, [&](std::size_t i, std::size_t tile) { items[next[tile]++] = order[i]; });
     });
     return lists;

@@ -5,7 +5,6 @@
 #include <CL/opencl.hpp>
 
 #include <cstddef>
-
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -21,14 +20,17 @@ struct PixelBox {
 // Images the tile kernels take: at most this many pixels a side (PixelBox holds them).
 inline constexpr int kTileImageMax = 16384;
 
-// Per tile (row-major, tilesX per row) the items whose box reaches it, in `order`'s order: tile t's items are
-// items[start[t] .. start[t + 1]). A stable counting sort by chunks of the order on the host's threads (each chunk
-// counts its items' tiles, the counts become each chunk's offsets within each tile, each chunk writes its items).
+// Per tile (row-major, tilesX per row) the items whose box reaches it: tile t's items are items[start[t] ..
+// start[t + 1]).
 struct TileLists {
     int tilesX = 0, tilesY = 0;
     std::vector<cl_uint> start, items;
 };
-// tileW and tileH: powers of two. InputError "<what>: the tile lists have more than 2^32 entries; <remedy>" where they would.
+
+// The items of `order` binned to tiles of tileW x tileH pixels (powers of two) by boxes[item], each tile's in
+// `order`'s order: a stable counting sort by chunks of the order on the host's threads (each chunk counts its items'
+// tiles, the counts become each chunk's offsets within each tile, each chunk writes its items). InputError
+// "<what>: the tile lists have more than 2^32 entries; <remedy>" where they would.
 TileLists binToTiles(const std::vector<PixelBox>& boxes, const std::vector<std::uint32_t>& order, int width, int height,
                      int tileW, int tileH, const std::string& what, const std::string& remedy);
 

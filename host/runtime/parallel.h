@@ -1,5 +1,5 @@
 // host/runtime/parallel.h — the process-wide thread budget and running one worker function on several host
-// threads (CPU references, harc's face sort, the ceiling loop).
+// threads (CPU references, harc's face sort, the ceiling loop, the renderers' per-frame host loops).
 #pragma once
 
 #include <algorithm>
