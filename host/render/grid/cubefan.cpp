@@ -271,6 +271,21 @@ private:
     Image4f renderRaster(FrameStats& stats);
     Image4f renderFused(FrameStats& stats);
     Image4f renderTiles(FrameStats& stats);
+    // The fused and tile paths' kernel parameters for the current camera (the walk adds its filled box).
+    ClCubefanFusedParams kernelParams() const
+    {
+        ClCubefanFusedParams p{};
+        p.camera = toClCamera(camera_, image_.width, image_.height, shift_);
+        p.field_lo = toCl4(lo_ - shift_, 0.0);
+        p.inv_spacing = toCl4(1.0 / spacing_, 0.0);
+        p.background = toCl4(glm::dvec3(image_.background), 0.0);
+        p.dims = cl_int4{{dims_.x, dims_.y, dims_.z, 0}};
+        p.width = image_.width;
+        p.height = image_.height;
+        p.tf_count = static_cast<cl_int>(tf_.count());
+        p.ert_alpha = options_.earlyTermination < 1.0 ? static_cast<float>(options_.earlyTermination) : 2.0f;
+        return p;
+    }
     // What the fused and tile paths report of their selection (built this frame in selectionMs, else 0) and chords.
     void reportSelection(FrameStats& stats, double selectionMs, std::uint64_t crossed) const
     {
@@ -285,6 +300,7 @@ private:
     }
     void updateTexture(double k);
     double updateSelectionGrid();
+    double updateSelectionTree();
 
     Device& device_;
     CubefanOptions options_;
@@ -313,8 +329,9 @@ private:
     bool packet_ = false;  // fused_ is cubefan_fused_packet
     cl::Buffer gridLevel_, gridValue_, gridSpace_, fusedSteps_, fusedSkipped_;
     bool gridCurrent_ = false;  // the selection grid, or on the tile path the selection tree and its cubes
-    // The tile path: the selection as a tree (the order per view), its cubes on the device (2 float4 each: low
-    // corner and value, high corner, in the selection grid's coordinates), the frame's order, boxes and tile lists.
+    // The tile path: the selection as a tree (the order per view), its cubes on the device (3 float4 each: low
+    // corner and value, high corner, in the selection grid's coordinates; color and extinction) and their boxes, the
+    // frame's order and tile lists.
     cubefan::CubeOctree::SelectionTree tree_;
     cl::Buffer tileCubes_, tileBoxesOut_;
     std::uint64_t tileCubeBytes_ = 0;
@@ -429,16 +446,7 @@ Image4f CubefanRenderer::renderFused(FrameStats& stats)
 {
     const FrameClock clock;
     const double gridMs = updateSelectionGrid();
-    ClCubefanFusedParams p{};
-    p.camera = toClCamera(camera_, image_.width, image_.height, shift_);
-    p.field_lo = toCl4(lo_ - shift_, 0.0);
-    p.inv_spacing = toCl4(1.0 / spacing_, 0.0);
-    p.background = toCl4(glm::dvec3(image_.background), 0.0);
-    p.dims = cl_int4{{dims_.x, dims_.y, dims_.z, 0}};
-    p.width = image_.width;
-    p.height = image_.height;
-    p.tf_count = static_cast<cl_int>(tf_.count());
-    p.ert_alpha = options_.earlyTermination < 1.0 ? static_cast<float>(options_.earlyTermination) : 2.0f;
+    ClCubefanFusedParams p = kernelParams();
     p.filled_lo = cl_int4{{filledLo_.x, filledLo_.y, filledLo_.z, 0}};
     p.filled_hi = cl_int4{{filledHi_.x, filledHi_.y, filledHi_.z, 0}};
     int a = 0;
@@ -469,57 +477,56 @@ Image4f CubefanRenderer::renderFused(FrameStats& stats)
     return image;
 }
 
+// Builds the tile path's selection tree for the current tolerance and transfer function, uploads its cubes and has
+// their colors computed; returns its milliseconds (0 when it was current).
+double CubefanRenderer::updateSelectionTree()
+{
+    if (gridCurrent_)
+        return 0.0;
+    const auto t0 = std::chrono::steady_clock::now();
+    tree_ = octree_->selectTree(options_.error, tfHost_, &gridStats_);
+    const std::size_t n = tree_.cubes.size();
+    if (n >= (std::size_t(1) << 30))  // the kernels index 3 float4 per cube in 32 bits
+        throw InputError("cubefan: \"path\": \"tiles\" takes fewer than 2^30 cubes, the selection has " +
+                         std::to_string(n) + "; use \"path\": \"fused\" or a larger error");
+    checkHostMemory("cubefan's tile path (" + std::to_string(n) + " cubes)", n * 3 * sizeof(cl_float4));
+    std::vector<cl_float4> cubes(3 * n);
+    for (std::size_t i = 0; i < n; ++i) {
+        const cubefan::Cube& c = tree_.cubes[i];
+        const glm::ivec3 lo = c.index * (1 << c.level), hi = glm::min(lo + (1 << c.level), dims_);
+        cubes[3 * i] = cl_float4{{static_cast<float>(lo.x), static_cast<float>(lo.y), static_cast<float>(lo.z), c.value}};
+        cubes[3 * i + 1] = cl_float4{{static_cast<float>(hi.x), static_cast<float>(hi.y), static_cast<float>(hi.z), 0.0f}};
+    }
+    residentBytes_ -= tileCubeBytes_;
+    tileCubes_ = device_.upload("cubefan tile path cubes", cubes.empty() ? std::vector<cl_float4>(3) : cubes,
+                                CL_MEM_READ_WRITE);
+    tileBoxesOut_ = device_.buffer("cubefan tile path cube boxes", std::max<std::size_t>(n, 1) * sizeof(cl_short4));
+    tileCubeBytes_ = std::max<std::size_t>(3 * n, 3) * sizeof(cl_float4) + std::max<std::size_t>(n, 1) * sizeof(cl_short4);
+    residentBytes_ += tileCubeBytes_;
+    if (n > 0) {  // each cube's color (the transfer function on the device, as the walk evaluates it)
+        int a = 0;
+        cubeColors_.setArg(a++, tileCubes_);
+        cubeColors_.setArg(a++, tf_.buffer());
+        cubeColors_.setArg(a++, static_cast<cl_int>(tf_.count()));
+        cubeColors_.setArg(a++, static_cast<cl_uint>(n));
+        device_.launch("cubefan: cube colors", cubeColors_, n);
+    }
+    gridCurrent_ = true;
+    gridMs_ = msSince(t0);
+    return gridMs_;
+}
+
 // The tile path: the selection as a tree (when the tolerance or transfer function changed), its cubes ordered front to
 // back for the eye, boxed and binned to tiles on the host's threads, then cubefan_tiles (or its packets) over the image.
 Image4f CubefanRenderer::renderTiles(FrameStats& stats)
 {
     const FrameClock clock;
     std::vector<PassTime> hostPasses;
-    double selectionMs = 0.0;  // this frame's
-    if (!gridCurrent_) {
-        const auto t0 = std::chrono::steady_clock::now();
-        tree_ = octree_->selectTree(options_.error, tfHost_, &gridStats_);
-        const std::size_t n = tree_.cubes.size();
-        if (n >= (std::size_t(1) << 30))  // the kernels index 3 float4 per cube in 32 bits
-            throw InputError("cubefan: \"path\": \"tiles\" takes fewer than 2^30 cubes, the selection has " +
-                             std::to_string(n) + "; use \"path\": \"fused\" or a larger error");
-        checkHostMemory("cubefan's tile path (" + std::to_string(n) + " cubes)", n * 3 * sizeof(cl_float4));
-        std::vector<cl_float4> cubes(3 * n);
-        for (std::size_t i = 0; i < n; ++i) {
-            const cubefan::Cube& c = tree_.cubes[i];
-            const glm::ivec3 lo = c.index * (1 << c.level), hi = glm::min(lo + (1 << c.level), dims_);
-            cubes[3 * i] = cl_float4{{static_cast<float>(lo.x), static_cast<float>(lo.y), static_cast<float>(lo.z), c.value}};
-            cubes[3 * i + 1] = cl_float4{{static_cast<float>(hi.x), static_cast<float>(hi.y), static_cast<float>(hi.z), 0.0f}};
-        }
-        residentBytes_ -= tileCubeBytes_;
-        tileCubes_ = device_.upload("cubefan tile path cubes", cubes.empty() ? std::vector<cl_float4>(3) : cubes,
-                                    CL_MEM_READ_WRITE);
-        tileBoxesOut_ = device_.buffer("cubefan tile path cube boxes", std::max<std::size_t>(n, 1) * sizeof(cl_short4));
-        tileCubeBytes_ = std::max<std::size_t>(3 * n, 3) * sizeof(cl_float4) + std::max<std::size_t>(n, 1) * sizeof(cl_short4);
-        residentBytes_ += tileCubeBytes_;
-        if (n > 0) {  // each cube's color (the transfer function on the device, as the walk evaluates it)
-            int a = 0;
-            cubeColors_.setArg(a++, tileCubes_);
-            cubeColors_.setArg(a++, tf_.buffer());
-            cubeColors_.setArg(a++, static_cast<cl_int>(tf_.count()));
-            cubeColors_.setArg(a++, static_cast<cl_uint>(n));
-            device_.launch("cubefan: cube colors", cubeColors_, n);
-        }
-        gridCurrent_ = true;
-        gridMs_ = selectionMs = msSince(t0);
-        hostPasses.push_back({"cubefan: selection tree (host, when the tolerance or transfer function changes)", gridMs_});
-    }
+    const double selectionMs = updateSelectionTree();
+    if (selectionMs > 0.0)
+        hostPasses.push_back({"cubefan: selection tree (host, when the tolerance or transfer function changes)", selectionMs});
     const int width = image_.width, height = image_.height;
-    ClCubefanFusedParams p{};
-    p.camera = toClCamera(camera_, width, height, shift_);
-    p.field_lo = toCl4(lo_ - shift_, 0.0);
-    p.inv_spacing = toCl4(1.0 / spacing_, 0.0);
-    p.background = toCl4(glm::dvec3(image_.background), 0.0);
-    p.dims = cl_int4{{dims_.x, dims_.y, dims_.z, 0}};
-    p.width = width;
-    p.height = height;
-    p.tf_count = static_cast<cl_int>(tf_.count());
-    p.ert_alpha = options_.earlyTermination < 1.0 ? static_cast<float>(options_.earlyTermination) : 2.0f;
+    const ClCubefanFusedParams p = kernelParams();
     // The cubes' boxes on the device while the host orders the cubes for the eye; then the boxes read back and the
     // cubes binned to tiles in that order.
     const std::size_t n = tree_.cubes.size();
