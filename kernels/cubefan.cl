@@ -364,7 +364,7 @@ kernel void cubefan_fused_packet(global float4* out, global uint* steps, global 
 #define CUBEFAN_TILE_W_LOG2 3 /* host/render/grid/cubefan.h kCubefanTileW, H */
 #define CUBEFAN_TILE_H_LOG2 2
 #define CUBEFAN_TILE_H (1 << CUBEFAN_TILE_H_LOG2)
-#define CUBEFAN_AHEAD 12 /* how many tile entries ahead cubefan_tiles_packet prefetches its cubes */
+#define CUBEFAN_AHEAD 12 /* how many tile entries ahead cubefan_tiles_packet prefetches its cubes (BENCHMARKS.md run CT3) */
 #if (1 << CUBEFAN_TILE_W_LOG2) != CLVR_LANES || CUBEFAN_TILE_H != 4
 #error "cubefan_tiles_packet takes a tile as two pairs of rows of 8"
 #endif
@@ -527,18 +527,6 @@ kernel void cubefan_tiles(global float4* out, global uint* steps, global const u
     steps[pixel] = crossed;
 }
 
-/* cubefan_tiles for a whole tile per work-item, each row's 8 pixels as the lanes of 8-wide vectors: every cube is
- * loaded and its color looked up once for the tile, and met by the rows its box reaches. Lane by lane the same
- * operations as cubefan_tiles (kernels/packet.h's rule): the same bits. */
-/* clvr_exp2 for 16 lanes (kernels/packet.h's clvr_exp2_8, twice as wide): the same polynomial and exponent bits. */
-static float16 cubefan_exp2_16(const float16 x)
-{
-    const float16 n = rint(x);
-    const float16 f = x - n;
-    const float16 r = CLVR_EXP2_POLYNOMIAL(f) * as_float16((convert_int16(n) + 127) << 23);
-    return select((float16)(0.0f), r, isgreaterequal(x, -126.0f));
-}
-
 /* cubefan_tiles for a whole tile per work-item: two rows of 8 pixels as the 16 lanes of one vector (16 floats, one
  * AVX-512 register), the tile's 4 rows as two such pairs. Each cube of the list is loaded once for the tile and met by
  * the pairs its box reaches, the lanes outside its box (or past the image) masked, without asking whether any lane
@@ -585,7 +573,7 @@ kernel void cubefan_tiles_packet(global float4* out, global uint* steps, global 
         const float4 lo = cubes[3 * i], hi = cubes[3 * i + 1], ct = cubes[3 * i + 2];
         const float a_x = lo.x - e_x, a_y = lo.y - e_y, a_z = lo.z - e_z, b_x = hi.x - e_x, b_y = hi.y - e_y,
                     b_z = hi.z - e_z;
-        const int pair_lo = max((int)b.y - y0, 0) >> 1, pair_hi = min((int)b.w - y0, 3) >> 1;
+        const int pair_lo = max((int)b.y - y0, 0) >> 1, pair_hi = min((int)b.w - y0, CUBEFAN_TILE_H - 1) >> 1;
         for (int pair = pair_lo; pair <= pair_hi; ++pair) {
             const int16 row = y0 + 2 * pair + lane_row;
             const float16 t0x = (eye ? (float16)(a_x) : lo.x - qex[pair]) * ix[pair];
@@ -598,7 +586,7 @@ kernel void cubefan_tiles_packet(global float4* out, global uint* steps, global 
             const float16 t_out = fmin(fmin(fmax(t0x, t1x), fmax(t0y, t1y)), fmax(t0z, t1z));
             const int16 m = live[pair] & columns & (row >= (int)b.y) & (row <= (int)b.w) & isgreater(t_out, t_in);
             crossed[pair] -= m;
-            const float16 alpha = 1.0f - cubefan_exp2_16(ct.w * ((t_in - t_out) * M_LOG2E_F));
+            const float16 alpha = 1.0f - clvr_exp2_16(ct.w * ((t_in - t_out) * M_LOG2E_F));
             const float16 ta = transmittance[pair] * alpha;
             c_r[pair] = select(c_r[pair], c_r[pair] + ta * ct.x, m);
             c_g[pair] = select(c_g[pair], c_g[pair] + ta * ct.y, m);

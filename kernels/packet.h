@@ -84,14 +84,19 @@ float8 clvr_atan2_8(const float8 y, const float8 x)
     return copysign(r, y);
 }
 
-/* clvr_exp2 (kernels/clvr_common.h) lane by lane, the same operations. */
-float8 clvr_exp2_8(const float8 x)
-{
-    const float8 n = rint(x);
-    const float8 f = x - n;
-    const float8 r = CLVR_EXP2_POLYNOMIAL(f) * as_float8((convert_int8(n) + 127) << 23);
-    return select((float8)(0.0f), r, isgreaterequal(x, -126.0f));
-}
+/* clvr_exp2 (kernels/clvr_common.h) lane by lane, the same operations: clvr_exp2_8 and clvr_exp2_16 (two rows of a
+ * packet in one vector, kernels/cubefan.cl's tiles). */
+#define CLVR_EXP2_LANES(N)                                                                            \
+    float##N clvr_exp2_##N(const float##N x)                                                          \
+    {                                                                                                 \
+        const float##N n = rint(x);                                                                   \
+        const float##N f = x - n;                                                                     \
+        const float##N r = CLVR_EXP2_POLYNOMIAL(f) * as_float##N((convert_int##N(n) + 127) << 23);     \
+        return select((float##N)(0.0f), r, isgreaterequal(x, -126.0f));                              \
+    }
+CLVR_EXP2_LANES(8)
+CLVR_EXP2_LANES(16)
+#undef CLVR_EXP2_LANES
 
 /* clvr_tf_eval (kernels/transfer_function.h) lane by lane: the same segment and expression per lane, found
  * by selects over the segments instead of a search. */

@@ -14,6 +14,16 @@ namespace clvr::cubefan {
 
 namespace {
 
+// The octant of a node's children nearest the eye: bit a set when the eye is on the high side of the split plane of
+// axis a (parallel: when the view runs down axis a). Child nearSide ^ m for m = 0 .. 7 is nearest first.
+int nearSide(const glm::dvec3& split, const glm::dvec3& eye, const glm::dvec3& forward, bool parallel)
+{
+    int side = 0;
+    for (int a = 0; a < 3; ++a)
+        side |= (parallel ? forward[a] < 0.0 : eye[a] > split[a]) ? (1 << a) : 0;
+    return side;
+}
+
 // Voxels of level-k cube i along an axis of n voxels.
 int leavesAlong(int i, int k, int n)
 {
@@ -132,17 +142,13 @@ std::vector<Cube> CubeOctree::select(double tolerance, const TransferFunction& t
             out.push_back(take(level, i, s));
             return;
         }
-        // The children's split planes; bit a of `near` set when the eye is on the high side of axis a's.
+        // The children's split planes: the high corner of the low child's box.
         glm::dvec3 lo, hi;
         box(level - 1, 2 * i, lo, hi);
-        int nearSide = 0;
-        for (int a = 0; a < 3; ++a) {
-            const bool high = parallel ? forward[a] < 0.0 : eye[a] > hi[a];
-            nearSide |= high ? (1 << a) : 0;
-        }
+        const int side = nearSide(hi, eye, forward, parallel);
         const glm::ivec3 childDims = levels_[level - 1].dims;
         for (int m = 7; m >= 0; --m) {  // farthest first: the child on the far side of every plane
-            const int child = nearSide ^ m;
+            const int child = side ^ m;
             const glm::ivec3 ci = 2 * i + glm::ivec3(child & 1, (child >> 1) & 1, (child >> 2) & 1);
             if (glm::all(glm::lessThan(ci, childDims)))
                 self(self, level - 1, ci);
@@ -248,12 +254,12 @@ CubeOctree::SelectionTree CubeOctree::selectTree(double tolerance, const Transfe
 void CubeOctree::SelectionTree::frontToBack(const glm::dvec3& eye, const glm::dvec3& forward, bool parallel,
                                             std::vector<std::uint32_t>& order) const
 {
-    // Depth first, a node's children nearest first: child nearSide ^ m for m = 0 .. 7 (select()'s order reversed).
-    auto nearSide = [&](const Node& n) {
-        int side = 0;
-        for (int a = 0; a < 3; ++a)
-            side |= (parallel ? forward[a] < 0.0 : eye[a] > n.split[a]) ? (1 << a) : 0;
-        return side;
+    // Depth first, a node's children nearest first (select()'s order reversed): visit(child) for each child there is.
+    auto forChildren = [&](const Node& n, const auto& visit) {
+        const int side = nearSide(n.split, eye, forward, parallel);
+        for (int m = 0; m < 8; ++m)
+            if (const std::int32_t child = n.child[static_cast<std::size_t>(side ^ m)]; child != kNone)
+                visit(child);
     };
     // The top levels expanded in that order into at least kItems subtrees and cubes, then the subtrees walked on the
     // host's threads, each into its own list (recursion depth: the level count), and the lists joined in order.
@@ -270,11 +276,7 @@ void CubeOctree::SelectionTree::frontToBack(const glm::dvec3& eye, const glm::dv
                 continue;
             }
             expanded = true;
-            const Node& n = nodes[static_cast<std::size_t>(item)];
-            const int side = nearSide(n);
-            for (int m = 0; m < 8; ++m)
-                if (const std::int32_t child = n.child[static_cast<std::size_t>(side ^ m)]; child != kNone)
-                    next.push_back(child);
+            forChildren(nodes[static_cast<std::size_t>(item)], [&](std::int32_t child) { next.push_back(child); });
         }
         items.swap(next);
     }
@@ -284,11 +286,7 @@ void CubeOctree::SelectionTree::frontToBack(const glm::dvec3& eye, const glm::dv
             out.push_back(static_cast<std::uint32_t>(~item));
             return;
         }
-        const Node& n = nodes[static_cast<std::size_t>(item)];
-        const int side = nearSide(n);
-        for (int m = 0; m < 8; ++m)
-            if (const std::int32_t child = n.child[static_cast<std::size_t>(side ^ m)]; child != kNone)
-                self(self, child, out);
+        forChildren(nodes[static_cast<std::size_t>(item)], [&](std::int32_t child) { self(self, child, out); });
     };
     std::atomic<std::size_t> taken{0};
     runOnThreads(0, static_cast<int>(std::min<std::size_t>(items.size(), cubes.size() / 16384 + 1)), [&] {
