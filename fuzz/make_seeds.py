@@ -424,3 +424,87 @@ seed("transfer_function", "default_scene", text("""
             [0.88, 1.00, 0.20, 0.10, 0.0], [1.00, 1.00, 1.00, 1.00, 20.0]]}
 """))
 seed("transfer_function", "wide_range", text('{"points": [[-1e30, 0, 0.5, 1, 0], [-1e-300, 1, 1, 1, 1e10], [3e38, 0, 0, 0, 0.5]]}'))
+
+# --- numpy .npy
+def npy(descr, fortran, shape, data, version=1):
+    d = "{'descr': '%s', 'fortran_order': %s, 'shape': (%s), }" % (
+        descr, "True" if fortran else "False", ", ".join(str(s) for s in shape))
+    pre = 10 if version == 1 else 12
+    d += " " * ((64 - (pre + len(d) + 1) % 64) % 64) + "\n"
+    n = struct.pack("<H", len(d)) if version == 1 else struct.pack("<I", len(d))
+    return b"\x93NUMPY" + bytes([version, 0]) + n + d.encode() + data
+
+
+seed("npy", "u1_c.npy", npy("|u1", False, (2, 3, 2), bytes(range(12))))
+seed("npy", "i2_f_big.npy", npy(">i2", True, (2, 2, 2), struct.pack(">8h", *range(-4, 4))))
+seed("npy", "f4_v2.npy", npy("<f4", False, (2, 2, 2), struct.pack("<8f", *[0.5 * i for i in range(8)]), 2))
+seed("npy", "f8_c.npy", npy("<f8", False, (2, 2, 3), struct.pack("<12d", *range(12))))
+
+# --- VTK XML image data (.vti, .pvti + piece) and unstructured grids (.vtu)
+VTI_ASCII = text("""
+<?xml version="1.0"?>
+<VTKFile type="ImageData" version="1.0" byte_order="LittleEndian" header_type="UInt64">
+  <ImageData WholeExtent="0 2 0 1 0 1" Origin="0 0 0" Spacing="1 0.5 2" Direction="1 0 0 0 1 0 0 0 1">
+  <Piece Extent="0 2 0 1 0 1">
+    <PointData Scalars="density">
+      <DataArray type="UInt16" Name="density" format="ascii" RangeMin="0" RangeMax="11">
+        0 1 2 3 4 5 6 7 8 9 10 11
+      </DataArray>
+      <DataArray type="Float32" Name="other" format="ascii">
+        0 -1 -2 -3 -4 -5 -6 -7 -8 -9 -10 -11
+      </DataArray>
+    </PointData>
+    <CellData>
+    </CellData>
+  </Piece>
+  </ImageData>
+</VTKFile>
+""")
+seed("vti", "ascii.vti", VTI_ASCII)
+APPENDED = struct.pack("<Q", 16) + struct.pack("<8H", *range(8))
+seed("vti", "appended_raw.vti", text("""
+<?xml version="1.0"?>
+<VTKFile type="ImageData" version="1.0" byte_order="LittleEndian" header_type="UInt64">
+  <ImageData WholeExtent="0 1 0 1 0 1" Origin="0 0 0" Spacing="1 1 1">
+  <Piece Extent="0 1 0 1 0 1">
+    <PointData Scalars="s">
+      <DataArray type="UInt16" Name="s" format="appended" offset="0"/>
+    </PointData>
+  </Piece>
+  </ImageData>
+  <AppendedData encoding="raw">
+   _""") + APPENDED + b"\n  </AppendedData>\n</VTKFile>\n")
+seed("vti", "pvti_piece", text("""
+<?xml version="1.0"?>
+<VTKFile type="PImageData" version="1.0" byte_order="LittleEndian" header_type="UInt64">
+  <PImageData WholeExtent="0 2 0 1 0 1" GhostLevel="0" Origin="0 0 0" Spacing="1 0.5 2">
+    <PPointData Scalars="density">
+      <PDataArray type="UInt16" Name="density"/>
+      <PDataArray type="Float32" Name="other"/>
+    </PPointData>
+    <Piece Extent="0 2 0 1 0 1" Source="piece.vti"/>
+  </PImageData>
+</VTKFile>
+""") + MARK + VTI_ASCII)
+seed("vtu", "ascii.vtu", text("""
+<?xml version="1.0"?>
+<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" header_type="UInt64">
+  <UnstructuredGrid>
+    <Piece NumberOfPoints="7" NumberOfCells="2">
+      <PointData Scalars="t">
+        <DataArray type="Float32" Name="t" format="ascii">0 1 2 3 4 5 6</DataArray>
+      </PointData>
+      <Points>
+        <DataArray type="Float32" NumberOfComponents="3" format="ascii">
+          0 0 0 1 0 0 0 1 0 0 0 1 1 1 0 1 0 1 0 1 1
+        </DataArray>
+      </Points>
+      <Cells>
+        <DataArray type="Int64" Name="connectivity" format="ascii">0 1 2 3 1 4 2 5 0 6</DataArray>
+        <DataArray type="Int64" Name="offsets" format="ascii">4 10</DataArray>
+        <DataArray type="UInt8" Name="types" format="ascii">10 13</DataArray>
+      </Cells>
+    </Piece>
+  </UnstructuredGrid>
+</VTKFile>
+"""))

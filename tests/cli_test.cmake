@@ -218,6 +218,52 @@ if(PART STREQUAL "input")
 
   expect_error(2 ${out} "default scene: options.slicez: unknown option"
     ${CLVR} render -o ${out} ${SMALL} --set options.slicez=3)
+
+  # --- VTK's formats (host/io/vtk_xml_io.h): a .vti and a .pvti of one piece render; a missing piece, a
+  # broken file and cell data are one line each; a build without VTK says so in one line.
+  set(vti_data "0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26")
+  file(WRITE "${WORK}/cube.vti" "<?xml version=\"1.0\"?>
+<VTKFile type=\"ImageData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">
+  <ImageData WholeExtent=\"0 2 0 2 0 2\" Origin=\"-1 -1 -1\" Spacing=\"1 1 1\">
+  <Piece Extent=\"0 2 0 2 0 2\">
+    <PointData Scalars=\"s\"><DataArray type=\"UInt8\" Name=\"s\" format=\"ascii\">${vti_data}</DataArray></PointData>
+  </Piece>
+  </ImageData>
+</VTKFile>
+")
+  file(WRITE "${WORK}/cube.pvti" "<?xml version=\"1.0\"?>
+<VTKFile type=\"PImageData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">
+  <PImageData WholeExtent=\"0 2 0 2 0 2\" GhostLevel=\"0\" Origin=\"-1 -1 -1\" Spacing=\"1 1 1\">
+    <PPointData Scalars=\"s\"><PDataArray type=\"UInt8\" Name=\"s\"/></PPointData>
+    <Piece Extent=\"0 2 0 2 0 2\" Source=\"cube.vti\"/>
+  </PImageData>
+</VTKFile>
+")
+  file(READ "${WORK}/cube.pvti" pvti)
+  string(REPLACE "cube.vti" "gone.vti" pvti "${pvti}")
+  file(WRITE "${WORK}/gone.pvti" "${pvti}")
+  file(READ "${WORK}/cube.vti" vti)
+  string(REPLACE "PointData" "CellData" cells "${vti}")
+  file(WRITE "${WORK}/cells.vti" "${cells}")
+  string(SUBSTRING "${vti}" 0 200 broken)
+  file(WRITE "${WORK}/broken.vti" "${broken}")
+  set(TF "--set=transfer_function.points=[[0,0,0,0,0],[26,1,1,1,4]]")
+  if(VTK)
+    foreach(name cube.vti cube.pvti)
+      expect_run(0 "^wrote .*cube.png" ${CLVR} render -o ${WORK}/cube.png ${SMALL} ${TF}
+        "--set=volume={\"file\": \"${WORK}/${name}\"}" --unset camera)
+      expect_png(${WORK}/cube.png 64 64)
+    endforeach()
+    expect_error(2 ${out} "gone.pvti: its piece gone.vti cannot be read"
+      ${CLVR} render -o ${out} ${SMALL} ${TF} "--set=volume={\"file\": \"${WORK}/gone.pvti\"}" --unset camera)
+    expect_error(2 ${out} "cells.vti: no point data, only cell data \\(s\\)"
+      ${CLVR} render -o ${out} ${SMALL} ${TF} "--set=volume={\"file\": \"${WORK}/cells.vti\"}" --unset camera)
+    expect_error(2 ${out} "broken.vti: VTK's reader failed: "
+      ${CLVR} render -o ${out} ${SMALL} ${TF} "--set=volume={\"file\": \"${WORK}/broken.vti\"}" --unset camera)
+  else()
+    expect_error(2 ${out} "cube.vti: this clvr was built without VTK"
+      ${CLVR} render -o ${out} ${SMALL} ${TF} "--set=volume={\"file\": \"${WORK}/cube.vti\"}" --unset camera)
+  endif()
 endif()
 
 if(PART STREQUAL "device")

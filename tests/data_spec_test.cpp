@@ -54,6 +54,18 @@ TEST(DataSpec, FilesAreResolvedAgainstTheSceneFolder)
     const Scene vtk = parseWith("volume", R"({"file": "/abs/v.vtk"})");
     EXPECT_EQ(vtk.volume->kind, VolumeSpec::Kind::Vtk);
     EXPECT_EQ(vtk.volume->file, fs::path("/abs/v.vtk"));
+    for (const char* name : {"a.vti", "a.PVTI", "a.mhd", "a.mha"}) {
+        const Scene v = parseWith("volume", std::string(R"({"file": ")") + name + R"(", "scalar": "rho"})");
+        EXPECT_EQ(v.volume->kind, VolumeSpec::Kind::VtkImage) << name;
+        EXPECT_EQ(v.volume->scalar, "rho");
+    }
+    const Scene npy = parseWith("volume", R"({"file": "a.npy", "spacing": [1, 2, 3]})");
+    EXPECT_EQ(npy.volume->kind, VolumeSpec::Kind::Npy);
+    EXPECT_EQ(npy.volume->raw.spacing, glm::dvec3(1, 2, 3));
+    EXPECT_EQ(npy.volume->raw.origin, glm::dvec3(0.0));
+    EXPECT_EQ(errorOf("volume", R"({"file": "a.vti", "spacing": [1, 1, 1]})"),
+              "volume: unknown key \"spacing\" for a .vti file (allowed: file, scalar)");
+    EXPECT_EQ(parseWith("mesh", R"({"file": "m.pvtu"})").mesh->kind, MeshSpec::Kind::File);
 }
 
 TEST(DataSpec, RawLayoutHoldsWhatTheSceneSays)
@@ -88,7 +100,7 @@ TEST(DataSpec, MalformedVolumeFailsInParse)
     EXPECT_EQ(errorOf("volume", R"({"file": "a.nrrd", "dims2": 1})"),
               "volume: unknown key \"dims2\" for a .nrrd file (allowed: file)");
     EXPECT_EQ(errorOf("volume", R"({"file": "a.png"})"),
-              "/no/such/scenes/a.png: unknown volume format \".png\" (.nrrd, .nhdr, .vtk, or .raw / any file with \"dims\")");
+              "/no/such/scenes/a.png: unknown volume format \".png\" (.nrrd, .nhdr, .vtk, .vti, .pvti, .mhd, .mha, .npy, or .raw / any file with \"dims\")");
 }
 
 TEST(DataSpec, MeshFileAndPlot3d)
@@ -130,7 +142,7 @@ TEST(DataSpec, MalformedMeshFailsInParse)
     EXPECT_EQ(errorOf("mesh", R"({"file": "xyz.bin"})"),
               "scene: mesh.file /no/such/scenes/xyz.bin looks like a PLOT3D grid: mesh.q_file is missing");
     EXPECT_EQ(errorOf("mesh", R"({"file": "a.obj"})"),
-              "/no/such/scenes/a.obj: unknown mesh format \".obj\" (.node, .ele, .vtk, .off, or PLOT3D with q_file)");
+              "/no/such/scenes/a.obj: unknown mesh format \".obj\" (.node, .ele, .vtk, .vtu, .pvtu, .off, or PLOT3D with q_file)");
     EXPECT_EQ(errorOf("mesh", R"({"surface": "t.off", "max_volume": 0})"),
               "scene: mesh.max_volume must be a positive number, got 0");
     EXPECT_EQ(errorOf("mesh", R"({"surface": "t.off", "file": "a.vtk"})"),

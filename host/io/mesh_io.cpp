@@ -3,7 +3,9 @@
 // every count from a header is compared with what the file can hold before anything is allocated.
 #include "host/io/mesh_io.h"
 
+#include "host/io/cell_split.h"
 #include "host/io/generators.h"
+#include "host/io/vtk_xml_io.h"
 
 #include "host/runtime/errors.h"
 #include "host/runtime/file_io.h"
@@ -101,37 +103,6 @@ std::uint64_t checkedCount(const std::string& where, const std::string& what, lo
         throw InputError(where + ": " + what + " count " + std::to_string(v) +
                          " is more than the file can hold (truncated or a wrong count)");
     return v;
-}
-
-// The 6-tetrahedron split of a hexahedron with VTK's vertex order (0-3 bottom, 4-7 top, 0-4 an edge):
-// the six tetrahedra around the diagonal 0-6. Applied with the same orientation in every cell of a
-// structured grid, neighboring cells choose the same diagonal on their shared face.
-constexpr int kHexSplit[6][4] = {{0, 1, 2, 6}, {0, 2, 3, 6}, {0, 3, 7, 6}, {0, 7, 4, 6}, {0, 4, 5, 6}, {0, 5, 1, 6}};
-
-void splitHex(const std::array<std::uint32_t, 8>& v, std::vector<glm::uvec4>& tets)
-{
-    for (const auto& t : kHexSplit)
-        tets.emplace_back(v[t[0]], v[t[1]], v[t[2]], v[t[3]]);
-}
-
-// Wedge (VTK order: triangle 0 1 2, triangle 3 4 5, edges 0-3 1-4 2-5) into 3 tetrahedra by Dompierre
-// et al.'s rule: every quadrilateral face is cut through its smallest point index, so neighbors agree.
-void splitWedge(const std::array<std::uint32_t, 6>& w, std::vector<glm::uvec4>& tets)
-{
-    static constexpr int kRot[6][6] = {{0, 1, 2, 3, 4, 5}, {1, 2, 0, 4, 5, 3}, {2, 0, 1, 5, 3, 4},
-                                       {3, 5, 4, 0, 2, 1}, {4, 3, 5, 1, 0, 2}, {5, 4, 3, 2, 1, 0}};
-    const int m = static_cast<int>(std::min_element(w.begin(), w.end()) - w.begin());
-    std::array<std::uint32_t, 6> v;
-    for (int i = 0; i < 6; ++i)
-        v[i] = w[kRot[m][i]];
-    if (std::min(v[1], v[5]) < std::min(v[2], v[4])) {
-        tets.emplace_back(v[0], v[1], v[2], v[5]);
-        tets.emplace_back(v[0], v[1], v[5], v[4]);
-    } else {
-        tets.emplace_back(v[0], v[1], v[2], v[4]);
-        tets.emplace_back(v[0], v[4], v[2], v[5]);
-    }
-    tets.emplace_back(v[0], v[4], v[5], v[3]);
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -1064,6 +1035,8 @@ TetMesh readMeshFile(const MeshSpec& spec)
         return readVtkUnstructured(spec.file, spec.scalar);
     if (ext == ".off")
         return readOffTet(spec.file, spec.scalar);
+    if (ext == ".vtu" || ext == ".pvtu")
+        return readVtkXmlUnstructured(spec.file, spec.scalar);
     throw InternalError("loadMesh: mesh file " + spec.file.string() + " has an extension parseMeshSpec rejects");
 }
 

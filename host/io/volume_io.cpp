@@ -6,6 +6,7 @@
 #include "host/runtime/errors.h"
 #include "host/runtime/file_io.h"
 #include "host/io/generators.h"
+#include "host/io/vtk_xml_io.h"
 
 #include <nlohmann/json.hpp>
 #include <zlib.h>
@@ -911,6 +912,143 @@ Volume readRaw(const fs::path& path, const RawLayout& layout)
     return v;
 }
 
+namespace {
+
+// The header of a .npy file (numpy's format, versions 1 to 3): the dict
+// "{'descr': '<u2', 'fortran_order': False, 'shape': (64, 64, 93), }" after the magic, version and length.
+struct NpyHeader {
+    ScalarType type = ScalarType::UInt8;
+    Endian endian = Endian::Little;
+    bool fortranOrder = false;
+    std::vector<long long> shape;
+    std::uint64_t dataOffset = 0;
+};
+
+NpyHeader readNpyHeader(const fs::path& path)
+{
+    const std::string source = path.string();
+    const std::uint64_t size = fileSize(path);
+    std::ifstream in = openBinary(path);
+    unsigned char pre[12] = {};
+    in.read(reinterpret_cast<char*>(pre), static_cast<std::streamsize>(std::min<std::uint64_t>(size, 12)));
+    if (size < 10 || std::memcmp(pre, "\x93NUMPY", 6) != 0)
+        throw InputError(source + ": not a .npy file (no \\x93NUMPY magic at its start)");
+    const int major = pre[6];
+    if (major < 1 || major > 3)
+        throw InputError(source + ": .npy format version " + std::to_string(major) + " (clvr reads versions 1 to 3)");
+    std::uint64_t headerLen = 0, start = 0;
+    if (major == 1) {
+        headerLen = pre[8] | (std::uint64_t(pre[9]) << 8);
+        start = 10;
+    } else {
+        if (size < 12)
+            throw InputError(source + ": .npy header is truncated");
+        headerLen = pre[8] | (std::uint64_t(pre[9]) << 8) | (std::uint64_t(pre[10]) << 16) | (std::uint64_t(pre[11]) << 24);
+        start = 12;
+    }
+    if (headerLen > 65536 || start + headerLen > size)
+        throw InputError(source + ": .npy header says " + std::to_string(headerLen) + " bytes, the file has " +
+                         std::to_string(size - start) + " after the preamble");
+    std::string dict(static_cast<std::size_t>(headerLen), '\0');
+    readExactly(in, path, start, dict.data(), headerLen);
+
+    NpyHeader h;
+    h.dataOffset = start + headerLen;
+    // The value after 'key': in the dict, as text up to the next ',' (or ')' for the shape tuple).
+    const auto value = [&](const std::string& key) -> std::string {
+        const std::size_t k = dict.find("'" + key + "'");
+        if (k == std::string::npos)
+            throw InputError(source + ": .npy header has no '" + key + "': " + shown(dict));
+        std::size_t c = dict.find(':', k);
+        if (c == std::string::npos)
+            throw InputError(source + ": .npy header is malformed at '" + key + "': " + shown(dict));
+        ++c;
+        while (c < dict.size() && std::isspace(static_cast<unsigned char>(dict[c])))
+            ++c;
+        if (c < dict.size() && dict[c] == '(') {
+            const std::size_t e = dict.find(')', c);
+            if (e == std::string::npos)
+                throw InputError(source + ": .npy header's '" + key + "' tuple is not closed: " + shown(dict));
+            return dict.substr(c + 1, e - c - 1);
+        }
+        std::size_t e = c;
+        while (e < dict.size() && dict[e] != ',' && dict[e] != '}')
+            ++e;
+        return trim(dict.substr(c, e - c));
+    };
+    std::string descr = value("descr");
+    if (descr.size() < 2 || (descr.front() != '\'' && descr.front() != '"') || descr.back() != descr.front())
+        throw InputError(source + ": .npy 'descr' is " + shown(descr) + ", not a simple type such as '<u2'");
+    descr = descr.substr(1, descr.size() - 2);
+    static const std::array<std::pair<const char*, ScalarType>, 8> kTypes{{
+        {"u1", ScalarType::UInt8},   {"i1", ScalarType::Int8},    {"u2", ScalarType::UInt16}, {"i2", ScalarType::Int16},
+        {"u4", ScalarType::UInt32},  {"i4", ScalarType::Int32},   {"f4", ScalarType::Float32}, {"f8", ScalarType::Float64},
+    }};
+    const auto known = std::find_if(kTypes.begin(), kTypes.end(),
+                                    [&](const auto& t) { return descr.size() == 3 && descr.substr(1) == t.first; });
+    if (known == kTypes.end() || (descr[0] != '<' && descr[0] != '>' && descr[0] != '|' && descr[0] != '='))
+        throw InputError(source + ": .npy dtype " + shown(descr) +
+                         " (clvr reads uint8, int8, uint16, int16, uint32, int32, float32 and float64)");
+    h.type = known->second;
+    h.endian = descr[0] == '>' ? Endian::Big : descr[0] == '=' && std::endian::native == std::endian::big ? Endian::Big
+                                                                                                          : Endian::Little;
+    const std::string order = value("fortran_order");
+    if (order != "True" && order != "False")
+        throw InputError(source + ": .npy 'fortran_order' is " + shown(order) + ", not True or False");
+    h.fortranOrder = order == "True";
+    for (const std::string& item : [&] {
+             std::string t = value("shape");
+             std::replace(t.begin(), t.end(), ',', ' ');
+             return splitWhitespace(t);
+         }()) {
+        const std::optional<long long> n = parseInteger(item);
+        if (!n)
+            throw InputError(source + ": .npy shape entry " + shown(item) + " is not an integer");
+        h.shape.push_back(*n);
+    }
+    if (h.shape.size() != 3)
+        throw InputError(source + ": .npy array has " + std::to_string(h.shape.size()) +
+                         " dimensions; clvr reads 3-D arrays indexed [x, y, z]");
+    return h;
+}
+
+}  // namespace
+
+Volume readNpy(const fs::path& path, const glm::dvec3& spacing, const glm::dvec3& origin)
+{
+    const NpyHeader h = readNpyHeader(path);
+    checkedVoxelCount(path.string(), h.shape);
+    RawLayout layout;
+    layout.type = h.type;
+    layout.endian = h.endian;
+    layout.spacing = spacing;
+    layout.origin = origin;
+    layout.headerBytes = h.dataOffset;
+    const glm::ivec3 dims(static_cast<int>(h.shape[0]), static_cast<int>(h.shape[1]), static_cast<int>(h.shape[2]));
+    if (h.fortranOrder) {  // x fastest in memory: clvr's own layout
+        layout.dims = dims;
+        return readRaw(path, layout);
+    }
+    // C order: z fastest. Read as a raw grid with the axes reversed, then transpose to x fastest.
+    layout.dims = glm::ivec3(dims.z, dims.y, dims.x);
+    Volume reversed = readRaw(path, layout);
+    Volume v;
+    v.source = reversed.source;
+    v.dims = dims;
+    v.spacing = spacing;
+    v.origin = origin;
+    v.values.resize(reversed.values.size());
+    const std::size_t nx = static_cast<std::size_t>(dims.x), ny = static_cast<std::size_t>(dims.y),
+                      nz = static_cast<std::size_t>(dims.z);
+    std::size_t src = 0;
+    for (std::size_t x = 0; x < nx; ++x)
+        for (std::size_t y = 0; y < ny; ++y)
+            for (std::size_t z = 0; z < nz; ++z)
+                v.values[(z * ny + y) * nx + x] = reversed.values[src++];
+    v.validate();
+    return v;
+}
+
 Volume readVtkStructuredPoints(const fs::path& path)
 {
     const std::string source = path.string();
@@ -1092,8 +1230,102 @@ Volume loadVolume(const VolumeSpec& spec)
     case VolumeSpec::Kind::Nrrd: return readNrrd(spec.file);
     case VolumeSpec::Kind::Vtk: return readVtkStructuredPoints(spec.file);
     case VolumeSpec::Kind::Raw: return readRaw(spec.file, spec.raw);
+    case VolumeSpec::Kind::Npy: return readNpy(spec.file, spec.raw.spacing, spec.raw.origin);
+    case VolumeSpec::Kind::VtkImage: return readVtkImage(spec.file, spec.scalar);
     }
     throw InternalError("loadVolume: unknown VolumeSpec::Kind " + std::to_string(static_cast<int>(spec.kind)));
+}
+
+namespace {
+
+// A raw layout's grid points [lo, hi], read row by row (a slab at once where the region spans whole rows
+// and planes). The file is checked as readRaw checks it.
+Volume readRawRegion(const fs::path& path, const RawLayout& layout, const GridRegion& region)
+{
+    const std::string source = path.string();
+    const std::vector<long long> sizes{layout.dims.x, layout.dims.y, layout.dims.z};
+    checkedVoxelCount(source, sizes, false);
+    const std::size_t elem = scalarSize(layout.type);
+    const std::uint64_t nx = static_cast<std::uint64_t>(layout.dims.x), ny = static_cast<std::uint64_t>(layout.dims.y);
+    const std::uint64_t bytes = nx * ny * static_cast<std::uint64_t>(layout.dims.z) * elem;
+    const std::uint64_t size = fileSize(path);
+    if (layout.headerBytes > kMaxVoxels * 8 || size != layout.headerBytes + bytes)
+        throw InputError(source + ": layout says " + dimsText(sizes) + " x " + std::to_string(elem) + " bytes" +
+                         (layout.headerBytes ? " + " + std::to_string(layout.headerBytes) + " header bytes" : "") +
+                         " = " + std::to_string(layout.headerBytes + bytes) + " bytes, file has " +
+                         std::to_string(size) + " bytes");
+    const glm::ivec3 n = region.dims();
+    const std::uint64_t count = static_cast<std::uint64_t>(n.x) * static_cast<std::uint64_t>(n.y) * static_cast<std::uint64_t>(n.z);
+    checkHostMemoryForVoxels(source, count);
+    Volume v;
+    v.source = source;
+    v.dims = n;
+    v.spacing = layout.spacing;
+    v.origin = layout.origin + glm::dvec3(region.lo) * layout.spacing;
+    v.values.resize(static_cast<std::size_t>(count));
+    std::ifstream in = openBinary(path);
+    // One read per run of contiguous samples: a whole plane's rows when the region spans x and y.
+    const bool wholeRows = n.x == layout.dims.x, wholePlanes = wholeRows && n.y == layout.dims.y;
+    const std::uint64_t run = wholePlanes ? static_cast<std::uint64_t>(n.x) * static_cast<std::uint64_t>(n.y)
+                                          : static_cast<std::uint64_t>(n.x);
+    std::vector<unsigned char> buffer(static_cast<std::size_t>(run * elem));
+    float* dst = v.values.data();
+    for (int k = region.lo.z; k <= region.hi.z; ++k)
+        for (int j = region.lo.y; j <= region.hi.y; j += wholePlanes ? n.y : 1) {
+            const std::uint64_t first = (static_cast<std::uint64_t>(k) * ny + static_cast<std::uint64_t>(j)) * nx +
+                                        static_cast<std::uint64_t>(region.lo.x);
+            readExactly(in, path, layout.headerBytes + first * elem, reinterpret_cast<char*>(buffer.data()), run * elem);
+            convertSamples(source, buffer.data(), static_cast<std::size_t>(run), layout.type, layout.endian, dst,
+                           first, layout.dims);
+            dst += run;
+        }
+    v.validate();
+    return v;
+}
+
+}  // namespace
+
+std::optional<GridHeader> volumeHeader(const VolumeSpec& spec)
+{
+    switch (spec.kind) {
+    case VolumeSpec::Kind::Raw: return GridHeader{spec.raw.dims, spec.raw.spacing, spec.raw.origin};
+    case VolumeSpec::Kind::Npy: {
+        const NpyHeader h = readNpyHeader(spec.file);
+        if (!h.fortranOrder)
+            return std::nullopt;
+        checkedVoxelCount(spec.file.string(), h.shape, false);
+        return GridHeader{glm::ivec3(static_cast<int>(h.shape[0]), static_cast<int>(h.shape[1]), static_cast<int>(h.shape[2])),
+                          spec.raw.spacing, spec.raw.origin};
+    }
+    case VolumeSpec::Kind::VtkImage: return readVtkImageHeader(spec.file);
+    default: return std::nullopt;
+    }
+}
+
+Volume loadVolumeRegion(const VolumeSpec& spec, const GridRegion& region)
+{
+    const std::optional<GridHeader> header = volumeHeader(spec);
+    if (!header)
+        throw InternalError("loadVolumeRegion: " + spec.file.string() + " cannot be read by regions");
+    if (glm::any(glm::lessThan(region.lo, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(region.hi, header->dims)) ||
+        glm::any(glm::lessThan(region.hi, region.lo)))
+        throw InternalError("loadVolumeRegion: a region outside the grid of " + spec.file.string());
+    switch (spec.kind) {
+    case VolumeSpec::Kind::Raw: return readRawRegion(spec.file, spec.raw, region);
+    case VolumeSpec::Kind::Npy: {
+        const NpyHeader h = readNpyHeader(spec.file);
+        RawLayout layout;
+        layout.dims = header->dims;
+        layout.type = h.type;
+        layout.endian = h.endian;
+        layout.spacing = spec.raw.spacing;
+        layout.origin = spec.raw.origin;
+        layout.headerBytes = h.dataOffset;
+        return readRawRegion(spec.file, layout, region);
+    }
+    case VolumeSpec::Kind::VtkImage: return readVtkImage(spec.file, spec.scalar, region);
+    default: throw InternalError("loadVolumeRegion: unreachable");
+    }
 }
 
 Volume loadVolume(const nlohmann::json& spec, const fs::path& baseDir)

@@ -208,10 +208,30 @@ VolumeSpec parseVolumeSpec(const json& spec, const fs::path& baseDir)
     const fs::path file = jsonString(spec, "file");
     v.file = file.is_absolute() ? file : baseDir / file;
     const std::string ext = asciiLower(file.extension().string());
-    const bool selfDescribing = ext == ".nrrd" || ext == ".nhdr" || ext == ".vtk";
+    const bool vtkImage = ext == ".vti" || ext == ".pvti" || ext == ".mhd" || ext == ".mha";
+    const bool selfDescribing = ext == ".nrrd" || ext == ".nhdr" || ext == ".vtk" || ext == ".npy" || vtkImage;
     if (!selfDescribing && (spec.contains("dims") || ext == ".raw")) {
         v.kind = VolumeSpec::Kind::Raw;
         v.raw = parseRawLayout(spec);
+        return v;
+    }
+    if (ext == ".npy") {  // an array without geometry: spacing and origin from the scene
+        checkKeys(spec, {"file", "spacing", "origin"}, "a .npy file");
+        v.kind = VolumeSpec::Kind::Npy;
+        if (spec.contains("spacing"))
+            v.raw.spacing = volumeVec3(spec, "spacing");
+        if (spec.contains("origin"))
+            v.raw.origin = volumeVec3(spec, "origin");
+        for (int a = 0; a < 3; ++a)
+            if (!(v.raw.spacing[a] > 0.0) || !std::isfinite(v.raw.spacing[a]) || !std::isfinite(v.raw.origin[a]))
+                badVolumeKey("spacing", "must be finite and > 0, with a finite origin");
+        return v;
+    }
+    if (vtkImage) {
+        checkKeys(spec, {"file", "scalar"}, "a " + ext + " file");
+        v.kind = VolumeSpec::Kind::VtkImage;
+        if (spec.contains("scalar"))
+            v.scalar = jsonString(spec, "scalar");
         return v;
     }
     checkKeys(spec, {"file"}, ext.empty() ? "a file" : "a " + ext + " file");
@@ -221,7 +241,7 @@ VolumeSpec parseVolumeSpec(const json& spec, const fs::path& baseDir)
         v.kind = VolumeSpec::Kind::Vtk;
     else
         throw InputError(v.file.string() + ": unknown volume format " + shown(ext, 60) +
-                         " (.nrrd, .nhdr, .vtk, or .raw / any file with \"dims\")");
+                         " (.nrrd, .nhdr, .vtk, .vti, .pvti, .mhd, .mha, .npy, or .raw / any file with \"dims\")");
     return v;
 }
 
@@ -275,9 +295,9 @@ MeshSpec parseMeshSpec(const json& spec, const fs::path& baseDir)
     const std::string ext = asciiLower(m.file.extension().string());
     if (ext == ".bin" || ext == ".xyz" || ext == ".x")
         throw InputError("scene: mesh.file " + m.file.string() + " looks like a PLOT3D grid: mesh.q_file is missing");
-    if (ext != ".node" && ext != ".ele" && ext != ".vtk" && ext != ".off")
+    if (ext != ".node" && ext != ".ele" && ext != ".vtk" && ext != ".off" && ext != ".vtu" && ext != ".pvtu")
         throw InputError(m.file.string() + ": unknown mesh format " + shown(ext, 40) +
-                         " (.node, .ele, .vtk, .off, or PLOT3D with q_file)");
+                         " (.node, .ele, .vtk, .vtu, .pvtu, .off, or PLOT3D with q_file)");
     return m;
 }
 

@@ -29,12 +29,15 @@ struct RawLayout {
 
 // The scene's "volume": a generator, or a file in one of the formats host/io/volume_io.h reads.
 struct VolumeSpec {
-    enum class Kind { Generator, Nrrd, Vtk, Raw };
+    // Vtk: legacy STRUCTURED_POINTS; VtkImage: .vti, .pvti, .mhd, .mha through VTK's readers.
+    enum class Kind { Generator, Nrrd, Vtk, Raw, Npy, VtkImage };
     Kind kind = Kind::Generator;
     std::string generator;        // Kind::Generator: its name (host/io/generators.h checks it)
     glm::ivec3 dims{0};           // Kind::Generator: grid points per axis
     std::filesystem::path file;   // the file kinds: resolved against the scene's folder
-    RawLayout raw;                // Kind::Raw: the layout "dims", "type", "endian", ... give
+    RawLayout raw;                // Kind::Raw: the layout "dims", "type", "endian", ... give;
+                                  // Kind::Npy: only its spacing and origin (the file says the rest)
+    std::string scalar;           // Kind::VtkImage: the point array's name; empty: the active scalars
     bool operator==(const VolumeSpec&) const = default;
 };
 

@@ -40,6 +40,19 @@ struct GridPart {
     glm::vec3 ownHi(const glm::ivec3& dims) const;
 };
 
+// A box of a grid's points, [lo, hi] inclusive per axis (a sort-last rank's part, with its ghost layers).
+struct GridRegion {
+    glm::ivec3 lo{0}, hi{0};
+    glm::ivec3 dims() const { return hi - lo + 1; }
+};
+
+// What a volume file's header says of its grid, before any value is read.
+struct GridHeader {
+    glm::ivec3 dims{0};
+    glm::dvec3 spacing{1.0};
+    glm::dvec3 origin{0.0};
+};
+
 struct Volume {
     glm::ivec3 dims{0};
     glm::dvec3 spacing{1.0};

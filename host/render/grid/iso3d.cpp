@@ -5,6 +5,7 @@
 
 #include "host/render/grid/slice3d.h"  // buildBrickGrid, emptySpaceRadii: slice3d's bricks
 
+#include "host/render/camera_args.h"
 #include "host/render/scaffold.h"
 #include "host/runtime/embedded_kernels.h"
 #include "host/runtime/errors.h"
