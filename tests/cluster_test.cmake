@@ -135,6 +135,61 @@ if(PART STREQUAL "volume")
   endif()
 endif()
 
+# A blob on a 24x20x16 grid as a .pvti of two .vti pieces (ascii, cut at z = 8, sharing that layer): under
+# sort-last each rank reads only the pieces its part meets (host/io/vtk_xml_io.h), and the image is one
+# process's.
+function(write_blob_pvti dir)
+  foreach(piece 0 1)
+    if(piece EQUAL 0)
+      set(z0 0)
+      set(z1 8)
+    else()
+      set(z0 8)
+      set(z1 15)
+    endif()
+    set(values "")
+    foreach(k RANGE ${z0} ${z1})
+      foreach(j RANGE 19)
+        foreach(i RANGE 23)
+          math(EXPR v "200 - ((${i} - 11) * (${i} - 11) + (${j} - 9) * (${j} - 9) + 2 * (${k} - 7) * (${k} - 7))")
+          if(v LESS 0)
+            set(v 0)
+          endif()
+          string(APPEND values "${v} ")
+        endforeach()
+      endforeach()
+    endforeach()
+    file(WRITE "${dir}/blob_${piece}.vti" "<?xml version=\"1.0\"?>
+<VTKFile type=\"ImageData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">
+<ImageData WholeExtent=\"0 23 0 19 ${z0} ${z1}\" Origin=\"-1 -0.8 -0.6\" Spacing=\"0.08 0.08 0.08\">
+<Piece Extent=\"0 23 0 19 ${z0} ${z1}\"><PointData Scalars=\"s\">
+<DataArray type=\"Int16\" Name=\"s\" format=\"ascii\">${values}</DataArray>
+</PointData></Piece></ImageData></VTKFile>
+")
+  endforeach()
+  file(WRITE "${dir}/blob.pvti" "<?xml version=\"1.0\"?>
+<VTKFile type=\"PImageData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">
+<PImageData WholeExtent=\"0 23 0 19 0 15\" GhostLevel=\"0\" Origin=\"-1 -0.8 -0.6\" Spacing=\"0.08 0.08 0.08\">
+<PPointData Scalars=\"s\"><PDataArray type=\"Int16\" Name=\"s\"/></PPointData>
+<Piece Extent=\"0 23 0 19 0 8\" Source=\"blob_0.vti\"/>
+<Piece Extent=\"0 23 0 19 8 15\" Source=\"blob_1.vti\"/>
+</PImageData></VTKFile>
+")
+endfunction()
+
+if(PART STREQUAL "volume" AND VTK)
+  write_blob_pvti(${WORK})
+  set(BLOB ${SRC}/data/scenes/default.json --set image={"width":64,"height":64,"background":[0.1,0.2,0.3]}
+      "--set=volume={\"file\": \"${WORK}/blob.pvti\"}" --unset camera
+      "--set=transfer_function={\"points\": [[0, 0,0,0, 0], [100, 0.2,0.4,1, 2], [200, 1,0.8,0.3, 8]]}")
+  sort_last(blob "2;3;4" ${BLOB})
+  # Not an empty image on both sides: clvr notes an empty one on stderr.
+  execute_process(COMMAND ${CLVR} render ${BLOB} -o ${WORK}/blob-check.png ERROR_VARIABLE err RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0 OR err MATCHES "image is empty")
+    message(FATAL_ERROR "the blob's image is empty or failed (exit ${rc}): ${err}")
+  endif()
+endif()
+
 if(PART STREQUAL "views")
   sort_last(volume-parallel "2;4" ${VOLUME} --set camera.projection=\"parallel\" --set camera.parallel_scale=1.3)
   sort_last(volume-inside "3;6" ${VOLUME} --set camera.position=[0.2,0.3,0.6] --set camera.view_angle=80)

@@ -5,10 +5,14 @@
 #include "host/cluster/partition.h"
 
 #include "host/io/generators.h"
+#include "host/io/volume_io.h"
+#include "host/model/data_spec.h"
 #include "host/render/renderer.h"
 #include "host/runtime/errors.h"
 #include "tests/support/mesh_fixtures.h"
 #include "tests/support/test_util.h"
+
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -165,6 +169,66 @@ double sortLastDifference(const Scene& scene, const std::function<Image4f(const 
 // Float tolerance of the sort-last composite against the whole image: the same samples (slice3d) or the
 // same segments cut at the boxes (harc), blended in another association. 8-bit: far below 1/255.
 constexpr double kSortLastFloatTolerance = 2e-5;
+
+// What a rank reads by itself (loadVolumeRegion of its gridPartRegion, placed by gridPartPlacement) is what
+// cutGridPart cuts from the whole: values, geometry and placement, for every part of 1..8, with and without
+// the ghost layer; for a raw file of every sample type and a Fortran-order .npy.
+TEST(Partition, PartReadByItselfEqualsPartCutFromTheWhole)
+{
+    test::TempDir dir;
+    const glm::ivec3 dims(13, 9, 11);
+    test::Rng rng(7);
+    std::string raw16, rawF;
+    for (int i = 0; i < dims.x * dims.y * dims.z; ++i) {
+        const auto v = static_cast<std::uint16_t>(rng.integer(0, 65535));
+        raw16.append(reinterpret_cast<const char*>(&v), 2);
+        const float f = static_cast<float>(rng.uniform(-1.0, 1.0));
+        rawF.append(reinterpret_cast<const char*>(&f), 4);
+    }
+    test::writeFile(dir / "v16.raw", raw16);
+    test::writeFile(dir / "vf.raw", rawF);
+    std::string npyHeader = "{'descr': '<u2', 'fortran_order': True, 'shape': (13, 9, 11), }";
+    while ((10 + npyHeader.size() + 1) % 64 != 0)
+        npyHeader += ' ';
+    npyHeader += '\n';
+    test::writeFile(dir / "v.npy", std::string("\x93NUMPY\x01\x00", 8) + static_cast<char>(npyHeader.size()) + '\0' +
+                                       npyHeader + raw16);
+    const std::vector<nlohmann::json> specs = {
+        {{"file", "v16.raw"}, {"dims", {13, 9, 11}}, {"type", "uint16"}, {"endian", "little"}, {"spacing", {0.5, 1, 2}}, {"origin", {1, 2, 3}}},
+        {{"file", "vf.raw"}, {"dims", {13, 9, 11}}, {"type", "float32"}, {"endian", "little"}},
+        {{"file", "v.npy"}, {"spacing", {0.5, 1, 2}}, {"origin", {1, 2, 3}}},
+    };
+    for (const nlohmann::json& json : specs) {
+        SCOPED_TRACE(json.dump());
+        const VolumeSpec spec = parseVolumeSpec(json, dir.path());
+        const Volume whole = loadVolume(spec);
+        const std::optional<GridHeader> header = volumeHeader(spec);
+        ASSERT_TRUE(header);
+        EXPECT_EQ(header->dims, whole.dims);
+        EXPECT_EQ(header->spacing, whole.spacing);
+        EXPECT_EQ(header->origin, whole.origin);
+        for (int n = 1; n <= 8; ++n)
+            for (int ghost = 0; ghost <= 1; ++ghost) {
+                const GridPartition partition = partitionGrid(whole.dims, whole.origin, whole.spacing, n);
+                for (int p = 0; p < n; ++p) {
+                    const Volume cut = cutGridPart(whole, partition, p, ghost);
+                    Volume read = loadVolumeRegion(spec, gridPartRegion(partition, header->dims, p, ghost));
+                    read.part = gridPartPlacement(partition, header->dims, header->origin, p, ghost);
+                    ASSERT_EQ(read.dims, cut.dims) << n << " parts, part " << p;
+                    EXPECT_EQ(read.origin, cut.origin);
+                    EXPECT_EQ(read.spacing, cut.spacing);
+                    EXPECT_EQ(read.values, cut.values) << n << " parts, part " << p;
+                    EXPECT_EQ(read.part->offset, cut.part->offset);
+                    EXPECT_EQ(read.part->ghostLo, cut.part->ghostLo);
+                    EXPECT_EQ(read.part->ghostHi, cut.part->ghostHi);
+                    EXPECT_EQ(read.part->fullDims, cut.part->fullDims);
+                    EXPECT_EQ(read.part->fullOrigin, cut.part->fullOrigin);
+                }
+            }
+    }
+    // Formats that cannot read a region say so (the caller loads them whole).
+    EXPECT_FALSE(volumeHeader(parseVolumeSpec({{"generator", "sphere"}, {"dims", {8, 8, 8}}}, dir.path())));
+}
 
 TEST(SortLast, Slice3dPartsCompositeToTheWholeImage)
 {

@@ -15,6 +15,7 @@
 #include "host/cluster/partition.h"
 #include "host/cluster/world.h"
 #include "host/io/image_io.h"
+#include "host/io/volume_io.h"
 #include "host/model/scene.h"
 #include "host/render/scaffold.h"
 #include "host/runtime/device.h"
@@ -162,21 +163,38 @@ int renderSortLast(const RenderOptions& options, World& world, Job& job)
     double setupMs = 0.0;
     world.agree([&] {
         const auto t0 = std::chrono::steady_clock::now();
-        SceneData data = loadSceneData(job.scene);
-        job.scene.camera = sceneCamera(job.scene, data);  // the whole data's camera, on every rank
-        // Cut out this rank's part (the rest of the data is freed here).
-        if (job.scene.mesh) {
-            const MeshPartition partition = partitionMesh(data.mesh, world.size());
-            data.mesh = cutMeshPart(data.mesh, partition, world.rank());
-            tree = partition.tree;
-            partText = std::to_string(data.mesh.tets.size()) + " tets";
-        } else {
-            const GridPartition partition = partitionGrid(data.volume.dims, data.volume.origin, data.volume.spacing,
-                                                          world.size());
-            data.volume = cutGridPart(data.volume, partition, world.rank(), technique(job.scene.technique).sortLastGhost);
+        // A volume whose format reads by regions (raw, Fortran-order .npy, .vti, .pvti, .mhd): each rank
+        // reads only its part's points, placed as cutGridPart would cut them from the whole.
+        const std::optional<GridHeader> header = job.scene.volume ? volumeHeader(*job.scene.volume) : std::nullopt;
+        SceneData data;
+        if (header) {
+            if (!job.scene.camera)  // the whole grid's camera, on every rank
+                job.scene.camera = fitCamera(header->origin, header->origin + glm::dvec3(header->dims - 1) * header->spacing);
+            const GridPartition partition = partitionGrid(header->dims, header->origin, header->spacing, world.size());
+            const int ghost = technique(job.scene.technique).sortLastGhost;
+            data.volume = loadVolumeRegion(*job.scene.volume, gridPartRegion(partition, header->dims, world.rank(), ghost));
+            data.volume.part = gridPartPlacement(partition, header->dims, header->origin, world.rank(), ghost);
+            data.loadMs = msSince(t0);
             tree = partition.tree;
             const glm::ivec3 n = data.volume.dims;
-            partText = std::to_string(n.x) + "x" + std::to_string(n.y) + "x" + std::to_string(n.z) + " points";
+            partText = std::to_string(n.x) + "x" + std::to_string(n.y) + "x" + std::to_string(n.z) + " points read";
+        } else {
+            // Else every rank loads the whole data and cuts out its part (the rest is freed here).
+            data = loadSceneData(job.scene);
+            job.scene.camera = sceneCamera(job.scene, data);  // the whole data's camera, on every rank
+            if (job.scene.mesh) {
+                const MeshPartition partition = partitionMesh(data.mesh, world.size());
+                data.mesh = cutMeshPart(data.mesh, partition, world.rank());
+                tree = partition.tree;
+                partText = std::to_string(data.mesh.tets.size()) + " tets";
+            } else {
+                const GridPartition partition = partitionGrid(data.volume.dims, data.volume.origin, data.volume.spacing,
+                                                              world.size());
+                data.volume = cutGridPart(data.volume, partition, world.rank(), technique(job.scene.technique).sortLastGhost);
+                tree = partition.tree;
+                const glm::ivec3 n = data.volume.dims;
+                partText = std::to_string(n.x) + "x" + std::to_string(n.y) + "x" + std::to_string(n.z) + " points";
+            }
         }
         Scene partScene = job.scene;
         partScene.image.background = glm::dvec3(0.0);  // premultiplied parts; the background goes on last

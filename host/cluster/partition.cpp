@@ -149,18 +149,32 @@ GridPartition partitionGrid(const glm::ivec3& dims, const glm::dvec3& origin, co
     return out;
 }
 
-Volume cutGridPart(const Volume& volume, const GridPartition& partition, int p, int ghost)
+GridRegion gridPartRegion(const GridPartition& partition, const glm::ivec3& dims, int p, int ghost)
 {
     if (ghost < 0 || ghost > 1)
-        throw InternalError("cutGridPart: a ghost layer of 0 or 1 points");
+        throw InternalError("gridPartRegion: a ghost layer of 0 or 1 points");
     const glm::ivec3 own0 = partition.lo.at(static_cast<std::size_t>(p)), own1 = partition.hi.at(static_cast<std::size_t>(p));
-    const glm::ivec3 lo = glm::max(own0 - ghost, glm::ivec3(0)), hi = glm::min(own1 + ghost, volume.dims - 1);
+    return {glm::max(own0 - ghost, glm::ivec3(0)), glm::min(own1 + ghost, dims - 1)};
+}
+
+GridPart gridPartPlacement(const GridPartition& partition, const glm::ivec3& dims, const glm::dvec3& origin, int p,
+                           int ghost)
+{
+    const GridRegion r = gridPartRegion(partition, dims, p, ghost);
+    const glm::ivec3 own0 = partition.lo.at(static_cast<std::size_t>(p)), own1 = partition.hi.at(static_cast<std::size_t>(p));
+    return GridPart{r.lo, dims, origin, own0 - r.lo, r.hi - own1};
+}
+
+Volume cutGridPart(const Volume& volume, const GridPartition& partition, int p, int ghost)
+{
+    const GridRegion r = gridPartRegion(partition, volume.dims, p, ghost);
+    const glm::ivec3 lo = r.lo, hi = r.hi;
     Volume part;
     part.dims = hi - lo + 1;
     part.spacing = volume.spacing;
     part.origin = volume.origin + glm::dvec3(lo) * volume.spacing;
     part.source = volume.source;
-    part.part = GridPart{lo, volume.dims, volume.origin, own0 - lo, hi - own1};
+    part.part = gridPartPlacement(partition, volume.dims, volume.origin, p, ghost);
     part.values.resize(part.voxelCount());
     std::size_t i = 0;
     for (int k = lo.z; k <= hi.z; ++k)

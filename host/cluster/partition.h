@@ -57,6 +57,14 @@ GridPartition partitionGrid(const glm::ivec3& dims, const glm::dvec3& origin, co
 // gradients their neighbours (TechniqueInfo::sortLastGhost).
 Volume cutGridPart(const Volume& volume, const GridPartition& partition, int p, int ghost = 0);
 
+// The grid points cutGridPart keeps of a grid with `dims` for part p (its own points and the ghost
+// layers), and the GridPart that places a volume holding exactly those points in the whole grid (whose
+// first point is at `origin`). A rank that reads only its part (loadVolumeRegion) reads this region and
+// sets this placement: the same Volume cutGridPart would cut from the whole.
+GridRegion gridPartRegion(const GridPartition& partition, const glm::ivec3& dims, int p, int ghost = 0);
+GridPart gridPartPlacement(const GridPartition& partition, const glm::ivec3& dims, const glm::dvec3& origin, int p,
+                           int ghost = 0);
+
 // A tetrahedral mesh cut into n k-d boxes (part p: [lo[p], hi[p]]) of its bounding box.
 struct MeshPartition {
     KdTree tree;
