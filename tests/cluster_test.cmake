@@ -257,7 +257,17 @@ if(PART STREQUAL "errors")
   expect_job_error(3 "CL_OUT_OF_RESOURCES .injected"
     ${MPI} -np 3 -x CLVR_INJECT_FAULT=launch:1 ${CLVR} render ${SRC}/data/scenes/default.json ${SMALL})
   expect_job_error(2 "iso3d does not render a part"
-    ${MPI} -np 2 ${CLVR} render ${SRC}/data/scenes/engine-iso.json ${SMALL})
+    ${MPI} -np 2 ${CLVR} render ${SRC}/data/scenes/engine-iso.json ${SMALL} --distribution sort-last)
+  # Under the default distribution such a technique renders sort-first, with one note: the image of one process.
+  set(ISO ${SRC}/data/scenes/engine-iso.json --set image.width=64 --set image.height=64)
+  run_ok(${CLVR} render ${ISO} -o ${WORK}/iso-1p.png)
+  execute_process(COMMAND ${MPI} -np 2 ${CLVR} render ${ISO} -o ${WORK}/iso-2.png RESULT_VARIABLE rc ERROR_VARIABLE err)
+  string(REGEX MATCHALL "clvr: note: iso3d does not render a part of the data: sort-first" notes "${err}")
+  list(LENGTH notes count)
+  if(NOT rc EQUAL 0 OR NOT count EQUAL 1)
+    message(FATAL_ERROR "iso3d under mpirun: exit ${rc}, ${count} notes (want 0 and 1):\n${err}")
+  endif()
+  expect_same(${WORK}/iso-1p.png ${WORK}/iso-2.png 0)
   expect_job_error(2 "unknown distribution \"tiles\""
     ${MPI} -np 2 ${CLVR} render ${SRC}/data/scenes/default.json ${SMALL} --distribution tiles)
 endif()

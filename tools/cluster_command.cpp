@@ -57,8 +57,10 @@ std::string rankDevice(const RenderOptions& options, const World& world)
     return std::to_string(gpus[static_cast<std::size_t>(world.nodeRank()) % gpus.size()].index);
 }
 
-// The job's distribution: --distribution, else the scene's, else sort-last (frames with --orbit).
-std::string distributionOf(const RenderOptions& options, const Scene& scene)
+// The job's distribution: --distribution, else the scene's, else frames with --orbit, else sort-last where
+// the technique renders a part of the data and sort-first where it does not (`note` then says so). A
+// sort-last asked for by name is kept: the technique's refusal is the error.
+std::string distributionOf(const RenderOptions& options, const Scene& scene, std::string& note)
 {
     if (!options.distribution.empty()) {
         checkDistribution(options.distribution, "--distribution");
@@ -66,7 +68,14 @@ std::string distributionOf(const RenderOptions& options, const Scene& scene)
     }
     if (!scene.distribution.empty())
         return scene.distribution;
-    return options.orbit > 0 ? "frames" : "sort-last";
+    if (options.orbit > 0)
+        return "frames";
+    if (const TechniqueInfo* t = findTechnique(scene.technique); t && !t->sortLast) {
+        note = "clvr: note: " + t->name + " does not render a part of the data: sort-first (each rank renders image "
+               "rows of the whole data; --distribution to choose)";
+        return "sort-first";
+    }
+    return "sort-last";
 }
 
 struct Job {
@@ -354,6 +363,7 @@ int renderCluster(const RenderOptions& options)
     }
     try {
         Job job;
+        std::string note;
         world.agree([&] {
             if (options.orbit < 0)
                 throw InputError("--orbit: the frame count must be at least 1, got " + std::to_string(options.orbit));
@@ -364,8 +374,10 @@ int renderCluster(const RenderOptions& options)
             job.sceneLabel = useDefault ? "default scene" : options.scene;
             job.scene = useDefault ? defaultScene(options.overrides, options.unsets)
                                    : loadScene(options.scene, options.overrides, options.unsets);
-            job.distribution = distributionOf(options, job.scene);
+            job.distribution = distributionOf(options, job.scene, note);
         });
+        if (world.rank() == 0 && !note.empty())
+            std::cerr << note << std::endl;
         if (job.distribution == "frames")
             return renderFrames(options, world, job);
         if (job.distribution == "sort-first")
