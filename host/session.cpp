@@ -6,6 +6,8 @@
 #include "host/io/mesh_io.h"
 #include "host/io/volume_io.h"
 
+#include <sys/resource.h>
+
 #include <chrono>
 #include <cmath>
 #include <numbers>
@@ -110,6 +112,12 @@ Frame Session::render()
     return frame;
 }
 
+std::uint64_t hostPeakBytes()
+{
+    rusage usage{};  // Linux gives ru_maxrss in kilobytes
+    return ::getrusage(RUSAGE_SELF, &usage) == 0 ? static_cast<std::uint64_t>(usage.ru_maxrss) * 1024 : 0;
+}
+
 nlohmann::json Session::stats(const Frame& frame) const
 {
     nlohmann::json passes = nlohmann::json::array();
@@ -127,6 +135,11 @@ nlohmann::json Session::stats(const Frame& frame) const
         {"passes", passes},
         {"samples", frame.stats.samples},
         {"resident_bytes", renderer_->residentBytes()},
+        // Memory as a figure (issue 37 goal 4): the process's peak resident set so far, and the device
+        // buffers alive now and at most.
+        {"host_peak_bytes", hostPeakBytes()},
+        {"device_bytes", device_->deviceBytes()},
+        {"device_peak_bytes", device_->deviceBytesPeak()},
     };
     if (!isMesh())
         out["voxels"] = data_.volume.voxelCount();

@@ -32,6 +32,10 @@ SceneData loadSceneData(const Scene& scene);
 // data set (Volume::part, TetMesh::part) must be given the whole data's camera.
 Camera sceneCamera(const Scene& scene, const SceneData& data);
 
+// The peak resident memory of this process so far, in bytes (getrusage; 0 where the system does not say):
+// --stats' host_peak_bytes, per rank under MPI.
+std::uint64_t hostPeakBytes();
+
 // One rendered frame: the image and what the frame did. stats.frameMs is the renderer's own time, or
 // the wall time where the renderer reports none; stats.passes the device time of each named launch.
 struct Frame {

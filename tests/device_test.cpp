@@ -28,6 +28,25 @@ TEST(Device, EmbeddedSourcesStartWithLineMarkersAndInlineHeaders)
     EXPECT_NE(it->source.find("#define CLVR_GUARD_1D(n) \\\n    if (get_global_id(0)"), std::string_view::npos);
 }
 
+// Device::deviceBytes counts a buffer in when it is made and out when OpenCL releases it (the last
+// cl::Buffer gone); the peak keeps the most there were.
+TEST(Device, CountsLiveDeviceBytesAndThePeak)
+{
+    clvr::Device& device = clvr::test::device();
+    const std::uint64_t before = device.deviceBytes();
+    {
+        cl::Buffer a = device.buffer("count a", 1000);
+        cl::Buffer b = device.buffer("count b", 3);  // allocated as 4 (no zero-sized buffers)
+        EXPECT_EQ(device.deviceBytes(), before + 1004);
+        cl::Buffer copy = a;  // the same buffer: counted once
+        EXPECT_EQ(device.deviceBytes(), before + 1004);
+        EXPECT_GE(device.deviceBytesPeak(), before + 1004);
+    }
+    device.queue().finish();
+    EXPECT_EQ(device.deviceBytes(), before);
+    EXPECT_GE(device.deviceBytesPeak(), before + 1004);
+}
+
 TEST(Device, FillKernelWritesEveryElementOfAnOddSizedBuffer)
 {
     clvr::Device& device = clvr::test::device();

@@ -251,8 +251,13 @@ int renderSortLast(const RenderOptions& options, World& world, Job& job)
             }
         });
     }
+    // Memory per rank (issue 37 goal 4): each rank's peak resident set and its most device bytes at once.
+    const std::vector<double> hostPeaks = world.gather(static_cast<double>(hostPeakBytes()));
+    const std::vector<double> devicePeaks = world.gather(static_cast<double>(device->deviceBytesPeak()));
     world.agree([&] {
         nlohmann::json stats = frame0Stats;  // rank 0's own part
+        stats["host_peak_bytes_per_rank"] = hostPeaks;
+        stats["device_peak_bytes_per_rank"] = devicePeaks;
         stats["rank0_part"] = partText;
         stats["setup_ms"] = setupMs;
         stats["composite_ms"] = composite0Ms;

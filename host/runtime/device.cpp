@@ -341,6 +341,37 @@ std::vector<PassTime> Device::takePassTimes()
     return out;
 }
 
+namespace {
+
+// Device::deviceBytes(): `bytes` counted in now and out when OpenCL releases the buffer.
+template <typename Count>
+void countBuffer(const cl::Buffer& buffer, std::uint64_t bytes, const std::shared_ptr<Count>& count)
+{
+    struct Release {
+        std::shared_ptr<Count> count;
+        std::uint64_t bytes;
+    };
+    const std::uint64_t live = count->live.fetch_add(bytes) + bytes;
+    std::uint64_t peak = count->peak.load();
+    while (live > peak && !count->peak.compare_exchange_weak(peak, live)) {
+    }
+    auto* release = new Release{count, bytes};
+    const cl_int err = clSetMemObjectDestructorCallback(
+        buffer(),
+        [](cl_mem, void* data) {
+            auto* r = static_cast<Release*>(data);
+            r->count->live.fetch_sub(r->bytes);
+            delete r;
+        },
+        release);
+    if (err != CL_SUCCESS) {  // not counted out then: forget it now rather than leak the record
+        count->live.fetch_sub(bytes);
+        delete release;
+    }
+}
+
+}  // namespace
+
 cl::Buffer Device::buffer(std::string_view what, std::size_t bytes, cl_mem_flags flags, const void* host)
 {
     if (bytes > listing_.maxAllocBytes || bytes > listing_.globalMemBytes)
@@ -357,7 +388,9 @@ cl::Buffer Device::buffer(std::string_view what, std::size_t bytes, cl_mem_flags
         host = padded.data();
     }
     try {
-        return cl::Buffer(context_, flags, std::max(bytes, kMinBytes), const_cast<void*>(host));
+        cl::Buffer buffer(context_, flags, std::max(bytes, kMinBytes), const_cast<void*>(host));
+        countBuffer(buffer, std::max(bytes, kMinBytes), memory_);
+        return buffer;
     } catch (const cl::Error& e) {
         const bool noMemory = e.err() == CL_MEM_OBJECT_ALLOCATION_FAILURE || e.err() == CL_OUT_OF_RESOURCES ||
                               e.err() == CL_OUT_OF_HOST_MEMORY || e.err() == CL_INVALID_BUFFER_SIZE;

@@ -4,7 +4,9 @@
 
 #include <CL/opencl.hpp>
 
+#include <atomic>
 #include <cstddef>
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <optional>
@@ -101,6 +103,11 @@ public:
     cl::Buffer buffer(std::string_view what, std::size_t bytes, cl_mem_flags flags = CL_MEM_READ_WRITE,
                       const void* host = nullptr);
 
+    // Bytes of the buffers buffer() made that are still alive (OpenCL frees a buffer when its last
+    // cl::Buffer goes: a destructor callback counts it out), and the most there were at once.
+    std::uint64_t deviceBytes() const { return memory_->live.load(); }
+    std::uint64_t deviceBytesPeak() const { return memory_->peak.load(); }
+
     template <typename T>
     cl::Buffer upload(std::string_view what, const std::vector<T>& data, cl_mem_flags flags = CL_MEM_READ_ONLY)
     {
@@ -131,6 +138,11 @@ private:
     std::optional<std::uint64_t> loopIterationCap_;
     FaultInjection fault_;
     std::uint64_t launches_ = 0;
+    // Shared with each buffer's destructor callback, which may run after the Device is gone.
+    struct MemoryCount {
+        std::atomic<std::uint64_t> live{0}, peak{0};
+    };
+    std::shared_ptr<MemoryCount> memory_ = std::make_shared<MemoryCount>();
 };
 
 }  // namespace clvr
