@@ -193,7 +193,15 @@ TEST(Partition, PartReadByItselfEqualsPartCutFromTheWhole)
     npyHeader += '\n';
     test::writeFile(dir / "v.npy", std::string("\x93NUMPY\x01\x00", 8) + static_cast<char>(npyHeader.size()) + '\0' +
                                        npyHeader + raw16);
+    // NRRD, raw encoding: attached after its header, and detached with a byte skip and trailing bytes.
+    test::writeFile(dir / "attached.nrrd", "NRRD0004\ntype: uint16\ndimension: 3\nsizes: 13 9 11\nendian: little\n"
+                                           "encoding: raw\nspacings: 0.5 1 2\nspace origin: (1,2,3)\n\n" + raw16);
+    test::writeFile(dir / "skip.data", std::string(7, 'x') + raw16 + "trailing");
+    test::writeFile(dir / "detached.nhdr", "NRRD0004\ntype: uint16\ndimension: 3\nsizes: 13 9 11\nendian: little\n"
+                                           "encoding: raw\nbyte skip: 7\ndata file: skip.data\n");
     const std::vector<nlohmann::json> specs = {
+        {{"file", "attached.nrrd"}},
+        {{"file", "detached.nhdr"}},
         {{"file", "v16.raw"}, {"dims", {13, 9, 11}}, {"type", "uint16"}, {"endian", "little"}, {"spacing", {0.5, 1, 2}}, {"origin", {1, 2, 3}}},
         {{"file", "vf.raw"}, {"dims", {13, 9, 11}}, {"type", "float32"}, {"endian", "little"}},
         {{"file", "v.npy"}, {"spacing", {0.5, 1, 2}}, {"origin", {1, 2, 3}}},
@@ -228,6 +236,11 @@ TEST(Partition, PartReadByItselfEqualsPartCutFromTheWhole)
     }
     // Formats that cannot read a region say so (the caller loads them whole).
     EXPECT_FALSE(volumeHeader(parseVolumeSpec({{"generator", "sphere"}, {"dims", {8, 8, 8}}}, dir.path())));
+    EXPECT_FALSE(volumeHeader(parseVolumeSpec({{"file", test::sharedData("engine/engine.nrrd")}}, dir.path())));  // gzip
+    // A NRRD shorter than its samples is the same one-line error as when read whole.
+    test::writeFile(dir / "short.nrrd", "NRRD0004\ntype: uint16\ndimension: 3\nsizes: 13 9 11\nendian: little\n"
+                                        "encoding: raw\n\n" + raw16.substr(0, 100));
+    EXPECT_THROW(volumeHeader(parseVolumeSpec({{"file", "short.nrrd"}}, dir.path())), InputError);
 }
 
 TEST(SortLast, Slice3dPartsCompositeToTheWholeImage)

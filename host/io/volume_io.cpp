@@ -768,10 +768,12 @@ std::size_t scalarSize(ScalarType type)
     return 1;
 }
 
-Volume readNrrd(const fs::path& path)
+namespace {
+
+// A NRRD header's grid (dims, spacing, origin; no values) and its sample count, every field checked.
+Volume nrrdGeometry(const NrrdHeader& h, std::uint64_t& count)
 {
-    const std::string source = path.string();
-    const NrrdHeader h = readNrrdHeader(path);
+    const std::string source = h.path.string();
     if (!h.dimension)
         throw InputError(source + ": NRRD header is missing the required field \"dimension\"");
     if (!h.sizes)
@@ -787,7 +789,7 @@ Volume readNrrd(const fs::path& path)
         throw InputError(source + ": sizes has " + std::to_string(h.sizes->size()) + " entries for dimension " +
                          std::to_string(dim));
     // Memory is checked once the data is known to be there (readNrrdData): a short file says so first.
-    const std::uint64_t count = checkedVoxelCount(source, *h.sizes, false);
+    count = checkedVoxelCount(source, *h.sizes, false);
     // Dimension 4 is read only as one scalar per grid point with an explicit first axis of size 1.
     const std::size_t skipAxes = dim == 4 ? 1 : 0;
     if (dim == 4 && (*h.sizes)[0] != 1)
@@ -845,6 +847,65 @@ Volume readNrrd(const fs::path& path)
         v.origin = *o;
     }
 
+    return v;
+}
+
+// Where the samples of a raw-encoded NRRD with one data stream (attached, or one detached file) lie: its
+// layout as a raw file (headerBytes: the first sample's byte after line and byte skips). nullopt for other
+// encodings and for several data files. InputError when the file is shorter than the samples.
+std::optional<std::pair<fs::path, RawLayout>> nrrdRawLayout(const NrrdHeader& h)
+{
+    std::uint64_t count = 0;
+    const Volume geometry = nrrdGeometry(h, count);
+    if (*h.encoding != NrrdEncoding::Raw || dataFileCount(h) > 1)
+        return std::nullopt;
+    const fs::path file = dataFileCount(h) == 0 ? h.path : dataFile(h, 0);
+    const std::string source = file.string();
+    const std::uint64_t size = fileSize(file);
+    std::uint64_t pos = dataFileCount(h) == 0 ? h.dataOffset : 0;
+    if (h.lineSkip > 0) {
+        std::ifstream in = openBinary(file);
+        in.seekg(static_cast<std::streamoff>(pos));
+        for (long long l = 0; l < h.lineSkip; ++l) {
+            int c;
+            while ((c = in.get()) != EOF && c != '\n') {
+            }
+            if (c == EOF)
+                throw InputError(source + ": line skip " + std::to_string(h.lineSkip) + " goes past the end of the file");
+        }
+        pos = static_cast<std::uint64_t>(static_cast<std::streamoff>(in.tellg()));
+    }
+    const std::uint64_t bytes = count * scalarSize(*h.type);
+    if (h.byteSkip == -1) {
+        if (size < bytes || size - bytes < pos)
+            throw InputError(source + ": header says " + std::to_string(bytes) + " bytes of samples, file has " +
+                             std::to_string(size > pos ? size - pos : 0) + " after the header");
+        pos = size - bytes;
+    } else {
+        pos += static_cast<std::uint64_t>(h.byteSkip);
+    }
+    if (size < pos || size - pos < bytes)
+        throw InputError(source + ": header says " + std::to_string(bytes) + " bytes of samples, file has " +
+                         std::to_string(size > pos ? size - pos : 0) + " after the header and skips");
+    RawLayout layout;
+    layout.dims = geometry.dims;
+    layout.type = *h.type;
+    layout.endian = h.endian.value_or(Endian::Little);
+    layout.spacing = geometry.spacing;
+    layout.origin = geometry.origin;
+    layout.headerBytes = pos;
+    return std::make_pair(file, layout);
+}
+
+}  // namespace
+
+Volume readNrrd(const fs::path& path)
+{
+    const std::string source = path.string();
+    const NrrdHeader h = readNrrdHeader(path);
+    std::uint64_t count = 0;
+    Volume v = nrrdGeometry(h, count);
+    v.source = source;
     const std::size_t elem = scalarSize(*h.type);
     const std::string sizes = dimsText(*h.sizes) + " x " + std::to_string(elem) + " bytes";
     if (dataFileCount(h) == 0) {
@@ -1239,8 +1300,9 @@ Volume loadVolume(const VolumeSpec& spec)
 namespace {
 
 // A raw layout's grid points [lo, hi], read row by row (a slab at once where the region spans whole rows
-// and planes). The file is checked as readRaw checks it.
-Volume readRawRegion(const fs::path& path, const RawLayout& layout, const GridRegion& region)
+// and planes). The file is checked as readRaw checks it: it must hold exactly the header and the samples,
+// or (`exactSize` false: a NRRD, whose data may be followed by more) at least that.
+Volume readRawRegion(const fs::path& path, const RawLayout& layout, const GridRegion& region, bool exactSize = true)
 {
     const std::string source = path.string();
     const std::vector<long long> sizes{layout.dims.x, layout.dims.y, layout.dims.z};
@@ -1249,7 +1311,7 @@ Volume readRawRegion(const fs::path& path, const RawLayout& layout, const GridRe
     const std::uint64_t nx = static_cast<std::uint64_t>(layout.dims.x), ny = static_cast<std::uint64_t>(layout.dims.y);
     const std::uint64_t bytes = nx * ny * static_cast<std::uint64_t>(layout.dims.z) * elem;
     const std::uint64_t size = fileSize(path);
-    if (layout.headerBytes > kMaxVoxels * 8 || size != layout.headerBytes + bytes)
+    if (layout.headerBytes > kMaxVoxels * 8 || (exactSize ? size != layout.headerBytes + bytes : size < layout.headerBytes + bytes))
         throw InputError(source + ": layout says " + dimsText(sizes) + " x " + std::to_string(elem) + " bytes" +
                          (layout.headerBytes ? " + " + std::to_string(layout.headerBytes) + " header bytes" : "") +
                          " = " + std::to_string(layout.headerBytes + bytes) + " bytes, file has " +
@@ -1298,6 +1360,12 @@ std::optional<GridHeader> volumeHeader(const VolumeSpec& spec)
                           spec.raw.spacing, spec.raw.origin};
     }
     case VolumeSpec::Kind::VtkImage: return readVtkImageHeader(spec.file);
+    case VolumeSpec::Kind::Nrrd: {
+        const auto raw = nrrdRawLayout(readNrrdHeader(spec.file));
+        if (!raw)
+            return std::nullopt;
+        return GridHeader{raw->second.dims, raw->second.spacing, raw->second.origin};
+    }
     default: return std::nullopt;
     }
 }
@@ -1324,6 +1392,12 @@ Volume loadVolumeRegion(const VolumeSpec& spec, const GridRegion& region)
         return readRawRegion(spec.file, layout, region);
     }
     case VolumeSpec::Kind::VtkImage: return readVtkImage(spec.file, spec.scalar, region);
+    case VolumeSpec::Kind::Nrrd: {
+        const auto raw = nrrdRawLayout(readNrrdHeader(spec.file));  // volumeHeader said it is raw
+        Volume v = readRawRegion(raw->first, raw->second, region, false);
+        v.source = spec.file.string();
+        return v;
+    }
     default: throw InternalError("loadVolumeRegion: unreachable");
     }
 }

@@ -31,8 +31,9 @@ inline constexpr std::uint64_t kMaxVoxels = std::uint64_t(1) << 34;
 Volume loadVolume(const VolumeSpec& spec);
 
 // What the spec's header says of its grid, for the kinds loadVolumeRegion reads a part of: raw, .npy in
-// Fortran order, and VTK's formats (.vti, .pvti, .mhd, .mha). nullopt for the others (NRRD, VTK legacy,
-// C-order .npy, generators), which a caller loads whole and cuts. InputError for a bad header.
+// Fortran order, NRRD with raw encoding in one data stream (attached or one detached file), and VTK's
+// formats (.vti, .pvti, .mhd, .mha). nullopt for the others (NRRD gzip, ascii or in several files, VTK
+// legacy, C-order .npy, generators), which a caller loads whole and cuts. InputError for a bad header.
 std::optional<GridHeader> volumeHeader(const VolumeSpec& spec);
 
 // The grid points `region` of the volume `spec` names, read alone: only those rows (raw, .npy) or the
