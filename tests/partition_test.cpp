@@ -225,7 +225,9 @@ TEST(Partition, PartReadByItselfEqualsPartCutFromTheWhole)
                     ASSERT_EQ(read.dims, cut.dims) << n << " parts, part " << p;
                     EXPECT_EQ(read.origin, cut.origin);
                     EXPECT_EQ(read.spacing, cut.spacing);
+                    EXPECT_EQ(read.voxelType, cut.voxelType);
                     EXPECT_EQ(read.values, cut.values) << n << " parts, part " << p;
+                    EXPECT_EQ(read.voxels, cut.voxels) << n << " parts, part " << p;
                     EXPECT_EQ(read.part->offset, cut.part->offset);
                     EXPECT_EQ(read.part->ghostLo, cut.part->ghostLo);
                     EXPECT_EQ(read.part->ghostHi, cut.part->ghostHi);

@@ -356,6 +356,50 @@ TEST(Slice3dRenderer, NativeIntegerVoxelsGiveTheFloat32ImageBitForBit)
     }
 }
 
+// A volume held in its own 1- or 2-byte type on the host (Volume::voxels, as the raw, NRRD, .npy and VTK
+// readers keep integer files) renders the bits of the same values held as float32: uploaded as it is where no
+// value is negative (int8 and int16 as the same bits of uint8 and uint16), else converted to float32.
+TEST(Slice3dRenderer, VolumesHeldInTheirOwnTypeGiveTheFloat32ImageBitForBit)
+{
+    const Volume sphere = generateVolume("sphere", {21, 19, 23});
+    struct Case {
+        VoxelType type;
+        float scale, offset;
+        const char* device;  // the type slice3d's kernel samples
+    };
+    const Case cases[] = {{VoxelType::UInt8, 255.0f, 0.0f, "uint8"},    {VoxelType::Int8, 127.0f, 0.0f, "uint8"},
+                          {VoxelType::Int8, 100.0f, -50.0f, "float32"}, {VoxelType::UInt16, 60000.0f, 0.0f, "uint16"},
+                          {VoxelType::Int16, 30000.0f, 0.0f, "uint16"}, {VoxelType::Int16, 2000.0f, -1000.0f, "float32"}};
+    for (const Case& c : cases) {
+        SCOPED_TRACE(std::string(voxelTypeName(c.type)) + " as " + c.device);
+        Volume f = sphere;
+        for (float& x : f.values)
+            x = std::round(x * c.scale + c.offset);
+        Volume n = f;  // the same values in their own type
+        n.voxelType = c.type;
+        n.values.clear();
+        n.voxels.resize(f.voxelCount() * voxelTypeSize(c.type));
+        for (std::size_t i = 0; i < f.voxelCount(); ++i) {
+            if (voxelTypeSize(c.type) == 1) {
+                n.voxels[i] = static_cast<std::uint8_t>(static_cast<int>(f.values[i]) & 0xff);
+            } else {
+                const auto v = static_cast<std::uint16_t>(static_cast<int>(f.values[i]) & 0xffff);
+                std::memcpy(n.voxels.data() + 2 * i, &v, 2);
+            }
+        }
+        ASSERT_NO_THROW(n.validate());
+        ASSERT_EQ(n.at(10, 9, 11), f.at(10, 9, 11));
+        EXPECT_EQ(n.range(), f.range());
+        const TransferFunction tf({{c.offset, {0, 0, 0}, 0.0}, {c.offset + 0.3 * c.scale, {0.2, 0.4, 1}, 0.0},
+                                   {c.offset + 0.6 * c.scale, {1, 0.5, 0}, 6.0}, {c.offset + c.scale, {1, 1, 1}, 12.0}});
+        const Scene scene = makeScene(perspectiveCamera(), tf, 41, {{"slices", 64}});
+        FrameStats nativeStats, floatStats;
+        const Image4f native = test::renderScene(scene, n, &nativeStats);
+        const Image4f f32 = test::renderScene(scene, f, &floatStats);
+        EXPECT_EQ(nativeStats.extra["voxel_type"], c.device);
+        EXPECT_TRUE(test::sameBits(native, f32));
+    }
+}
 
 // The empty-space tests' scenes: the sphere field (0 outside the unit sphere) and its transfer function with
 // tau 0 below 0.3, Marschner-Lobb's with tau 0 below 0.45, and a perspective camera on the z axis whose center

@@ -54,7 +54,7 @@ double valueAt(int i, int j, int k) { return 1000.0 + i + 17.0 * j + 301.0 * k; 
 void expectVolumeValues(const Volume& v, const glm::ivec3& dims, const glm::ivec3& offset = glm::ivec3(0))
 {
     ASSERT_EQ(v.dims, dims);
-    ASSERT_EQ(v.values.size(), v.voxelCount());
+    ASSERT_NO_THROW(v.validate());  // one storage, of the right size
     for (int k = 0; k < dims.z; ++k)
         for (int j = 0; j < dims.y; ++j)
             for (int i = 0; i < dims.x; ++i)
@@ -310,9 +310,12 @@ TEST(VtkXmlIo, VtiEveryEncodingAndCompressor)
         const Volume v = readVtkImage(path);
         expectVolumeValues(v, {7, 5, 4});
         expectImageGeometry(v);
+        EXPECT_EQ(v.voxelType, VoxelType::UInt16);  // kept in its own type: no float copy
+        EXPECT_EQ(v.valueBytes(), v.voxelCount() * 2);
         // By name: the float array, negated values.
         const Volume other = readVtkImage(path, "other");
         EXPECT_EQ(other.at(3, 2, 1), -valueAt(3, 2, 1));
+        EXPECT_FALSE(other.native());
         // A region: the same values as the same points of the whole.
         const Volume region = readVtkImage(path, "", GridRegion{{1, 2, 1}, {5, 4, 2}});
         expectVolumeValues(region, {5, 3, 2}, {1, 2, 1});

@@ -141,7 +141,8 @@ const Image4d& referenceImage(std::map<std::string, Image4d>& cache, const Scene
                               const Camera& camera, double& ms)
 {
     std::uint64_t hash = 1469598103934665603ull;  // FNV-1a over the values' bits: the volume's identity
-    for (const float v : volume.values) {
+    std::vector<float> scratch;
+    for (const float v : volume.floats(scratch)) {
         std::uint32_t bits;
         std::memcpy(&bits, &v, sizeof bits);
         hash = (hash ^ bits) * 1099511628211ull;

@@ -46,7 +46,8 @@ struct CeilingResult {
 // clvr_tf_eval (the exact piecewise-linear transfer function): (r, g, b, tau). Inline, as the loops need it.
 class CeilingClassifier {
 public:
-    CeilingClassifier(const Volume& volume, const TransferFunction& tf) : volume_(volume)
+    CeilingClassifier(const Volume& volume, const TransferFunction& tf)
+        : volume_(volume), values_(volume.floats(scratch_).data())
     {
         for (const ControlPoint& p : tf.points()) {
             s_.push_back(static_cast<float>(p.s));
@@ -64,7 +65,7 @@ public:
         const int j = std::min(static_cast<int>(g.y), n.y - 2);
         const int k = std::min(static_cast<int>(g.z), n.z - 2);
         const float fx = g.x - i, fy = g.y - j, fz = g.z - k;
-        const float* p = volume_.values.data() + k * nxy + j * nx + i;
+        const float* p = values_ + k * nxy + j * nx + i;
         const float c00 = p[0] + fx * (p[1] - p[0]);
         const float c10 = p[nx] + fx * (p[nx + 1] - p[nx]);
         const float c01 = p[nxy] + fx * (p[nxy + 1] - p[nxy]);
@@ -90,6 +91,8 @@ public:
 
 private:
     const Volume& volume_;
+    std::vector<float> scratch_;    // the values as float where the volume holds native voxels
+    const float* values_;
     std::vector<float> s_;          // control points' s, increasing
     std::vector<glm::vec4> value_;  // their (r, g, b, tau)
 };

@@ -98,7 +98,8 @@ std::uint64_t Iso3dCeiling::renderRow(int y, Image4f& image) const
     const glm::ivec3 n = volume_.dims;
     const glm::vec3 top = gridTop(n);
     const float depth0 = static_cast<float>(plan_.depth(0)), deltaS = static_cast<float>(plan_.deltaS);
-    const float* values = volume_.values.data();
+    std::vector<float> scratch;
+    const float* values = volume_.floats(scratch).data();
     auto onGrid = [&](const glm::vec3& g) {  // kernels/volume_sampling.h's clvr_grid_inside
         return g.x >= 0.0f && g.y >= 0.0f && g.z >= 0.0f && g.x <= static_cast<float>(n.x - 1) &&
                g.y <= static_cast<float>(n.y - 1) && g.z <= static_cast<float>(n.z - 1);

@@ -19,7 +19,7 @@ Volume stackVolume(const Volume& volume, int axis)
     const glm::ivec3 n = volume.dims;
     Volume stack;
     stack.dims = glm::ivec3(n[b], n[c], n[axis]);
-    stack.values.reserve(volume.values.size());
+    stack.values.reserve(volume.voxelCount());
     glm::ivec3 g;
     for (g[axis] = 0; g[axis] < n[axis]; ++g[axis])
         for (g[c] = 0; g[c] < n[c]; ++g[c])

@@ -5,6 +5,7 @@
 #include "host/runtime/errors.h"
 
 #include <algorithm>
+#include <cstring>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -175,13 +176,24 @@ Volume cutGridPart(const Volume& volume, const GridPartition& partition, int p, 
     part.origin = volume.origin + glm::dvec3(lo) * volume.spacing;
     part.source = volume.source;
     part.part = gridPartPlacement(partition, volume.dims, volume.origin, p, ghost);
-    part.values.resize(part.voxelCount());
+    // The rows of the part, in the volume's own storage (float32 or native voxels).
+    part.voxelType = volume.voxelType;
+    const std::size_t size = voxelTypeSize(volume.voxelType);
+    const unsigned char* from = volume.native() ? volume.voxels.data()
+                                                : reinterpret_cast<const unsigned char*>(volume.values.data());
+    unsigned char* to = nullptr;
+    if (part.native()) {
+        part.voxels.resize(part.voxelCount() * size);
+        to = part.voxels.data();
+    } else {
+        part.values.resize(part.voxelCount());
+        to = reinterpret_cast<unsigned char*>(part.values.data());
+    }
     std::size_t i = 0;
     for (int k = lo.z; k <= hi.z; ++k)
         for (int j = lo.y; j <= hi.y; ++j) {
             const std::size_t row = (static_cast<std::size_t>(k) * volume.dims.y + j) * volume.dims.x + lo.x;
-            std::copy_n(volume.values.begin() + static_cast<std::ptrdiff_t>(row), part.dims.x,
-                        part.values.begin() + static_cast<std::ptrdiff_t>(i));
+            std::memcpy(to + i * size, from + row * size, static_cast<std::size_t>(part.dims.x) * size);
             i += static_cast<std::size_t>(part.dims.x);
         }
     return part;

@@ -207,6 +207,27 @@ void convertSamples(const std::string& source, const unsigned char* src, std::si
     }
 }
 
+// The VoxelType a Volume keeps samples of `type` in without a float copy: the 1- and 2-byte integers.
+std::optional<VoxelType> nativeVoxelType(ScalarType type)
+{
+    switch (type) {
+    case ScalarType::UInt8: return VoxelType::UInt8;
+    case ScalarType::Int8: return VoxelType::Int8;
+    case ScalarType::UInt16: return VoxelType::UInt16;
+    case ScalarType::Int16: return VoxelType::Int16;
+    default: return std::nullopt;
+    }
+}
+
+// `count` samples of `size` bytes in place from `endian` to the host's order.
+void toHostOrder(unsigned char* data, std::size_t count, std::size_t size, Endian endian)
+{
+    if (size < 2 || (endian == Endian::Big) == (std::endian::native == std::endian::big))
+        return;
+    for (std::size_t i = 0; i < count; ++i)
+        std::reverse(data + i * size, data + (i + 1) * size);
+}
+
 // Whole-token numbers (ASCII encodings) into floats, with the same NaN and infinity check.
 void storeAsciiValue(const std::string& source, const std::string& token, std::uint64_t index, float* dst)
 {
@@ -850,6 +871,8 @@ Volume nrrdGeometry(const NrrdHeader& h, std::uint64_t& count)
     return v;
 }
 
+Volume readRawRegion(const fs::path& path, const RawLayout& layout, const GridRegion& region, bool exactSize = true);
+
 // Where the samples of a raw-encoded NRRD with one data stream (attached, or one detached file) lie: its
 // layout as a raw file (headerBytes: the first sample's byte after line and byte skips). nullopt for other
 // encodings and for several data files. InputError when the file is shorter than the samples.
@@ -875,18 +898,27 @@ std::optional<std::pair<fs::path, RawLayout>> nrrdRawLayout(const NrrdHeader& h)
         }
         pos = static_cast<std::uint64_t>(static_cast<std::streamoff>(in.tellg()));
     }
-    const std::uint64_t bytes = count * scalarSize(*h.type);
-    if (h.byteSkip == -1) {
+    const std::size_t elem = scalarSize(*h.type);
+    const std::uint64_t bytes = count * elem;
+    const std::uint64_t header = pos;
+    const auto tooShort = [&](std::uint64_t available) {
+        return InputError(source + ": header says " + dimsText(*h.sizes) + " x " + std::to_string(elem) +
+                          " bytes = " + std::to_string(bytes) + " bytes, file has " + std::to_string(available) +
+                          " bytes" +
+                          (header == 0 ? std::string()
+                           : h.byteSkip == 0 && h.lineSkip == 0 ? " after the " + std::to_string(header) + "-byte header"
+                                                                : " after " + std::to_string(header) +
+                                                                      " bytes of header and skips"));
+    };
+    if (h.byteSkip == -1) {  // the data is the last `bytes` of the file
         if (size < bytes || size - bytes < pos)
-            throw InputError(source + ": header says " + std::to_string(bytes) + " bytes of samples, file has " +
-                             std::to_string(size > pos ? size - pos : 0) + " after the header");
+            throw tooShort(size > pos ? size - pos : 0);
         pos = size - bytes;
     } else {
         pos += static_cast<std::uint64_t>(h.byteSkip);
     }
     if (size < pos || size - pos < bytes)
-        throw InputError(source + ": header says " + std::to_string(bytes) + " bytes of samples, file has " +
-                         std::to_string(size > pos ? size - pos : 0) + " after the header and skips");
+        throw tooShort(size > pos ? size - pos : 0);
     RawLayout layout;
     layout.dims = geometry.dims;
     layout.type = *h.type;
@@ -906,6 +938,11 @@ Volume readNrrd(const fs::path& path)
     std::uint64_t count = 0;
     Volume v = nrrdGeometry(h, count);
     v.source = source;
+    if (const auto raw = nrrdRawLayout(h)) {  // one raw stream: read in place, integers in their own type
+        Volume whole = readRawRegion(raw->first, raw->second, GridRegion{glm::ivec3(0), v.dims - 1}, false);
+        whole.source = source;
+        return whole;
+    }
     const std::size_t elem = scalarSize(*h.type);
     const std::string sizes = dimsText(*h.sizes) + " x " + std::to_string(elem) + " bytes";
     if (dataFileCount(h) == 0) {
@@ -959,16 +996,23 @@ Volume readRaw(const fs::path& path, const RawLayout& layout)
                          " = " + std::to_string(layout.headerBytes + bytes) + " bytes, file has " +
                          std::to_string(size) + " bytes");
     std::ifstream in = openBinary(path);
-    std::vector<unsigned char> raw(static_cast<std::size_t>(bytes));
-    readExactly(in, path, layout.headerBytes, reinterpret_cast<char*>(raw.data()), bytes);
     Volume v;
     v.source = source;
     v.dims = layout.dims;
     v.spacing = layout.spacing;
     v.origin = layout.origin;
-    v.values.resize(static_cast<std::size_t>(count));
-    convertSamples(source, raw.data(), static_cast<std::size_t>(count), layout.type, layout.endian, v.values.data(),
-                   0, v.dims);
+    if (const std::optional<VoxelType> native = nativeVoxelType(layout.type)) {  // read straight into place
+        v.voxelType = *native;
+        v.voxels.resize(static_cast<std::size_t>(bytes));
+        readExactly(in, path, layout.headerBytes, reinterpret_cast<char*>(v.voxels.data()), bytes);
+        toHostOrder(v.voxels.data(), static_cast<std::size_t>(count), elem, layout.endian);
+    } else {
+        std::vector<unsigned char> raw(static_cast<std::size_t>(bytes));
+        readExactly(in, path, layout.headerBytes, reinterpret_cast<char*>(raw.data()), bytes);
+        v.values.resize(static_cast<std::size_t>(count));
+        convertSamples(source, raw.data(), static_cast<std::size_t>(count), layout.type, layout.endian,
+                       v.values.data(), 0, v.dims);
+    }
     v.validate();
     return v;
 }
@@ -1098,14 +1142,25 @@ Volume readNpy(const fs::path& path, const glm::dvec3& spacing, const glm::dvec3
     v.dims = dims;
     v.spacing = spacing;
     v.origin = origin;
-    v.values.resize(reversed.values.size());
+    v.voxelType = reversed.voxelType;
+    const std::size_t size = voxelTypeSize(v.voxelType);
+    const unsigned char* from = reversed.native() ? reversed.voxels.data()
+                                                  : reinterpret_cast<const unsigned char*>(reversed.values.data());
+    unsigned char* to = nullptr;
+    if (v.native()) {
+        v.voxels.resize(reversed.voxels.size());
+        to = v.voxels.data();
+    } else {
+        v.values.resize(reversed.values.size());
+        to = reinterpret_cast<unsigned char*>(v.values.data());
+    }
     const std::size_t nx = static_cast<std::size_t>(dims.x), ny = static_cast<std::size_t>(dims.y),
                       nz = static_cast<std::size_t>(dims.z);
     std::size_t src = 0;
     for (std::size_t x = 0; x < nx; ++x)
         for (std::size_t y = 0; y < ny; ++y)
-            for (std::size_t z = 0; z < nz; ++z)
-                v.values[(z * ny + y) * nx + x] = reversed.values[src++];
+            for (std::size_t z = 0; z < nz; ++z, ++src)
+                std::memcpy(to + ((z * ny + y) * nx + x) * size, from + src * size, size);
     v.validate();
     return v;
 }
@@ -1302,7 +1357,7 @@ namespace {
 // A raw layout's grid points [lo, hi], read row by row (a slab at once where the region spans whole rows
 // and planes). The file is checked as readRaw checks it: it must hold exactly the header and the samples,
 // or (`exactSize` false: a NRRD, whose data may be followed by more) at least that.
-Volume readRawRegion(const fs::path& path, const RawLayout& layout, const GridRegion& region, bool exactSize = true)
+Volume readRawRegion(const fs::path& path, const RawLayout& layout, const GridRegion& region, bool exactSize)
 {
     const std::string source = path.string();
     const std::vector<long long> sizes{layout.dims.x, layout.dims.y, layout.dims.z};
@@ -1324,22 +1379,35 @@ Volume readRawRegion(const fs::path& path, const RawLayout& layout, const GridRe
     v.dims = n;
     v.spacing = layout.spacing;
     v.origin = layout.origin + glm::dvec3(region.lo) * layout.spacing;
-    v.values.resize(static_cast<std::size_t>(count));
+    const std::optional<VoxelType> native = nativeVoxelType(layout.type);
+    if (native) {  // 1- and 2-byte integers in their own type, read straight into place
+        v.voxelType = *native;
+        v.voxels.resize(static_cast<std::size_t>(count * elem));
+    } else {
+        v.values.resize(static_cast<std::size_t>(count));
+    }
     std::ifstream in = openBinary(path);
     // One read per run of contiguous samples: a whole plane's rows when the region spans x and y.
     const bool wholeRows = n.x == layout.dims.x, wholePlanes = wholeRows && n.y == layout.dims.y;
     const std::uint64_t run = wholePlanes ? static_cast<std::uint64_t>(n.x) * static_cast<std::uint64_t>(n.y)
                                           : static_cast<std::uint64_t>(n.x);
-    std::vector<unsigned char> buffer(static_cast<std::size_t>(run * elem));
-    float* dst = v.values.data();
+    std::vector<unsigned char> buffer(native ? 0 : static_cast<std::size_t>(run * elem));
+    std::size_t at = 0;  // samples stored so far
     for (int k = region.lo.z; k <= region.hi.z; ++k)
         for (int j = region.lo.y; j <= region.hi.y; j += wholePlanes ? n.y : 1) {
             const std::uint64_t first = (static_cast<std::uint64_t>(k) * ny + static_cast<std::uint64_t>(j)) * nx +
                                         static_cast<std::uint64_t>(region.lo.x);
-            readExactly(in, path, layout.headerBytes + first * elem, reinterpret_cast<char*>(buffer.data()), run * elem);
-            convertSamples(source, buffer.data(), static_cast<std::size_t>(run), layout.type, layout.endian, dst,
-                           first, layout.dims);
-            dst += run;
+            if (native) {
+                unsigned char* dst = v.voxels.data() + at * elem;
+                readExactly(in, path, layout.headerBytes + first * elem, reinterpret_cast<char*>(dst), run * elem);
+                toHostOrder(dst, static_cast<std::size_t>(run), elem, layout.endian);
+            } else {
+                readExactly(in, path, layout.headerBytes + first * elem, reinterpret_cast<char*>(buffer.data()),
+                            run * elem);
+                convertSamples(source, buffer.data(), static_cast<std::size_t>(run), layout.type, layout.endian,
+                               v.values.data() + at, first, layout.dims);
+            }
+            at += static_cast<std::size_t>(run);
         }
     v.validate();
     return v;

@@ -19,6 +19,7 @@
 #include <mutex>
 #include <new>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #ifdef CLVR_HAVE_VTK
@@ -325,8 +326,8 @@ vtkDataArray* pointScalar(vtkDataSet& data, const std::string& name, CapturedRea
 }
 
 // Rows of `src` (extent `have`) inside `want` (both inclusive point ranges) into dst, x fastest.
-template <typename T>
-void copyRegion(const T* src, const int have[6], const glm::ivec3& lo, const glm::ivec3& hi, float* dst)
+template <typename T, typename D>
+void copyRegion(const T* src, const int have[6], const glm::ivec3& lo, const glm::ivec3& hi, D* dst)
 {
     const std::size_t nx = static_cast<std::size_t>(have[1] - have[0] + 1), ny = static_cast<std::size_t>(have[3] - have[2] + 1);
     for (int k = lo.z; k <= hi.z; ++k)
@@ -334,7 +335,7 @@ void copyRegion(const T* src, const int have[6], const glm::ivec3& lo, const glm
             const T* row = src + ((static_cast<std::size_t>(k - have[4]) * ny + static_cast<std::size_t>(j - have[2])) * nx +
                                   static_cast<std::size_t>(lo.x - have[0]));
             for (int i = 0; i <= hi.x - lo.x; ++i)
-                *dst++ = static_cast<float>(row[i]);
+                *dst++ = static_cast<D>(row[i]);
         }
 }
 
@@ -406,19 +407,30 @@ Volume readVtkImage(const fs::path& path, const std::string& scalar, const std::
     v.spacing = info.spacing;
     v.origin = info.origin + glm::dvec3(lo) * info.spacing;
     v.source = path.string();
-    v.values.resize(count);
     const glm::ivec3 wlo(want[0], want[2], want[4]), whi(want[1], want[3], want[5]);
     const void* src = array->GetVoidPointer(0);
+    // 1- and 2-byte integers stay in their own type (Volume::voxels); the others become float.
+    const auto native = [&](VoxelType type, auto* typed) {
+        using T = std::remove_cv_t<std::remove_pointer_t<decltype(typed)>>;
+        v.voxelType = type;
+        v.voxels.resize(count * sizeof(T));
+        copyRegion(static_cast<const T*>(src), have, wlo, whi, reinterpret_cast<T*>(v.voxels.data()));
+    };
+    const auto floats = [&](auto* typed) {
+        using T = std::remove_cv_t<std::remove_pointer_t<decltype(typed)>>;
+        v.values.resize(count);
+        copyRegion(static_cast<const T*>(src), have, wlo, whi, v.values.data());
+    };
     switch (array->GetDataType()) {
-    case VTK_UNSIGNED_CHAR: copyRegion(static_cast<const std::uint8_t*>(src), have, wlo, whi, v.values.data()); break;
+    case VTK_UNSIGNED_CHAR: native(VoxelType::UInt8, static_cast<std::uint8_t*>(nullptr)); break;
     case VTK_SIGNED_CHAR:
-    case VTK_CHAR: copyRegion(static_cast<const std::int8_t*>(src), have, wlo, whi, v.values.data()); break;
-    case VTK_SHORT: copyRegion(static_cast<const std::int16_t*>(src), have, wlo, whi, v.values.data()); break;
-    case VTK_UNSIGNED_SHORT: copyRegion(static_cast<const std::uint16_t*>(src), have, wlo, whi, v.values.data()); break;
-    case VTK_INT: copyRegion(static_cast<const std::int32_t*>(src), have, wlo, whi, v.values.data()); break;
-    case VTK_UNSIGNED_INT: copyRegion(static_cast<const std::uint32_t*>(src), have, wlo, whi, v.values.data()); break;
-    case VTK_FLOAT: copyRegion(static_cast<const float*>(src), have, wlo, whi, v.values.data()); break;
-    case VTK_DOUBLE: copyRegion(static_cast<const double*>(src), have, wlo, whi, v.values.data()); break;
+    case VTK_CHAR: native(VoxelType::Int8, static_cast<std::int8_t*>(nullptr)); break;
+    case VTK_SHORT: native(VoxelType::Int16, static_cast<std::int16_t*>(nullptr)); break;
+    case VTK_UNSIGNED_SHORT: native(VoxelType::UInt16, static_cast<std::uint16_t*>(nullptr)); break;
+    case VTK_INT: floats(static_cast<std::int32_t*>(nullptr)); break;
+    case VTK_UNSIGNED_INT: floats(static_cast<std::uint32_t*>(nullptr)); break;
+    case VTK_FLOAT: floats(static_cast<float*>(nullptr)); break;
+    case VTK_DOUBLE: floats(static_cast<double*>(nullptr)); break;
     default:
         read.fail("point array \"" + std::string(array->GetName() ? array->GetName() : "") + "\" has type " +
                   array->GetDataTypeAsString() + " (clvr reads 8-, 16- and 32-bit integers, float32 and float64)");

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <unistd.h>
 
 namespace clvr {
@@ -50,6 +51,62 @@ void checkHostMemory(const std::string& what, std::uint64_t bytes)
                          std::to_string(physical >> 20) + " MiB of memory");
 }
 
+std::size_t voxelTypeSize(VoxelType type)
+{
+    switch (type) {
+    case VoxelType::UInt8:
+    case VoxelType::Int8: return 1;
+    case VoxelType::UInt16:
+    case VoxelType::Int16: return 2;
+    case VoxelType::Float32: break;
+    }
+    return 4;
+}
+
+const char* voxelTypeName(VoxelType type)
+{
+    switch (type) {
+    case VoxelType::UInt8: return "uint8";
+    case VoxelType::Int8: return "int8";
+    case VoxelType::UInt16: return "uint16";
+    case VoxelType::Int16: return "int16";
+    case VoxelType::Float32: break;
+    }
+    return "float32";
+}
+
+float Volume::value(std::size_t index) const
+{
+    switch (voxelType) {
+    case VoxelType::UInt8: return static_cast<float>(voxels[index]);
+    case VoxelType::Int8: return static_cast<float>(static_cast<std::int8_t>(voxels[index]));
+    case VoxelType::UInt16: {
+        std::uint16_t v;
+        std::memcpy(&v, voxels.data() + 2 * index, 2);
+        return static_cast<float>(v);
+    }
+    case VoxelType::Int16: {
+        std::int16_t v;
+        std::memcpy(&v, voxels.data() + 2 * index, 2);
+        return static_cast<float>(v);
+    }
+    case VoxelType::Float32: break;
+    }
+    return values[index];
+}
+
+const std::vector<float>& Volume::floats(std::vector<float>& scratch) const
+{
+    if (!native())
+        return values;
+    scratch.resize(voxelCount());
+    withVoxels(*this, [&](const auto* data, std::size_t n) {
+        for (std::size_t i = 0; i < n; ++i)
+            scratch[i] = static_cast<float>(data[i]);
+    });
+    return scratch;
+}
+
 std::optional<double> Volume::sample(const glm::dvec3& p) const
 {
     const glm::dvec3 g = (p - origin) / spacing;  // grid coordinates
@@ -72,8 +129,12 @@ std::optional<double> Volume::sample(const glm::dvec3& p) const
 
 glm::dvec2 Volume::range() const
 {
-    const auto [lo, hi] = std::minmax_element(values.begin(), values.end());
-    return values.empty() ? glm::dvec2(0.0) : glm::dvec2(*lo, *hi);
+    return withVoxels(*this, [](const auto* data, std::size_t n) {
+        if (n == 0)
+            return glm::dvec2(0.0);
+        const auto [lo, hi] = std::minmax_element(data, data + n);
+        return glm::dvec2(static_cast<double>(*lo), static_cast<double>(*hi));
+    });
 }
 
 void Volume::validate() const
@@ -87,13 +148,15 @@ void Volume::validate() const
         if (!std::isfinite(origin[a]))
             throw InputError(source + ": origin must be finite");
     }
-    if (values.size() != voxelCount())
-        throw InputError(source + ": has " + std::to_string(values.size()) + " values for " +
+    const std::size_t held = native() ? voxels.size() / voxelTypeSize(voxelType) : values.size();
+    if (held != voxelCount() || (native() && (!values.empty() || voxels.size() % voxelTypeSize(voxelType) != 0)))
+        throw InputError(source + ": has " + std::to_string(held) + " values for " +
                          std::to_string(dims.x) + "x" + std::to_string(dims.y) + "x" + std::to_string(dims.z) +
                          " grid points");
-    for (std::size_t i = 0; i < values.size(); ++i)
-        if (!std::isfinite(values[i]))
-            throw InputError(source + ": value " + std::to_string(i) + " is NaN or infinite");
+    if (!native())  // integers are finite
+        for (std::size_t i = 0; i < values.size(); ++i)
+            if (!std::isfinite(values[i]))
+                throw InputError(source + ": value " + std::to_string(i) + " is NaN or infinite");
     if (part)  // made by code (host/cluster/partition.h), never read from a file
         for (int a = 0; a < 3; ++a)
             if (part->offset[a] < 0 || part->offset[a] + dims[a] > part->fullDims[a])

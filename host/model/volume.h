@@ -53,11 +53,23 @@ struct GridHeader {
     glm::dvec3 origin{0.0};
 };
 
+// The types a Volume holds its values in: float32, or (where a file stores them so) integers of one and two
+// bytes in their own type, which float represents exactly (issue 37 goal 2: no float copy of such a volume).
+enum class VoxelType : std::uint32_t { Float32, UInt8, Int8, UInt16, Int16 };
+std::size_t voxelTypeSize(VoxelType type);
+const char* voxelTypeName(VoxelType type);  // "float32", "uint8", ...
+
 struct Volume {
     glm::ivec3 dims{0};
     glm::dvec3 spacing{1.0};
     glm::dvec3 origin{0.0};
-    std::vector<float> values;  // data units, as stored (int16 CT numbers stay CT numbers)
+    std::vector<float> values;  // data units, as stored (int16 CT numbers stay CT numbers); empty when
+                                // `voxels` holds them
+    // The values in their own integer type (voxelType, host byte order), where a reader kept them so (raw,
+    // NRRD in one raw stream, .npy, VTK's formats); `values` is then empty. Read either storage through
+    // at(), value(), floats() or withVoxels().
+    VoxelType voxelType = VoxelType::Float32;
+    std::vector<std::uint8_t> voxels;
     std::string source;         // file or generator it came from, for messages
     std::optional<GridPart> part;  // set only on a part of a larger grid (sort-last); see GridPart
     // `part`, or for a whole volume the GridPart that makes it the only part of itself (offset 0).
@@ -66,10 +78,15 @@ struct Volume {
     std::size_t voxelCount() const { return static_cast<std::size_t>(dims.x) * dims.y * dims.z; }
     glm::dvec3 boundsMin() const { return origin; }
     glm::dvec3 boundsMax() const { return origin + glm::dvec3(dims - 1) * spacing; }
-    float at(int i, int j, int k) const
-    {
-        return values[(static_cast<std::size_t>(k) * dims.y + j) * dims.x + i];
-    }
+    bool native() const { return voxelType != VoxelType::Float32; }
+    // The value of grid point `index` (x fastest), from either storage.
+    float value(std::size_t index) const;
+    float at(int i, int j, int k) const { return value((static_cast<std::size_t>(k) * dims.y + j) * dims.x + i); }
+    // Every value as float: `values` itself, or the native voxels converted into `scratch` (for code that
+    // needs float32 on the host; it costs 4 bytes per grid point while `scratch` lives).
+    const std::vector<float>& floats(std::vector<float>& scratch) const;
+    // Host bytes of the values: 4 per grid point as float32, 1 or 2 as native voxels.
+    std::uint64_t valueBytes() const { return values.size() * sizeof(float) + voxels.size(); }
     // Trilinear reconstruction at a world position; nullopt outside the bounds.
     std::optional<double> sample(const glm::dvec3& p) const;
     // Smallest and largest value.
@@ -78,5 +95,21 @@ struct Volume {
     // non-finite, a values size that disagrees with dims, or NaN/infinite values.
     void validate() const;
 };
+
+// Calls f(const T* data, std::size_t count) with the volume's values in their storage type T (float,
+// std::uint8_t, std::int8_t, std::uint16_t or std::int16_t) and returns what it returns.
+template <typename F>
+decltype(auto) withVoxels(const Volume& v, F&& f)
+{
+    const std::size_t n = v.voxelCount();
+    switch (v.voxelType) {
+    case VoxelType::UInt8: return f(reinterpret_cast<const std::uint8_t*>(v.voxels.data()), n);
+    case VoxelType::Int8: return f(reinterpret_cast<const std::int8_t*>(v.voxels.data()), n);
+    case VoxelType::UInt16: return f(reinterpret_cast<const std::uint16_t*>(v.voxels.data()), n);
+    case VoxelType::Int16: return f(reinterpret_cast<const std::int16_t*>(v.voxels.data()), n);
+    case VoxelType::Float32: break;
+    }
+    return f(v.values.data(), n);
+}
 
 }  // namespace clvr

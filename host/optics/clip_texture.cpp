@@ -262,9 +262,11 @@ ClipTexture makeClipTexture(const ClipTextureSpec& spec, const fs::path& baseDir
         t.desc.depth = mask.dims.z;
         t.origin = mask.origin;
         t.spacing = mask.spacing;
-        t.texels.resize(mask.values.size());
+        std::vector<float> scratch;
+        const std::vector<float>& values = mask.floats(scratch);
+        t.texels.resize(values.size());
         // Inside where the mask's value is > 0.5: store 0.5 - value, so that inside is < 0 as for shapes.
-        std::transform(mask.values.begin(), mask.values.end(), t.texels.begin(), [](float v) { return 0.5f - v; });
+        std::transform(values.begin(), values.end(), t.texels.begin(), [](float v) { return 0.5f - v; });
         t.pivot = t.origin + 0.5 * glm::dvec3(mask.dims - 1) * t.spacing;
         raster::validate(t.desc, t.texels.size());
         return t;

@@ -18,7 +18,7 @@ namespace {
 // into the grid (the caller only asks for points inside the box; the clamp absorbs rounding at its
 // faces). Same formula as Volume::sample.
 template <typename T, typename R>
-R trilinearOf(const std::vector<T>& data, const glm::ivec3& dims, glm::dvec3 g)
+R trilinearOf(const T* data, const glm::ivec3& dims, glm::dvec3 g)
 {
     const glm::dvec3 last(dims - 1);
     g = glm::clamp(g, glm::dvec3(0.0), last);
@@ -26,7 +26,7 @@ R trilinearOf(const std::vector<T>& data, const glm::ivec3& dims, glm::dvec3 g)
     const glm::dvec3 f = g - glm::dvec3(i0);
     const std::size_t nx = static_cast<std::size_t>(dims.x);
     const std::size_t nxy = nx * static_cast<std::size_t>(dims.y);
-    const T* p = data.data() + static_cast<std::size_t>(i0.z) * nxy + static_cast<std::size_t>(i0.y) * nx + i0.x;
+    const T* p = data + static_cast<std::size_t>(i0.z) * nxy + static_cast<std::size_t>(i0.y) * nx + i0.x;
     auto at = [p](std::size_t k) { return R(p[k]); };
     const R c00 = at(0) * (1 - f.x) + at(1) * f.x;
     const R c10 = at(nx) * (1 - f.x) + at(nx + 1) * f.x;
@@ -37,7 +37,16 @@ R trilinearOf(const std::vector<T>& data, const glm::ivec3& dims, glm::dvec3 g)
     return c0 * (1 - f.z) + c1 * f.z;
 }
 
-double trilinear(const Volume& v, const glm::dvec3& g) { return trilinearOf<float, double>(v.values, v.dims, g); }
+double trilinear(const Volume& v, const glm::dvec3& g)
+{
+    if (!v.native())
+        return trilinearOf<float, double>(v.values.data(), v.dims, g);
+    // Native integer voxels: the same arithmetic on the same values (integers convert exactly).
+    return withVoxels(v, [&](const auto* data, std::size_t) {
+        using T = std::remove_cv_t<std::remove_pointer_t<decltype(data)>>;
+        return trilinearOf<T, double>(data, v.dims, g);
+    });
+}
 
 // (r, g, b, tau) of the sample at grid coordinates g: classification after interpolation, and with
 // shading the color times the shade of the interpolated gradient.
@@ -45,7 +54,7 @@ glm::dvec4 classify(const Volume& v, const TransferFunction& tf, const Reference
 {
     if (!shading)
         return tf(trilinear(v, g));
-    const glm::dvec4 s = trilinearOf<glm::vec4, glm::dvec4>(*shading->gradients, v.dims, g);
+    const glm::dvec4 s = trilinearOf<glm::vec4, glm::dvec4>(shading->gradients->data(), v.dims, g);
     const glm::dvec4 c = tf(s.w);
     return glm::dvec4(glm::dvec3(c) * phongShade(shading->lighting, glm::dvec3(s), shading->toEye), c.a);
 }

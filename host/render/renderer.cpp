@@ -112,7 +112,7 @@ std::unique_ptr<Renderer> makeRenderer(Device& device, const Scene& scene, const
         unknownTechnique(scene.technique);
     if (t->data != DataKind::Volume)
         throw InputError("technique " + t->name + " needs a tetrahedral \"mesh\", and the scene has none");
-    if (volume.values.empty())
+    if (volume.voxelCount() == 0)
         throw InputError("technique " + t->name + " needs a regular-grid \"volume\", and the scene has none");
     if (volume.part && !t->sortLast)
         sortLastUnsupported(*t);

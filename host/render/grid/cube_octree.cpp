@@ -44,9 +44,10 @@ CubeOctree::CubeOctree(const Volume& volume)
 {
     Level leaves;
     leaves.dims = volume.dims;
-    leaves.mean = volume.values;
-    leaves.min = volume.values;
-    leaves.max = volume.values;
+    std::vector<float> scratch;
+    leaves.mean = volume.floats(scratch);
+    leaves.min = leaves.mean;
+    leaves.max = leaves.mean;
     const glm::dvec2 r = volume.range();
     range_ = r.y - r.x;
     levels_.push_back(std::move(leaves));

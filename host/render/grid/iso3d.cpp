@@ -161,8 +161,9 @@ Iso3dRendererImpl::Iso3dRendererImpl(Device& device, const Scene& scene, const V
     framebuffer_ = std::make_unique<raster::Framebuffer>(device_, image_.width, image_.height);
     finish_ = device_.kernel("iso3d.cl", "iso3d_finish");
     if (options_.path == Iso3dOptions::Path::Fused) {
-        values_ = device_.upload("iso3d scalar volume (fused path's alpha test; float32)", volume.values);
-        residentBytes_ += volume.values.size() * sizeof(float);
+        std::vector<float> scratch;
+        values_ = device_.upload("iso3d scalar volume (fused path's alpha test; float32)", volume.floats(scratch));
+        residentBytes_ += volume.voxelCount() * sizeof(float);
         // Empty-space skipping: slice3d's bricks whose values all lie below the iso-value.
         const std::vector<std::uint8_t> space = iso3dEmptySpace(volume, iso_.value, brickDims_, emptyBrickCount_);
         space_ = device_.upload("iso3d empty-space radii", space);
@@ -196,7 +197,8 @@ Iso3dRendererImpl::Iso3dRendererImpl(Device& device, const Scene& scene, const V
         desc.channels = 1;
         desc.filter = raster::Filter::Linear;
         desc.wrap = raster::Wrap::ClampToEdge;
-        scalarTexture_ = std::make_unique<raster::Texture>(device_, desc, volume.values);
+        std::vector<float> scratch;
+        scalarTexture_ = std::make_unique<raster::Texture>(device_, desc, volume.floats(scratch));
         residentBytes_ += scalarTexture_->bytes();
         gradientlessStep_ = options_.gradientlessStep > 0.0
                                 ? options_.gradientlessStep

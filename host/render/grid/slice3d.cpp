@@ -132,14 +132,31 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
 
     // On the fused path with voxel_type auto, uint8 or uint16 when every value is an integer in that
     // range (1 or 2 bytes per grid point, converted to float exactly in the kernel); else float32, 4
-    // bytes per grid point. Device::buffer throws DeviceError if too big.
+    // bytes per grid point. Device::buffer throws DeviceError if too big. A volume held in its own 1- or
+    // 2-byte type (Volume::voxels) goes up as it is, with no host copy: int8 and int16 too where no value
+    // is negative (the same bits as uint8 and uint16).
     std::string trilinearOptions;
     const bool fused = options_.path == Slice3dOptions::Path::Fused;
     auto integralUpTo = [&](float top) {
-        return std::all_of(volume.values.begin(), volume.values.end(),
-                           [top](float v) { return v >= 0.0f && v <= top && v == std::floor(v); });
+        return !volume.native() && std::all_of(volume.values.begin(), volume.values.end(), [top](float v) {
+            return v >= 0.0f && v <= top && v == std::floor(v);
+        });
     };
-    if (fused && options_.nativeVoxels && integralUpTo(255.0f)) {
+    const bool nativeUnsigned = volume.native() && volume.range().x >= 0.0;
+    const std::size_t nativeSize = voxelTypeSize(volume.voxelType);
+    std::vector<float> scratch;  // only where a native volume must go up as float32
+    if (fused && options_.nativeVoxels && nativeUnsigned) {
+        volume_ = device_.buffer(nativeSize == 1 ? "slice3d volume (uint8)" : "slice3d volume (uint16)",
+                                 volume.voxels.size(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, volume.voxels.data());
+        voxelType_ = nativeSize == 1 ? "uint8" : "uint16";
+        residentBytes_ = volume.voxels.size();
+        trilinearOptions = nativeSize == 1
+                               ? "-DSLICE3D_VOXEL=uchar -DSLICE3D_VOXEL_BITS=8 -DSLICE3D_TRILINEAR=clvr_trilinear_uchar"
+                               : "-DSLICE3D_VOXEL=ushort -DSLICE3D_VOXEL_BITS=16 -DSLICE3D_TRILINEAR=clvr_trilinear_ushort";
+    } else if (volume.native()) {
+        volume_ = device_.upload("slice3d volume (float32)", volume.floats(scratch));
+        residentBytes_ = volume.voxelCount() * sizeof(float);
+    } else if (fused && options_.nativeVoxels && integralUpTo(255.0f)) {
         std::vector<cl_uchar> v(volume.values.begin(), volume.values.end());
         volume_ = device_.upload("slice3d volume (uint8)", v);
         voxelType_ = "uint8";
@@ -747,12 +764,14 @@ BrickGrid buildBrickGrid(const Volume& volume)
     std::vector<glm::vec2> row(grid.dims.x);
     for (int k = 0; k < n.z; ++k)
         for (int j = 0; j < n.y; ++j) {
-            const float* v = volume.values.data() + (static_cast<std::size_t>(k) * n.y + j) * n.x;
-            for (int bx = 0; bx < grid.dims.x; ++bx) {
-                const int i0 = bx * kBrickCells, i1 = std::min(i0 + kBrickCells, n.x - 1);
-                const auto [mn, mx] = std::minmax_element(v + i0, v + i1 + 1);
-                row[bx] = {*mn, *mx};
-            }
+            withVoxels(volume, [&](const auto* data, std::size_t) {  // the row in the volume's own type
+                const auto* v = data + (static_cast<std::size_t>(k) * n.y + j) * n.x;
+                for (int bx = 0; bx < grid.dims.x; ++bx) {
+                    const int i0 = bx * kBrickCells, i1 = std::min(i0 + kBrickCells, n.x - 1);
+                    const auto [mn, mx] = std::minmax_element(v + i0, v + i1 + 1);
+                    row[bx] = {static_cast<float>(*mn), static_cast<float>(*mx)};
+                }
+            });
             const int by1 = std::min(j / kBrickCells, grid.dims.y - 1), bz1 = std::min(k / kBrickCells, grid.dims.z - 1);
             const int by0 = (j % kBrickCells == 0 && j > 0) ? j / kBrickCells - 1 : by1;
             const int bz0 = (k % kBrickCells == 0 && k > 0) ? k / kBrickCells - 1 : bz1;

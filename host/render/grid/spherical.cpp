@@ -246,7 +246,8 @@ SphericalRenderer::SphericalRenderer(Device& device, const Scene& scene, const V
     desc.channels = 1;
     desc.filter = raster::Filter::Linear;
     desc.wrap = raster::Wrap::ClampToEdge;
-    texture_ = std::make_unique<raster::Texture>(device_, desc, volume.values);
+    std::vector<float> scratch;
+    texture_ = std::make_unique<raster::Texture>(device_, desc, volume.floats(scratch));
     residentBytes_ += texture_->bytes();
     setTransferFunction(scene.transferFunction);
 

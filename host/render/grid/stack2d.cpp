@@ -155,9 +155,9 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
         iso.diffuse = scene.iso->diffuse;
         if (!scene.transferFunction.points().empty())
             iso.color = glm::dvec3(scene.transferFunction(iso.value));
-        const auto [mn, mx] = std::minmax_element(volume.values.begin(), volume.values.end());
-        iso.dataMin = *mn;
-        iso.dataMax = *mx;
+        const glm::dvec2 range = volume.range();
+        iso.dataMin = static_cast<float>(range.x);
+        iso.dataMax = static_cast<float>(range.y);
         iso_ = iso;
     }
     if (options_.clipTexture) {
@@ -173,7 +173,8 @@ Stack2dRenderer::Stack2dRenderer(Device& device, const Scene& scene, const Volum
     std::vector<glm::vec4> rgba;
     if (gradients)
         rgba = sobelGradientVolume(volume);
-    const float* points = gradients ? &rgba[0].x : volume.values.data();
+    std::vector<float> scratch;
+    const float* points = gradients ? &rgba[0].x : volume.floats(scratch).data();
     for (int a = 0; a < 3; ++a) {
         const StackShape s = stackShape(a);
         raster::TextureDesc desc;
