@@ -1,6 +1,7 @@
 // host/session.cpp — clvr::Session: one scene's data, device and renderer kept across frames.
 #include "host/session.h"
 
+#include "host/cluster/bricks.h"
 #include "host/render/scaffold.h"
 #include "host/runtime/errors.h"
 #include "host/io/mesh_io.h"
@@ -83,8 +84,17 @@ void Session::makeRenderer()
     renderer_.reset();  // the old renderer's device buffers go before the new one's are allocated
     const Clock::time_point t0 = Clock::now();
     try {
-        renderer_ = isMesh() ? makeMeshRenderer(*device_, scene_, data_.mesh)
-                             : clvr::makeRenderer(*device_, scene_, data_.volume);
+        try {
+            renderer_ = isMesh() ? makeMeshRenderer(*device_, scene_, data_.mesh)
+                                 : clvr::makeRenderer(*device_, scene_, data_.volume);
+        } catch (const DeviceError& e) {
+            // A volume that does not fit one device allocation renders in bricks, where the technique
+            // renders parts (host/cluster/bricks.h); anything else is the error it was.
+            const TechniqueInfo* t = findTechnique(scene_.technique);
+            if (isMesh() || data_.volume.part || !t || !t->sortLast || !isOutOfDeviceMemory(e))
+                throw;
+            renderer_ = makeBrickedRenderer(*device_, scene_, data_.volume);
+        }
     } catch (const DeviceError&) {
         throw;
     } catch (const InputError& e) {  // technique or options: say which scene they came from
