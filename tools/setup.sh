@@ -22,7 +22,8 @@ packages=(cmake make g++ pkg-config clang
     pocl-opencl-icd mesa-opencl-icd ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers
     libglm-dev libopenimageio-dev openimageio-tools libtet1.5-dev nlohmann-json3-dev libcli11-dev
     libgtest-dev libbenchmark-dev zlib1g-dev
-    openmpi-bin libopenmpi-dev paraview-dev)  # MPI and IceT (inside ParaView) for mpirun -np N clvr render
+    openmpi-bin libopenmpi-dev paraview-dev  # MPI and IceT (inside ParaView) for mpirun -np N clvr render
+    python3-numpy)  # tests/cluster_memcap.sh writes its 768 MiB volume with numpy
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
