@@ -13,6 +13,7 @@
 #include "tests/support/test_util.h"
 
 #include <nlohmann/json.hpp>
+#include <zlib.h>
 
 #include <algorithm>
 #include <cmath>
@@ -199,7 +200,25 @@ TEST(Partition, PartReadByItselfEqualsPartCutFromTheWhole)
     test::writeFile(dir / "skip.data", std::string(7, 'x') + raw16 + "trailing");
     test::writeFile(dir / "detached.nhdr", "NRRD0004\ntype: uint16\ndimension: 3\nsizes: 13 9 11\nendian: little\n"
                                            "encoding: raw\nbyte skip: 7\ndata file: skip.data\n");
+    // NRRD, gzip: attached, with a byte skip inside the inflated data, in two gzip members.
+    const auto gzip = [](const std::string& data) {
+        z_stream z{};
+        EXPECT_EQ(deflateInit2(&z, 6, Z_DEFLATED, 16 + MAX_WBITS, 8, Z_DEFAULT_STRATEGY), Z_OK);
+        std::string out(deflateBound(&z, static_cast<uLong>(data.size())) + 64, '\0');
+        z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data.data()));
+        z.avail_in = static_cast<uInt>(data.size());
+        z.next_out = reinterpret_cast<Bytef*>(out.data());
+        z.avail_out = static_cast<uInt>(out.size());
+        EXPECT_EQ(deflate(&z, Z_FINISH), Z_STREAM_END);
+        out.resize(z.total_out);
+        deflateEnd(&z);
+        return out;
+    };
+    test::writeFile(dir / "gz.nrrd", "NRRD0004\ntype: uint16\ndimension: 3\nsizes: 13 9 11\nendian: little\n"
+                                     "encoding: gzip\nbyte skip: 5\nspacings: 0.5 1 2\n\n" +
+                                         gzip("skip!" + raw16.substr(0, 1000)) + gzip(raw16.substr(1000)));
     const std::vector<nlohmann::json> specs = {
+        {{"file", "gz.nrrd"}},
         {{"file", "attached.nrrd"}},
         {{"file", "detached.nhdr"}},
         {{"file", "v16.raw"}, {"dims", {13, 9, 11}}, {"type", "uint16"}, {"endian", "little"}, {"spacing", {0.5, 1, 2}}, {"origin", {1, 2, 3}}},
@@ -238,7 +257,17 @@ TEST(Partition, PartReadByItselfEqualsPartCutFromTheWhole)
     }
     // Formats that cannot read a region say so (the caller loads them whole).
     EXPECT_FALSE(volumeHeader(parseVolumeSpec({{"generator", "sphere"}, {"dims", {8, 8, 8}}}, dir.path())));
-    EXPECT_FALSE(volumeHeader(parseVolumeSpec({{"file", test::sharedData("engine/engine.nrrd")}}, dir.path())));  // gzip
+    test::writeFile(dir / "ascii.nrrd", "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: ascii\n\n"
+                                        "1 2 3 4 5 6 7 8\n");
+    EXPECT_FALSE(volumeHeader(parseVolumeSpec({{"file", "ascii.nrrd"}}, dir.path())));
+    // The engine (gzip NRRD, uint8, 256x256x128): a rank's part inflated in order is the cut of the whole.
+    const VolumeSpec engine = parseVolumeSpec({{"file", test::sharedData("engine/engine.nrrd")}}, dir.path());
+    const Volume whole = loadVolume(engine);
+    EXPECT_EQ(whole.voxelType, VoxelType::UInt8);
+    const GridPartition four = partitionGrid(whole.dims, whole.origin, whole.spacing, 4);
+    for (int p = 0; p < 4; ++p)
+        EXPECT_EQ(loadVolumeRegion(engine, gridPartRegion(four, whole.dims, p, 1)).voxels,
+                  cutGridPart(whole, four, p, 1).voxels) << "part " << p;
     // A NRRD shorter than its samples is the same one-line error as when read whole.
     test::writeFile(dir / "short.nrrd", "NRRD0004\ntype: uint16\ndimension: 3\nsizes: 13 9 11\nendian: little\n"
                                         "encoding: raw\n\n" + raw16.substr(0, 100));

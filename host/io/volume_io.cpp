@@ -20,6 +20,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <sstream>
@@ -253,36 +254,44 @@ bool gzipCanHold(std::uint64_t compressed, std::uint64_t n)
     return n <= compressed * 1032 + 1024;
 }
 
-void gunzip(const std::string& source, const std::vector<unsigned char>& src, std::uint64_t skip, unsigned char* dst,
-            std::uint64_t n, const std::string& sizeText)
+// Inflates gzip data read through `read(buffer, max) -> bytes` (0 at its end), drops the first `skip` bytes
+// of the output and hands the next `n` to `sink(offset, data, length)` in order, in pieces of at most 1 MiB;
+// stops once `n` bytes are out, so a reader that needs only the start of the data inflates only that.
+// Several gzip members are read as one stream. InputError for corrupt or truncated data.
+void gunzipTo(const std::string& source, const std::function<std::size_t(unsigned char*, std::size_t)>& read,
+              std::uint64_t skip, std::uint64_t n, const std::string& sizeText,
+              const std::function<void(std::uint64_t, const unsigned char*, std::size_t)>& sink)
 {
-    if (!gzipCanHold(src.size(), n + skip))
-        throw InputError(source + ": gzip data is truncated (" + std::to_string(src.size()) +
-                         " compressed bytes cannot hold " + sizeText + ")");
     z_stream z{};
     if (inflateInit2(&z, 16 + MAX_WBITS) != Z_OK)  // 16: gzip wrapper, as NRRD writes it
         throw InputError(source + ": cannot initialise zlib");
-    std::vector<unsigned char> scratch(std::min<std::uint64_t>(skip, 1 << 20));
-    std::uint64_t in = 0, skipped = 0, out = 0;
+    constexpr std::size_t kChunk = 1 << 20;
+    std::vector<unsigned char> input(kChunk), output(kChunk);
+    std::uint64_t skipped = 0, out = 0;
+    bool inputEnded = false;
     std::string error;
     while (out < n) {
-        if (z.avail_in == 0) {
-            const std::uint64_t chunk = std::min<std::uint64_t>(src.size() - in, UINT_MAX);
-            z.next_in = const_cast<unsigned char*>(src.data() + in);
-            z.avail_in = static_cast<uInt>(chunk);
-            in += chunk;
+        if (z.avail_in == 0 && !inputEnded) {
+            const std::size_t got = read(input.data(), input.size());
+            inputEnded = got == 0;
+            z.next_in = input.data();
+            z.avail_in = static_cast<uInt>(got);
         }
-        const bool skipping = skipped < skip;
-        unsigned char* target = skipping ? scratch.data() : dst + out;
-        const std::uint64_t want = skipping ? std::min<std::uint64_t>(skip - skipped, scratch.size()) : n - out;
-        z.next_out = target;
-        z.avail_out = static_cast<uInt>(std::min<std::uint64_t>(want, UINT_MAX));
+        const std::uint64_t wanted = (skip - skipped) + (n - out);
+        z.next_out = output.data();
+        z.avail_out = static_cast<uInt>(std::min<std::uint64_t>(wanted, output.size()));
         const uInt before = z.avail_out;
         const int rc = inflate(&z, Z_NO_FLUSH);
-        const std::uint64_t produced = before - z.avail_out;
-        (skipping ? skipped : out) += produced;
+        std::uint64_t produced = before - z.avail_out;
+        const std::uint64_t dropped = std::min(produced, skip - skipped);
+        skipped += dropped;
+        produced -= dropped;
+        if (produced > 0) {
+            sink(out, output.data() + dropped, static_cast<std::size_t>(produced));
+            out += produced;
+        }
         if (rc == Z_STREAM_END) {
-            if (z.avail_in == 0 && in == src.size())
+            if (z.avail_in == 0 && inputEnded)
                 break;  // all input used; checked below
             if (inflateReset(&z) != Z_OK) {  // another gzip member follows
                 error = "corrupt gzip data";
@@ -290,13 +299,13 @@ void gunzip(const std::string& source, const std::vector<unsigned char>& src, st
             }
             continue;
         }
-        if (rc == Z_BUF_ERROR && z.avail_in == 0 && in == src.size())
+        if (rc == Z_BUF_ERROR && z.avail_in == 0 && inputEnded)
             break;  // the input ended mid-stream
         if (rc != Z_OK && rc != Z_BUF_ERROR) {
             error = std::string("corrupt gzip data (") + (z.msg ? z.msg : "zlib error " + std::to_string(rc)) + ")";
             break;
         }
-        if (rc == Z_BUF_ERROR && produced == 0 && z.avail_in != 0)
+        if (rc == Z_BUF_ERROR && before - z.avail_out == 0 && z.avail_in != 0)
             break;  // no progress possible
     }
     inflateEnd(&z);
@@ -305,6 +314,26 @@ void gunzip(const std::string& source, const std::vector<unsigned char>& src, st
     if (out < n)
         throw InputError(source + ": gzip data is truncated (decompresses to " + std::to_string(skipped + out) +
                          " bytes, " + sizeText + (skip ? " after a byte skip of " + std::to_string(skip) : "") + ")");
+}
+
+// gunzipTo from memory into dst[0, n); first checks that src can hold n + skip bytes at deflate's best ratio.
+void gunzip(const std::string& source, const std::vector<unsigned char>& src, std::uint64_t skip, unsigned char* dst,
+            std::uint64_t n, const std::string& sizeText)
+{
+    if (!gzipCanHold(src.size(), n + skip))
+        throw InputError(source + ": gzip data is truncated (" + std::to_string(src.size()) +
+                         " compressed bytes cannot hold " + sizeText + ")");
+    std::size_t at = 0;
+    gunzipTo(
+        source,
+        [&](unsigned char* buffer, std::size_t max) {
+            const std::size_t k = std::min(max, src.size() - at);
+            std::memcpy(buffer, src.data() + at, k);
+            at += k;
+            return k;
+        },
+        skip, n, sizeText,
+        [&](std::uint64_t offset, const unsigned char* data, std::size_t length) { std::memcpy(dst + offset, data, length); });
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -873,21 +902,32 @@ Volume nrrdGeometry(const NrrdHeader& h, std::uint64_t& count)
 
 Volume readRawRegion(const fs::path& path, const RawLayout& layout, const GridRegion& region, bool exactSize = true);
 
-// Where the samples of a raw-encoded NRRD with one data stream (attached, or one detached file) lie: its
-// layout as a raw file (headerBytes: the first sample's byte after line and byte skips). nullopt for other
-// encodings and for several data files. InputError when the file is shorter than the samples.
-std::optional<std::pair<fs::path, RawLayout>> nrrdRawLayout(const NrrdHeader& h)
+// Where the samples of a NRRD with one data stream (attached, or one detached file) lie, raw or gzip: the
+// layout of its samples as a raw file (raw: headerBytes is the first sample's byte after line and byte skips;
+// gzip: where the compressed data starts after the line skip, its byte skip applying to the inflated data).
+// nullopt for ascii and for several data files. InputError when the file is shorter than the samples (raw).
+struct NrrdStream {
+    fs::path file;
+    RawLayout layout;
+    bool gzip = false;
+    std::uint64_t gzipSkip = 0;
+    std::string sizeText;  // "header says 5x4x6 x 2 bytes = 240 bytes", for messages
+};
+
+std::optional<NrrdStream> nrrdStream(const NrrdHeader& h)
 {
     std::uint64_t count = 0;
     const Volume geometry = nrrdGeometry(h, count);
-    if (*h.encoding != NrrdEncoding::Raw || dataFileCount(h) > 1)
+    if (*h.encoding == NrrdEncoding::Ascii || dataFileCount(h) > 1)
         return std::nullopt;
-    const fs::path file = dataFileCount(h) == 0 ? h.path : dataFile(h, 0);
-    const std::string source = file.string();
-    const std::uint64_t size = fileSize(file);
+    NrrdStream st;
+    st.file = dataFileCount(h) == 0 ? h.path : dataFile(h, 0);
+    st.gzip = *h.encoding == NrrdEncoding::Gzip;
+    const std::string source = st.file.string();
+    const std::uint64_t size = fileSize(st.file);
     std::uint64_t pos = dataFileCount(h) == 0 ? h.dataOffset : 0;
     if (h.lineSkip > 0) {
-        std::ifstream in = openBinary(file);
+        std::ifstream in = openBinary(st.file);
         in.seekg(static_cast<std::streamoff>(pos));
         for (long long l = 0; l < h.lineSkip; ++l) {
             int c;
@@ -900,11 +940,23 @@ std::optional<std::pair<fs::path, RawLayout>> nrrdRawLayout(const NrrdHeader& h)
     }
     const std::size_t elem = scalarSize(*h.type);
     const std::uint64_t bytes = count * elem;
+    st.sizeText = "header says " + dimsText(*h.sizes) + " x " + std::to_string(elem) + " bytes = " + std::to_string(bytes) +
+                  " bytes";
+    st.layout.dims = geometry.dims;
+    st.layout.type = *h.type;
+    st.layout.endian = h.endian.value_or(Endian::Little);
+    st.layout.spacing = geometry.spacing;
+    st.layout.origin = geometry.origin;
+    if (st.gzip) {
+        if (h.byteSkip == -1)
+            throw InputError(source + ": byte skip -1 is only allowed with raw encoding");
+        st.gzipSkip = static_cast<std::uint64_t>(h.byteSkip);
+        st.layout.headerBytes = pos;
+        return st;
+    }
     const std::uint64_t header = pos;
     const auto tooShort = [&](std::uint64_t available) {
-        return InputError(source + ": header says " + dimsText(*h.sizes) + " x " + std::to_string(elem) +
-                          " bytes = " + std::to_string(bytes) + " bytes, file has " + std::to_string(available) +
-                          " bytes" +
+        return InputError(source + ": " + st.sizeText + ", file has " + std::to_string(available) + " bytes" +
                           (header == 0 ? std::string()
                            : h.byteSkip == 0 && h.lineSkip == 0 ? " after the " + std::to_string(header) + "-byte header"
                                                                 : " after " + std::to_string(header) +
@@ -919,14 +971,16 @@ std::optional<std::pair<fs::path, RawLayout>> nrrdRawLayout(const NrrdHeader& h)
     }
     if (size < pos || size - pos < bytes)
         throw tooShort(size > pos ? size - pos : 0);
-    RawLayout layout;
-    layout.dims = geometry.dims;
-    layout.type = *h.type;
-    layout.endian = h.endian.value_or(Endian::Little);
-    layout.spacing = geometry.spacing;
-    layout.origin = geometry.origin;
-    layout.headerBytes = pos;
-    return std::make_pair(file, layout);
+    st.layout.headerBytes = pos;
+    return st;
+}
+
+Volume readGzipRegion(const NrrdStream& st, const GridRegion& region);
+
+// A NRRD stream's grid points `region`: by offset (raw) or inflated in order, keeping only the region (gzip).
+Volume readNrrdRegion(const NrrdStream& st, const GridRegion& region)
+{
+    return st.gzip ? readGzipRegion(st, region) : readRawRegion(st.file, st.layout, region, false);
 }
 
 }  // namespace
@@ -938,8 +992,8 @@ Volume readNrrd(const fs::path& path)
     std::uint64_t count = 0;
     Volume v = nrrdGeometry(h, count);
     v.source = source;
-    if (const auto raw = nrrdRawLayout(h)) {  // one raw stream: read in place, integers in their own type
-        Volume whole = readRawRegion(raw->first, raw->second, GridRegion{glm::ivec3(0), v.dims - 1}, false);
+    if (const auto stream = nrrdStream(h)) {  // one raw or gzip stream: integers kept in their own type
+        Volume whole = readNrrdRegion(*stream, GridRegion{glm::ivec3(0), v.dims - 1});
         whole.source = source;
         return whole;
     }
@@ -1415,6 +1469,80 @@ Volume readRawRegion(const fs::path& path, const RawLayout& layout, const GridRe
 
 }  // namespace
 
+namespace {
+
+// A gzip NRRD stream's grid points `region`: the compressed data read and inflated in order, 1 MiB at a time,
+// keeping only the region's rows and stopping after its last one (a part near the start of the file inflates
+// only that far). Integers of 1 and 2 bytes kept in their own type, as readRawRegion keeps them.
+Volume readGzipRegion(const NrrdStream& st, const GridRegion& region)
+{
+    const std::string source = st.file.string();
+    const RawLayout& layout = st.layout;
+    const std::size_t elem = scalarSize(layout.type);
+    const std::uint64_t nx = static_cast<std::uint64_t>(layout.dims.x), ny = static_cast<std::uint64_t>(layout.dims.y);
+    const std::uint64_t total = nx * ny * static_cast<std::uint64_t>(layout.dims.z) * elem;
+    const std::uint64_t size = fileSize(st.file);
+    const std::uint64_t compressed = size > layout.headerBytes ? size - layout.headerBytes : 0;
+    if (!gzipCanHold(compressed, total + st.gzipSkip))
+        throw InputError(source + ": gzip data is truncated: " + st.sizeText + ", and " + std::to_string(compressed) +
+                         " compressed bytes cannot hold that many");
+    const glm::ivec3 n = region.dims();
+    const std::uint64_t count = static_cast<std::uint64_t>(n.x) * static_cast<std::uint64_t>(n.y) * static_cast<std::uint64_t>(n.z);
+    checkHostMemoryForVoxels(source, count);
+    // The region's runs of contiguous samples in the inflated data (a whole plane's rows where it spans x and y).
+    const bool wholePlanes = n.x == layout.dims.x && n.y == layout.dims.y;
+    const std::uint64_t run = wholePlanes ? nx * ny : static_cast<std::uint64_t>(n.x);
+    std::vector<std::uint64_t> runStart;  // first sample of each run
+    for (int k = region.lo.z; k <= region.hi.z; ++k)
+        for (int j = region.lo.y; j <= region.hi.y; j += wholePlanes ? n.y : 1)
+            runStart.push_back((static_cast<std::uint64_t>(k) * ny + static_cast<std::uint64_t>(j)) * nx +
+                               static_cast<std::uint64_t>(region.lo.x));
+    std::vector<unsigned char> bytes(static_cast<std::size_t>(count * elem));
+    std::size_t next = 0;  // the first run not yet complete
+    std::ifstream in = openBinary(st.file);
+    in.seekg(static_cast<std::streamoff>(layout.headerBytes));
+    gunzipTo(
+        source,
+        [&](unsigned char* buffer, std::size_t max) {
+            in.read(reinterpret_cast<char*>(buffer), static_cast<std::streamsize>(max));
+            return static_cast<std::size_t>(in.gcount());
+        },
+        st.gzipSkip, (runStart.back() + run) * elem, st.sizeText,
+        [&](std::uint64_t offset, const unsigned char* data, std::size_t length) {
+            const std::uint64_t end = offset + length;
+            while (next < runStart.size()) {
+                const std::uint64_t r0 = runStart[next] * elem, r1 = r0 + run * elem;
+                if (r0 >= end)
+                    return;
+                const std::uint64_t c0 = std::max(r0, offset), c1 = std::min(r1, end);
+                if (c1 > c0)
+                    std::memcpy(bytes.data() + next * run * elem + (c0 - r0), data + (c0 - offset), c1 - c0);
+                if (r1 > end)
+                    return;  // the rest of this run comes with the next piece
+                ++next;
+            }
+        });
+    Volume v;
+    v.source = source;
+    v.dims = n;
+    v.spacing = layout.spacing;
+    v.origin = layout.origin + glm::dvec3(region.lo) * layout.spacing;
+    if (const std::optional<VoxelType> native = nativeVoxelType(layout.type)) {
+        v.voxelType = *native;
+        toHostOrder(bytes.data(), static_cast<std::size_t>(count), elem, layout.endian);
+        v.voxels = std::move(bytes);
+    } else {
+        v.values.resize(static_cast<std::size_t>(count));
+        for (std::size_t r = 0; r < runStart.size(); ++r)
+            convertSamples(source, bytes.data() + r * run * elem, static_cast<std::size_t>(run), layout.type,
+                           layout.endian, v.values.data() + r * run, runStart[r], layout.dims);
+    }
+    v.validate();
+    return v;
+}
+
+}  // namespace
+
 std::optional<GridHeader> volumeHeader(const VolumeSpec& spec)
 {
     switch (spec.kind) {
@@ -1429,10 +1557,10 @@ std::optional<GridHeader> volumeHeader(const VolumeSpec& spec)
     }
     case VolumeSpec::Kind::VtkImage: return readVtkImageHeader(spec.file);
     case VolumeSpec::Kind::Nrrd: {
-        const auto raw = nrrdRawLayout(readNrrdHeader(spec.file));
-        if (!raw)
+        const auto stream = nrrdStream(readNrrdHeader(spec.file));
+        if (!stream)
             return std::nullopt;
-        return GridHeader{raw->second.dims, raw->second.spacing, raw->second.origin};
+        return GridHeader{stream->layout.dims, stream->layout.spacing, stream->layout.origin};
     }
     default: return std::nullopt;
     }
@@ -1461,8 +1589,7 @@ Volume loadVolumeRegion(const VolumeSpec& spec, const GridRegion& region)
     }
     case VolumeSpec::Kind::VtkImage: return readVtkImage(spec.file, spec.scalar, region);
     case VolumeSpec::Kind::Nrrd: {
-        const auto raw = nrrdRawLayout(readNrrdHeader(spec.file));  // volumeHeader said it is raw
-        Volume v = readRawRegion(raw->first, raw->second, region, false);
+        Volume v = readNrrdRegion(*nrrdStream(readNrrdHeader(spec.file)), region);  // volumeHeader said it has one
         v.source = spec.file.string();
         return v;
     }
