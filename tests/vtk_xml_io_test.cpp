@@ -371,6 +371,44 @@ TEST(VtkXmlIo, PvtiPiecesWholeAndRegions)
     expectVolumeValues(readVtkImage(dir / "p.pvti", "", GridRegion{{0, 0, 4}, {8, 5, 7}}), {9, 6, 4}, {0, 0, 4});
     EXPECT_THROW(readVtkImage(dir / "p.pvti"), InputError);
     EXPECT_THROW(readVtkImage(dir / "p.pvti", "", GridRegion{{5, 0, 0}, {6, 5, 1}}), InputError);
+
+    // clvr copies the pieces itself (VTK's parallel reader trusts the summary: a piece of another type than
+    // the summary says overflowed its copy under fuzzing). A summary that lies about the type reads by the
+    // pieces' own; pieces of different types, and pieces that leave a hole, are one error each.
+    std::string lying = summary;
+    const std::string declared = "<PDataArray type=\"UInt16\"";
+    lying.replace(lying.find(declared), declared.size(), "<PDataArray type=\"UInt64\"");
+    fs::remove(dir / "p.pvti");
+    test::writeFile(dir / "lie.pvti", lying);
+    fs::copy_file(dir / "p_0.vti", dir / "p_1.vti");  // a piece at the wrong extent
+    EXPECT_THROW(readVtkImage(dir / "lie.pvti"), InputError);  // piece 1 does not hold its extent
+    expectVolumeValues(readVtkImage(dir / "lie.pvti", "", GridRegion{{0, 0, 0}, {3, 5, 7}}), {4, 6, 8});
+    vtkNew<vtkImageData> floatPiece = makeImage({9, 6, 8}, pieces[1]);
+    vtkNew<vtkFloatArray> asFloat;
+    asFloat->SetName("density");
+    asFloat->DeepCopy(floatPiece->GetPointData()->GetArray("density"));
+    floatPiece->GetPointData()->RemoveArray("density");
+    floatPiece->GetPointData()->SetScalars(asFloat);
+    vtkNew<vtkXMLImageDataWriter> writer1;
+    writer1->SetInputData(floatPiece);
+    writer1->SetFileName((dir / "p_1.vti").c_str());
+    ASSERT_EQ(writer1->Write(), 1);
+    try {
+        readVtkImage(dir / "lie.pvti", "density");
+        ADD_FAILURE() << "pieces of two types read as one";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("another piece's has"), std::string::npos) << e.what();
+    }
+    std::string holed = summary;
+    holed.erase(holed.find("    <Piece Extent=\"6 10 1 6 0 3\""), holed.find("\n", holed.find("Extent=\"6 10 1 6 0 3\"")) -
+                                                                  holed.find("    <Piece Extent=\"6 10 1 6 0 3\"") + 1);
+    test::writeFile(dir / "holed.pvti", holed);
+    try {
+        readVtkImage(dir / "holed.pvti");
+        ADD_FAILURE() << "a hole read as data";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("no piece holds grid point"), std::string::npos) << e.what();
+    }
 }
 
 TEST(VtkXmlIo, MetaImageMhdAndMha)

@@ -14,6 +14,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <mutex>
@@ -173,6 +174,16 @@ public:
         }
         return "";
     }
+    int pieceCount() const { return this->NumberOfPieces; }
+    const int* pieceExtent(int i) const { return this->PieceExtents + 6 * i; }  // the summary's Extent
+    // Piece i's file as the summary names it, resolved against the summary's folder; empty when it cannot be
+    // read.
+    std::string pieceFile(int i)
+    {
+        if (!this->CanReadPiece(i) || !this->PieceReaders[i] || !this->PieceReaders[i]->GetFileName())
+            return "";
+        return this->PieceReaders[i]->GetFileName();
+    }
 };
 vtkStandardNewMacro(CheckedPImageReader);
 
@@ -325,18 +336,131 @@ vtkDataArray* pointScalar(vtkDataSet& data, const std::string& name, CapturedRea
     return a;
 }
 
-// Rows of `src` (extent `have`) inside `want` (both inclusive point ranges) into dst, x fastest.
-template <typename T, typename D>
-void copyRegion(const T* src, const int have[6], const glm::ivec3& lo, const glm::ivec3& hi, D* dst)
-{
-    const std::size_t nx = static_cast<std::size_t>(have[1] - have[0] + 1), ny = static_cast<std::size_t>(have[3] - have[2] + 1);
-    for (int k = lo.z; k <= hi.z; ++k)
-        for (int j = lo.y; j <= hi.y; ++j) {
-            const T* row = src + ((static_cast<std::size_t>(k - have[4]) * ny + static_cast<std::size_t>(j - have[2])) * nx +
-                                  static_cast<std::size_t>(lo.x - have[0]));
-            for (int i = 0; i <= hi.x - lo.x; ++i)
-                *dst++ = static_cast<D>(row[i]);
+// The region's values as they are read, box by box (the whole region from one file, or a .pvti's pieces):
+// stored in the first box's type (1- and 2-byte integers kept so, others as float), every point marked as
+// it is written, so that a region the pieces do not cover is an error, not zeros.
+class RegionStore {
+public:
+    RegionStore(Volume& v, const int extent[6], CapturedRead& read) : v_(v), read_(read)
+    {
+        std::copy(extent, extent + 6, extent_);
+        written_.assign(v.voxelCount(), false);
+    }
+
+    // Copies the points of `box` from `array`, which holds the points of extent `have` (x fastest).
+    void copy(vtkDataArray& array, const int have[6], const int box[6], const std::string& what)
+    {
+        const int type = array.GetDataType();
+        if (type_ < 0) {
+            type_ = type;
+            typeName_ = array.GetDataTypeAsString();
+            switch (type) {
+            case VTK_UNSIGNED_CHAR: v_.voxelType = VoxelType::UInt8; break;
+            case VTK_SIGNED_CHAR:
+            case VTK_CHAR: v_.voxelType = VoxelType::Int8; break;
+            case VTK_SHORT: v_.voxelType = VoxelType::Int16; break;
+            case VTK_UNSIGNED_SHORT: v_.voxelType = VoxelType::UInt16; break;
+            case VTK_INT: case VTK_UNSIGNED_INT: case VTK_FLOAT: case VTK_DOUBLE: break;
+            default:
+                read_.fail(what + "point array \"" + std::string(array.GetName() ? array.GetName() : "") + "\" has type " +
+                           array.GetDataTypeAsString() + " (clvr reads 8-, 16- and 32-bit integers, float32 and float64)");
+            }
+            if (v_.native())
+                v_.voxels.resize(v_.voxelCount() * voxelTypeSize(v_.voxelType));
+            else
+                v_.values.resize(v_.voxelCount());
+        } else if (type != type_) {
+            read_.fail(what + "point array \"" + std::string(array.GetName() ? array.GetName() : "") + "\" has type " +
+                       array.GetDataTypeAsString() + ", another piece's has " + typeName_);
         }
+        const void* src = array.GetVoidPointer(0);
+        switch (type) {
+        case VTK_UNSIGNED_CHAR: put(static_cast<const std::uint8_t*>(src), have, box); break;
+        case VTK_SIGNED_CHAR:
+        case VTK_CHAR: put(static_cast<const std::int8_t*>(src), have, box); break;
+        case VTK_SHORT: put(static_cast<const std::int16_t*>(src), have, box); break;
+        case VTK_UNSIGNED_SHORT: put(static_cast<const std::uint16_t*>(src), have, box); break;
+        case VTK_INT: put(static_cast<const std::int32_t*>(src), have, box); break;
+        case VTK_UNSIGNED_INT: put(static_cast<const std::uint32_t*>(src), have, box); break;
+        case VTK_FLOAT: put(static_cast<const float*>(src), have, box); break;
+        default: put(static_cast<const double*>(src), have, box); break;
+        }
+    }
+
+    void checkCovered() const
+    {
+        const auto gap = std::find(written_.begin(), written_.end(), false);
+        if (gap != written_.end()) {
+            const std::size_t i = static_cast<std::size_t>(gap - written_.begin());
+            const std::size_t nx = static_cast<std::size_t>(v_.dims.x), ny = static_cast<std::size_t>(v_.dims.y);
+            read_.fail("no piece holds grid point (" + std::to_string(extent_[0] + static_cast<int>(i % nx)) + "," +
+                       std::to_string(extent_[2] + static_cast<int>(i / nx % ny)) + "," +
+                       std::to_string(extent_[4] + static_cast<int>(i / nx / ny)) + ") of the extent read");
+        }
+    }
+
+private:
+    template <typename S>
+    void put(const S* src, const int have[6], const int box[6])
+    {
+        const std::size_t hx = static_cast<std::size_t>(have[1] - have[0] + 1), hy = static_cast<std::size_t>(have[3] - have[2] + 1);
+        const std::size_t dx = static_cast<std::size_t>(v_.dims.x), dy = static_cast<std::size_t>(v_.dims.y);
+        const std::size_t size = v_.native() ? voxelTypeSize(v_.voxelType) : sizeof(float);
+        for (int k = box[4]; k <= box[5]; ++k)
+            for (int j = box[2]; j <= box[3]; ++j) {
+                const S* row = src + (static_cast<std::size_t>(k - have[4]) * hy + static_cast<std::size_t>(j - have[2])) * hx +
+                               static_cast<std::size_t>(box[0] - have[0]);
+                const std::size_t at = (static_cast<std::size_t>(k - extent_[4]) * dy + static_cast<std::size_t>(j - extent_[2])) * dx +
+                                       static_cast<std::size_t>(box[0] - extent_[0]);
+                const std::size_t count = static_cast<std::size_t>(box[1] - box[0] + 1);
+                if (v_.native())
+                    std::memcpy(v_.voxels.data() + at * size, row, count * size);  // the same type (checked)
+                else
+                    for (std::size_t i = 0; i < count; ++i)
+                        v_.values[at + i] = static_cast<float>(row[i]);
+                std::fill(written_.begin() + static_cast<std::ptrdiff_t>(at),
+                          written_.begin() + static_cast<std::ptrdiff_t>(at + count), true);
+            }
+    }
+
+    Volume& v_;
+    CapturedRead& read_;
+    int extent_[6];
+    int type_ = -1;
+    std::string typeName_;
+    std::vector<bool> written_;
+};
+
+// Reads the points of `box` (index space) from one image file through `reader` (its information already
+// read) into `store`; the array is `scalar` by name, else the file's choice (pointScalar). Returns the
+// array's name, so that a .pvti's other pieces take the same one. `what` names a piece in messages.
+std::string readImageBox(vtkAlgorithm& reader, const int box[6], const std::string& scalar, RegionStore& store,
+                         CapturedRead& read, const std::string& what)
+{
+    const std::string prefix = what.empty() ? "" : "piece " + what + ": ";
+    try {
+        reader.UpdateExtent(box);
+    } catch (const std::bad_alloc&) {
+        read.fail("out of host memory while reading");
+    }
+    read.check();
+    vtkImageData* image = vtkImageData::SafeDownCast(reader.GetOutputDataObject(0));
+    if (!image)
+        read.fail(prefix + "no image data read");
+    int have[6];
+    image->GetExtent(have);
+    for (int a = 0; a < 3; ++a)
+        if (have[2 * a] > box[2 * a] || have[2 * a + 1] < box[2 * a + 1])
+            read.fail(prefix + "the data read covers less than the header's extent (a piece or part of the data is missing)");
+    vtkDataArray* array = pointScalar(*image, scalar, read);
+    const std::uint64_t haveCount = static_cast<std::uint64_t>(have[1] - have[0] + 1) *
+                                    static_cast<std::uint64_t>(have[3] - have[2] + 1) *
+                                    static_cast<std::uint64_t>(have[5] - have[4] + 1);
+    if (static_cast<std::uint64_t>(array->GetNumberOfTuples()) != haveCount)
+        read.fail(prefix + "point array \"" + std::string(array->GetName() ? array->GetName() : "") + "\" has " +
+                  std::to_string(array->GetNumberOfTuples()) + " values for " + std::to_string(haveCount) + " points");
+    store.copy(*array, have, box, prefix);
+    return array->GetName() ? array->GetName() : scalar;
 }
 
 }  // namespace
@@ -375,66 +499,42 @@ Volume readVtkImage(const fs::path& path, const std::string& scalar, const std::
 
     const int want[6] = {info.extent[0] + lo.x, info.extent[0] + hi.x, info.extent[2] + lo.y,
                          info.extent[2] + hi.y, info.extent[4] + lo.z, info.extent[4] + hi.z};
-    if (auto* pieces = CheckedPImageReader::SafeDownCast(reader)) {
-        const std::string missing = pieces->unreadablePiece(want);
-        if (!missing.empty())
-            read.fail("its piece " + missing + " cannot be read (missing or not a .vti file)");
-    }
-    try {
-        reader->UpdateExtent(want);
-    } catch (const std::bad_alloc&) {
-        read.fail("out of host memory while reading");
-    }
-    read.check();
-    vtkImageData* image = vtkImageData::SafeDownCast(reader->GetOutputDataObject(0));
-    if (!image)
-        read.fail("no image data read");
-    int have[6];
-    image->GetExtent(have);
-    for (int a = 0; a < 3; ++a)
-        if (have[2 * a] > want[2 * a] || have[2 * a + 1] < want[2 * a + 1])
-            read.fail("the data read covers less than the header's extent (a piece or part of the data is missing)");
-    vtkDataArray* array = pointScalar(*image, scalar, read);
-    const std::uint64_t haveCount = static_cast<std::uint64_t>(have[1] - have[0] + 1) *
-                                    static_cast<std::uint64_t>(have[3] - have[2] + 1) *
-                                    static_cast<std::uint64_t>(have[5] - have[4] + 1);
-    if (static_cast<std::uint64_t>(array->GetNumberOfTuples()) != haveCount)
-        read.fail("point array \"" + std::string(array->GetName() ? array->GetName() : "") + "\" has " +
-                  std::to_string(array->GetNumberOfTuples()) + " values for " + std::to_string(haveCount) + " points");
-
     Volume v;
     v.dims = n;
     v.spacing = info.spacing;
     v.origin = info.origin + glm::dvec3(lo) * info.spacing;
     v.source = path.string();
-    const glm::ivec3 wlo(want[0], want[2], want[4]), whi(want[1], want[3], want[5]);
-    const void* src = array->GetVoidPointer(0);
-    // 1- and 2-byte integers stay in their own type (Volume::voxels); the others become float.
-    const auto native = [&](VoxelType type, auto* typed) {
-        using T = std::remove_cv_t<std::remove_pointer_t<decltype(typed)>>;
-        v.voxelType = type;
-        v.voxels.resize(count * sizeof(T));
-        copyRegion(static_cast<const T*>(src), have, wlo, whi, reinterpret_cast<T*>(v.voxels.data()));
-    };
-    const auto floats = [&](auto* typed) {
-        using T = std::remove_cv_t<std::remove_pointer_t<decltype(typed)>>;
-        v.values.resize(count);
-        copyRegion(static_cast<const T*>(src), have, wlo, whi, v.values.data());
-    };
-    switch (array->GetDataType()) {
-    case VTK_UNSIGNED_CHAR: native(VoxelType::UInt8, static_cast<std::uint8_t*>(nullptr)); break;
-    case VTK_SIGNED_CHAR:
-    case VTK_CHAR: native(VoxelType::Int8, static_cast<std::int8_t*>(nullptr)); break;
-    case VTK_SHORT: native(VoxelType::Int16, static_cast<std::int16_t*>(nullptr)); break;
-    case VTK_UNSIGNED_SHORT: native(VoxelType::UInt16, static_cast<std::uint16_t*>(nullptr)); break;
-    case VTK_INT: floats(static_cast<std::int32_t*>(nullptr)); break;
-    case VTK_UNSIGNED_INT: floats(static_cast<std::uint32_t*>(nullptr)); break;
-    case VTK_FLOAT: floats(static_cast<float*>(nullptr)); break;
-    case VTK_DOUBLE: floats(static_cast<double*>(nullptr)); break;
-    default:
-        read.fail("point array \"" + std::string(array->GetName() ? array->GetName() : "") + "\" has type " +
-                  array->GetDataTypeAsString() + " (clvr reads 8-, 16- and 32-bit integers, float32 and float64)");
+    RegionStore store(v, want, read);
+    auto* pieces = CheckedPImageReader::SafeDownCast(reader);
+    if (!pieces) {  // one file: VTK reads the region's rows or blocks of it
+        readImageBox(*reader, want, scalar, store, read, "");
+    } else {
+        // A .pvti: each piece that meets the region read on its own and copied here, never by VTK's parallel
+        // reader, whose copy trusts the summary's types and extents (a piece of another type than the
+        // summary says overflowed its buffer under fuzzing: fuzz/regressions/vti).
+        std::string name = scalar;
+        for (int i = 0; i < pieces->pieceCount(); ++i) {
+            const int* e = pieces->pieceExtent(i);
+            int box[6];
+            bool meets = true;
+            for (int a = 0; a < 3; ++a) {
+                box[2 * a] = std::max(e[2 * a], want[2 * a]);
+                box[2 * a + 1] = std::min(e[2 * a + 1], want[2 * a + 1]);
+                meets = meets && box[2 * a] <= box[2 * a + 1];
+            }
+            if (!meets)
+                continue;
+            const std::string file = pieces->pieceFile(i);
+            if (file.empty())
+                read.fail("its piece " + pieces->unreadablePiece(box) + " cannot be read (missing or not a .vti file)");
+            auto piece = vtkSmartPointer<vtkXMLImageDataReader>::New();
+            piece->SetFileName(file.c_str());
+            piece->UpdateInformation();
+            read.check();
+            name = readImageBox(*piece, box, name, store, read, fs::path(file).filename().string());
+        }
     }
+    store.checkCovered();
     v.validate();
     return v;
 }
