@@ -178,17 +178,10 @@ Volume cutGridPart(const Volume& volume, const GridPartition& partition, int p, 
     part.part = gridPartPlacement(partition, volume.dims, volume.origin, p, ghost);
     // The rows of the part, in the volume's own storage (float32 or native voxels).
     part.voxelType = volume.voxelType;
+    part.allocateValues();
     const std::size_t size = voxelTypeSize(volume.voxelType);
-    const unsigned char* from = volume.native() ? volume.voxels.data()
-                                                : reinterpret_cast<const unsigned char*>(volume.values.data());
-    unsigned char* to = nullptr;
-    if (part.native()) {
-        part.voxels.resize(part.voxelCount() * size);
-        to = part.voxels.data();
-    } else {
-        part.values.resize(part.voxelCount());
-        to = reinterpret_cast<unsigned char*>(part.values.data());
-    }
+    const std::uint8_t* from = volume.valueData();
+    std::uint8_t* to = part.valueData();
     std::size_t i = 0;
     for (int k = lo.z; k <= hi.z; ++k)
         for (int j = lo.y; j <= hi.y; ++j) {

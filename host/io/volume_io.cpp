@@ -687,13 +687,9 @@ std::optional<glm::dvec3> parseVector(const std::string& s)
 
 // Reads one data file's share of the samples (or the attached data) and appends them to `out`. Every size
 // is checked before `out` grows, so a corrupt header cannot make it allocate more than the file can hold.
-void readNrrdData(const NrrdHeader& h, const fs::path& file, std::uint64_t start, std::uint64_t count,
-                  std::vector<float>& out, glm::ivec3 dims, const std::string& sizeText)
+// Skips the header's line skip from `start` of `file`'s stream `in`; the position after it.
+std::uint64_t skipLines(std::ifstream& in, const NrrdHeader& h, const std::string& source, std::uint64_t start)
 {
-    const std::string source = file.string();
-    const std::uint64_t size = fileSize(file);
-    const std::uint64_t first = out.size();  // index of this file's first sample, for messages
-    std::ifstream in = openBinary(file);
     in.seekg(static_cast<std::streamoff>(start));
     for (long long l = 0; l < h.lineSkip; ++l) {
         int c;
@@ -702,17 +698,33 @@ void readNrrdData(const NrrdHeader& h, const fs::path& file, std::uint64_t start
         if (c == EOF)
             throw InputError(source + ": line skip " + std::to_string(h.lineSkip) + " goes past the end of the file");
     }
-    std::uint64_t pos = static_cast<std::uint64_t>(static_cast<std::streamoff>(in.tellg()));
+    return static_cast<std::uint64_t>(static_cast<std::streamoff>(in.tellg()));
+}
+
+// "FILE: header says ..., file has N bytes after the P-byte header": a data file shorter than its samples.
+InputError nrrdTooShort(const NrrdHeader& h, const std::string& source, const std::string& sizeText,
+                        std::uint64_t available, std::uint64_t header)
+{
+    return InputError(source + ": " + sizeText + ", file has " + std::to_string(available) + " bytes" +
+                      (header == 0                            ? std::string()
+                       : h.byteSkip == 0 && h.lineSkip == 0 ? " after the " + std::to_string(header) + "-byte header"
+                                                            : " after " + std::to_string(header) +
+                                                                  " bytes of header and skips"));
+}
+
+void readNrrdData(const NrrdHeader& h, const fs::path& file, std::uint64_t start, std::uint64_t count,
+                  std::vector<float>& out, glm::ivec3 dims, const std::string& sizeText)
+{
+    const std::string source = file.string();
+    const std::uint64_t size = fileSize(file);
+    const std::uint64_t first = out.size();  // index of this file's first sample, for messages
+    std::ifstream in = openBinary(file);
+    std::uint64_t pos = skipLines(in, h, source, start);
     const std::size_t elem = scalarSize(*h.type);
     const std::uint64_t bytes = count * elem;
     const Endian endian = h.endian.value_or(Endian::Little);
-    auto tooShort = [&](std::uint64_t available) {
-        return InputError(source + ": " + sizeText + ", file has " + std::to_string(available) + " bytes" +
-                          (pos == 0                               ? std::string()
-                           : h.byteSkip == 0 && h.lineSkip == 0 ? " after the " + std::to_string(pos) + "-byte header"
-                                                                : " after " + std::to_string(pos) +
-                                                                      " bytes of header and skips"));
-    };
+    const std::uint64_t header = pos;
+    auto tooShort = [&](std::uint64_t available) { return nrrdTooShort(h, source, sizeText, available, header); };
 
     if (*h.encoding == NrrdEncoding::Raw) {
         if (h.byteSkip == -1) {  // the data is the last `bytes` of the file
@@ -902,6 +914,28 @@ Volume nrrdGeometry(const NrrdHeader& h, std::uint64_t& count)
 
 Volume readRawRegion(const fs::path& path, const RawLayout& layout, const GridRegion& region, bool exactSize = true);
 
+// A region of a grid with `dims` points as runs of samples contiguous in the file (x fastest): one run per row
+// of the region, or per z plane where the region spans whole rows and planes. `starts`: each run's first
+// sample, in file order.
+struct RegionRuns {
+    std::uint64_t length = 0;
+    std::vector<std::uint64_t> starts;
+};
+
+RegionRuns regionRuns(const glm::ivec3& dims, const GridRegion& region)
+{
+    const glm::ivec3 n = region.dims();
+    const std::uint64_t nx = static_cast<std::uint64_t>(dims.x), ny = static_cast<std::uint64_t>(dims.y);
+    const bool wholePlanes = n.x == dims.x && n.y == dims.y;
+    RegionRuns runs;
+    runs.length = wholePlanes ? nx * ny : static_cast<std::uint64_t>(n.x);
+    for (int k = region.lo.z; k <= region.hi.z; ++k)
+        for (int j = region.lo.y; j <= region.hi.y; j += wholePlanes ? n.y : 1)
+            runs.starts.push_back((static_cast<std::uint64_t>(k) * ny + static_cast<std::uint64_t>(j)) * nx +
+                                  static_cast<std::uint64_t>(region.lo.x));
+    return runs;
+}
+
 // Where the samples of a NRRD with one data stream (attached, or one detached file) lie, raw or gzip: the
 // layout of its samples as a raw file (raw: headerBytes is the first sample's byte after line and byte skips;
 // gzip: where the compressed data starts after the line skip, its byte skip applying to the inflated data).
@@ -914,10 +948,8 @@ struct NrrdStream {
     std::string sizeText;  // "header says 5x4x6 x 2 bytes = 240 bytes", for messages
 };
 
-std::optional<NrrdStream> nrrdStream(const NrrdHeader& h)
+std::optional<NrrdStream> nrrdStream(const NrrdHeader& h, const Volume& geometry, std::uint64_t count)
 {
-    std::uint64_t count = 0;
-    const Volume geometry = nrrdGeometry(h, count);
     if (*h.encoding == NrrdEncoding::Ascii || dataFileCount(h) > 1)
         return std::nullopt;
     NrrdStream st;
@@ -928,15 +960,7 @@ std::optional<NrrdStream> nrrdStream(const NrrdHeader& h)
     std::uint64_t pos = dataFileCount(h) == 0 ? h.dataOffset : 0;
     if (h.lineSkip > 0) {
         std::ifstream in = openBinary(st.file);
-        in.seekg(static_cast<std::streamoff>(pos));
-        for (long long l = 0; l < h.lineSkip; ++l) {
-            int c;
-            while ((c = in.get()) != EOF && c != '\n') {
-            }
-            if (c == EOF)
-                throw InputError(source + ": line skip " + std::to_string(h.lineSkip) + " goes past the end of the file");
-        }
-        pos = static_cast<std::uint64_t>(static_cast<std::streamoff>(in.tellg()));
+        pos = skipLines(in, h, source, pos);
     }
     const std::size_t elem = scalarSize(*h.type);
     const std::uint64_t bytes = count * elem;
@@ -955,13 +979,7 @@ std::optional<NrrdStream> nrrdStream(const NrrdHeader& h)
         return st;
     }
     const std::uint64_t header = pos;
-    const auto tooShort = [&](std::uint64_t available) {
-        return InputError(source + ": " + st.sizeText + ", file has " + std::to_string(available) + " bytes" +
-                          (header == 0 ? std::string()
-                           : h.byteSkip == 0 && h.lineSkip == 0 ? " after the " + std::to_string(header) + "-byte header"
-                                                                : " after " + std::to_string(header) +
-                                                                      " bytes of header and skips"));
-    };
+    const auto tooShort = [&](std::uint64_t available) { return nrrdTooShort(h, source, st.sizeText, available, header); };
     if (h.byteSkip == -1) {  // the data is the last `bytes` of the file
         if (size < bytes || size - bytes < pos)
             throw tooShort(size > pos ? size - pos : 0);
@@ -992,7 +1010,7 @@ Volume readNrrd(const fs::path& path)
     std::uint64_t count = 0;
     Volume v = nrrdGeometry(h, count);
     v.source = source;
-    if (const auto stream = nrrdStream(h)) {  // one raw or gzip stream: integers kept in their own type
+    if (const auto stream = nrrdStream(h, v, count)) {  // one raw or gzip stream: integers kept in their own type
         Volume whole = readNrrdRegion(*stream, GridRegion{glm::ivec3(0), v.dims - 1});
         whole.source = source;
         return whole;
@@ -1036,39 +1054,11 @@ Volume readNrrd(const fs::path& path)
 Volume readRaw(const fs::path& path, const RawLayout& layout)
 {
     const std::string source = path.string();
-    const std::vector<long long> sizes{layout.dims.x, layout.dims.y, layout.dims.z};
-    const std::uint64_t count = checkedVoxelCount(source, sizes);
+    checkedVoxelCount(source, {layout.dims.x, layout.dims.y, layout.dims.z});  // with the memory check
     for (int a = 0; a < 3; ++a)
         if (!(layout.spacing[a] > 0.0) || !std::isfinite(layout.spacing[a]))
             throw InputError(source + ": spacing of axis " + std::to_string(a) + " must be a positive finite number");
-    const std::size_t elem = scalarSize(layout.type);
-    const std::uint64_t bytes = count * elem;
-    const std::uint64_t size = fileSize(path);
-    if (layout.headerBytes > kMaxVoxels * 8 || size != layout.headerBytes + bytes)
-        throw InputError(source + ": layout says " + dimsText(sizes) + " x " + std::to_string(elem) + " bytes" +
-                         (layout.headerBytes ? " + " + std::to_string(layout.headerBytes) + " header bytes" : "") +
-                         " = " + std::to_string(layout.headerBytes + bytes) + " bytes, file has " +
-                         std::to_string(size) + " bytes");
-    std::ifstream in = openBinary(path);
-    Volume v;
-    v.source = source;
-    v.dims = layout.dims;
-    v.spacing = layout.spacing;
-    v.origin = layout.origin;
-    if (const std::optional<VoxelType> native = nativeVoxelType(layout.type)) {  // read straight into place
-        v.voxelType = *native;
-        v.voxels.resize(static_cast<std::size_t>(bytes));
-        readExactly(in, path, layout.headerBytes, reinterpret_cast<char*>(v.voxels.data()), bytes);
-        toHostOrder(v.voxels.data(), static_cast<std::size_t>(count), elem, layout.endian);
-    } else {
-        std::vector<unsigned char> raw(static_cast<std::size_t>(bytes));
-        readExactly(in, path, layout.headerBytes, reinterpret_cast<char*>(raw.data()), bytes);
-        v.values.resize(static_cast<std::size_t>(count));
-        convertSamples(source, raw.data(), static_cast<std::size_t>(count), layout.type, layout.endian,
-                       v.values.data(), 0, v.dims);
-    }
-    v.validate();
-    return v;
+    return readRawRegion(path, layout, GridRegion{glm::ivec3(0), layout.dims - 1});
 }
 
 namespace {
@@ -1171,25 +1161,32 @@ NpyHeader readNpyHeader(const fs::path& path)
     return h;
 }
 
+// A .npy's samples as a raw file: its grid (shape x, y, z) in Fortran order; in C order (z fastest) the
+// same bytes as a grid with the axes reversed, which readNpy transposes.
+RawLayout npyLayout(const NpyHeader& h, const glm::dvec3& spacing, const glm::dvec3& origin)
+{
+    RawLayout layout;
+    const glm::ivec3 dims(static_cast<int>(h.shape[0]), static_cast<int>(h.shape[1]), static_cast<int>(h.shape[2]));
+    layout.dims = h.fortranOrder ? dims : glm::ivec3(dims.z, dims.y, dims.x);
+    layout.type = h.type;
+    layout.endian = h.endian;
+    layout.spacing = spacing;
+    layout.origin = origin;
+    layout.headerBytes = h.dataOffset;
+    return layout;
+}
+
 }  // namespace
 
 Volume readNpy(const fs::path& path, const glm::dvec3& spacing, const glm::dvec3& origin)
 {
     const NpyHeader h = readNpyHeader(path);
     checkedVoxelCount(path.string(), h.shape);
-    RawLayout layout;
-    layout.type = h.type;
-    layout.endian = h.endian;
-    layout.spacing = spacing;
-    layout.origin = origin;
-    layout.headerBytes = h.dataOffset;
-    const glm::ivec3 dims(static_cast<int>(h.shape[0]), static_cast<int>(h.shape[1]), static_cast<int>(h.shape[2]));
-    if (h.fortranOrder) {  // x fastest in memory: clvr's own layout
-        layout.dims = dims;
+    const RawLayout layout = npyLayout(h, spacing, origin);
+    if (h.fortranOrder)  // x fastest in memory: clvr's own layout
         return readRaw(path, layout);
-    }
     // C order: z fastest. Read as a raw grid with the axes reversed, then transpose to x fastest.
-    layout.dims = glm::ivec3(dims.z, dims.y, dims.x);
+    const glm::ivec3 dims(layout.dims.z, layout.dims.y, layout.dims.x);
     Volume reversed = readRaw(path, layout);
     Volume v;
     v.source = reversed.source;
@@ -1197,17 +1194,10 @@ Volume readNpy(const fs::path& path, const glm::dvec3& spacing, const glm::dvec3
     v.spacing = spacing;
     v.origin = origin;
     v.voxelType = reversed.voxelType;
+    v.allocateValues();
     const std::size_t size = voxelTypeSize(v.voxelType);
-    const unsigned char* from = reversed.native() ? reversed.voxels.data()
-                                                  : reinterpret_cast<const unsigned char*>(reversed.values.data());
-    unsigned char* to = nullptr;
-    if (v.native()) {
-        v.voxels.resize(reversed.voxels.size());
-        to = v.voxels.data();
-    } else {
-        v.values.resize(reversed.values.size());
-        to = reinterpret_cast<unsigned char*>(v.values.data());
-    }
+    const std::uint8_t* from = reversed.valueData();
+    std::uint8_t* to = v.valueData();
     const std::size_t nx = static_cast<std::size_t>(dims.x), ny = static_cast<std::size_t>(dims.y),
                       nz = static_cast<std::size_t>(dims.z);
     std::size_t src = 0;
@@ -1434,35 +1424,25 @@ Volume readRawRegion(const fs::path& path, const RawLayout& layout, const GridRe
     v.spacing = layout.spacing;
     v.origin = layout.origin + glm::dvec3(region.lo) * layout.spacing;
     const std::optional<VoxelType> native = nativeVoxelType(layout.type);
-    if (native) {  // 1- and 2-byte integers in their own type, read straight into place
+    if (native)  // 1- and 2-byte integers in their own type, read straight into place
         v.voxelType = *native;
-        v.voxels.resize(static_cast<std::size_t>(count * elem));
-    } else {
-        v.values.resize(static_cast<std::size_t>(count));
-    }
+    v.allocateValues();
     std::ifstream in = openBinary(path);
-    // One read per run of contiguous samples: a whole plane's rows when the region spans x and y.
-    const bool wholeRows = n.x == layout.dims.x, wholePlanes = wholeRows && n.y == layout.dims.y;
-    const std::uint64_t run = wholePlanes ? static_cast<std::uint64_t>(n.x) * static_cast<std::uint64_t>(n.y)
-                                          : static_cast<std::uint64_t>(n.x);
-    std::vector<unsigned char> buffer(native ? 0 : static_cast<std::size_t>(run * elem));
-    std::size_t at = 0;  // samples stored so far
-    for (int k = region.lo.z; k <= region.hi.z; ++k)
-        for (int j = region.lo.y; j <= region.hi.y; j += wholePlanes ? n.y : 1) {
-            const std::uint64_t first = (static_cast<std::uint64_t>(k) * ny + static_cast<std::uint64_t>(j)) * nx +
-                                        static_cast<std::uint64_t>(region.lo.x);
-            if (native) {
-                unsigned char* dst = v.voxels.data() + at * elem;
-                readExactly(in, path, layout.headerBytes + first * elem, reinterpret_cast<char*>(dst), run * elem);
-                toHostOrder(dst, static_cast<std::size_t>(run), elem, layout.endian);
-            } else {
-                readExactly(in, path, layout.headerBytes + first * elem, reinterpret_cast<char*>(buffer.data()),
-                            run * elem);
-                convertSamples(source, buffer.data(), static_cast<std::size_t>(run), layout.type, layout.endian,
-                               v.values.data() + at, first, layout.dims);
-            }
-            at += static_cast<std::size_t>(run);
+    const RegionRuns runs = regionRuns(layout.dims, region);
+    std::vector<unsigned char> buffer(native ? 0 : static_cast<std::size_t>(runs.length * elem));
+    for (std::size_t r = 0; r < runs.starts.size(); ++r) {
+        const std::uint64_t first = runs.starts[r], at = r * runs.length;  // in the file, in the region
+        if (native) {
+            std::uint8_t* dst = v.valueData() + at * elem;
+            readExactly(in, path, layout.headerBytes + first * elem, reinterpret_cast<char*>(dst), runs.length * elem);
+            toHostOrder(dst, static_cast<std::size_t>(runs.length), elem, layout.endian);
+        } else {
+            readExactly(in, path, layout.headerBytes + first * elem, reinterpret_cast<char*>(buffer.data()),
+                        runs.length * elem);
+            convertSamples(source, buffer.data(), static_cast<std::size_t>(runs.length), layout.type, layout.endian,
+                           v.values.data() + at, first, layout.dims);
         }
+    }
     v.validate();
     return v;
 }
@@ -1489,14 +1469,9 @@ Volume readGzipRegion(const NrrdStream& st, const GridRegion& region)
     const glm::ivec3 n = region.dims();
     const std::uint64_t count = static_cast<std::uint64_t>(n.x) * static_cast<std::uint64_t>(n.y) * static_cast<std::uint64_t>(n.z);
     checkHostMemoryForVoxels(source, count);
-    // The region's runs of contiguous samples in the inflated data (a whole plane's rows where it spans x and y).
-    const bool wholePlanes = n.x == layout.dims.x && n.y == layout.dims.y;
-    const std::uint64_t run = wholePlanes ? nx * ny : static_cast<std::uint64_t>(n.x);
-    std::vector<std::uint64_t> runStart;  // first sample of each run
-    for (int k = region.lo.z; k <= region.hi.z; ++k)
-        for (int j = region.lo.y; j <= region.hi.y; j += wholePlanes ? n.y : 1)
-            runStart.push_back((static_cast<std::uint64_t>(k) * ny + static_cast<std::uint64_t>(j)) * nx +
-                               static_cast<std::uint64_t>(region.lo.x));
+    const RegionRuns runs = regionRuns(layout.dims, region);
+    const std::uint64_t run = runs.length;
+    const std::vector<std::uint64_t>& runStart = runs.starts;
     std::vector<unsigned char> bytes(static_cast<std::size_t>(count * elem));
     std::size_t next = 0;  // the first run not yet complete
     std::ifstream in = openBinary(st.file);
@@ -1543,58 +1518,68 @@ Volume readGzipRegion(const NrrdStream& st, const GridRegion& region)
 
 }  // namespace
 
-std::optional<GridHeader> volumeHeader(const VolumeSpec& spec)
+namespace {
+
+// A volume that reads by regions: its grid from the header, read once, and the reader of a region of it.
+struct RegionReader {
+    GridHeader header;
+    std::function<Volume(const GridRegion&)> read;
+};
+
+std::optional<RegionReader> regionReader(const VolumeSpec& spec)
 {
     switch (spec.kind) {
-    case VolumeSpec::Kind::Raw: return GridHeader{spec.raw.dims, spec.raw.spacing, spec.raw.origin};
+    case VolumeSpec::Kind::Raw:
+        return RegionReader{{spec.raw.dims, spec.raw.spacing, spec.raw.origin},
+                            [spec](const GridRegion& r) { return readRawRegion(spec.file, spec.raw, r); }};
     case VolumeSpec::Kind::Npy: {
         const NpyHeader h = readNpyHeader(spec.file);
         if (!h.fortranOrder)
             return std::nullopt;
         checkedVoxelCount(spec.file.string(), h.shape, false);
-        return GridHeader{glm::ivec3(static_cast<int>(h.shape[0]), static_cast<int>(h.shape[1]), static_cast<int>(h.shape[2])),
-                          spec.raw.spacing, spec.raw.origin};
+        const RawLayout layout = npyLayout(h, spec.raw.spacing, spec.raw.origin);
+        return RegionReader{{layout.dims, layout.spacing, layout.origin},
+                            [file = spec.file, layout](const GridRegion& r) { return readRawRegion(file, layout, r); }};
     }
-    case VolumeSpec::Kind::VtkImage: return readVtkImageHeader(spec.file);
+    case VolumeSpec::Kind::VtkImage:
+        return RegionReader{readVtkImageHeader(spec.file),
+                            [spec](const GridRegion& r) { return readVtkImage(spec.file, spec.scalar, r); }};
     case VolumeSpec::Kind::Nrrd: {
-        const auto stream = nrrdStream(readNrrdHeader(spec.file));
+        const NrrdHeader h = readNrrdHeader(spec.file);
+        std::uint64_t count = 0;
+        const Volume geometry = nrrdGeometry(h, count);
+        std::optional<NrrdStream> stream = nrrdStream(h, geometry, count);
         if (!stream)
             return std::nullopt;
-        return GridHeader{stream->layout.dims, stream->layout.spacing, stream->layout.origin};
+        return RegionReader{{geometry.dims, geometry.spacing, geometry.origin},
+                            [st = std::move(*stream), source = spec.file.string()](const GridRegion& r) {
+                                Volume v = readNrrdRegion(st, r);
+                                v.source = source;
+                                return v;
+                            }};
     }
     default: return std::nullopt;
     }
 }
 
+}  // namespace
+
+std::optional<GridHeader> volumeHeader(const VolumeSpec& spec)
+{
+    const std::optional<RegionReader> reader = regionReader(spec);
+    return reader ? std::optional<GridHeader>(reader->header) : std::nullopt;
+}
+
 Volume loadVolumeRegion(const VolumeSpec& spec, const GridRegion& region)
 {
-    const std::optional<GridHeader> header = volumeHeader(spec);
-    if (!header)
+    const std::optional<RegionReader> reader = regionReader(spec);
+    if (!reader)
         throw InternalError("loadVolumeRegion: " + spec.file.string() + " cannot be read by regions");
-    if (glm::any(glm::lessThan(region.lo, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(region.hi, header->dims)) ||
+    const glm::ivec3 dims = reader->header.dims;
+    if (glm::any(glm::lessThan(region.lo, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(region.hi, dims)) ||
         glm::any(glm::lessThan(region.hi, region.lo)))
         throw InternalError("loadVolumeRegion: a region outside the grid of " + spec.file.string());
-    switch (spec.kind) {
-    case VolumeSpec::Kind::Raw: return readRawRegion(spec.file, spec.raw, region);
-    case VolumeSpec::Kind::Npy: {
-        const NpyHeader h = readNpyHeader(spec.file);
-        RawLayout layout;
-        layout.dims = header->dims;
-        layout.type = h.type;
-        layout.endian = h.endian;
-        layout.spacing = spec.raw.spacing;
-        layout.origin = spec.raw.origin;
-        layout.headerBytes = h.dataOffset;
-        return readRawRegion(spec.file, layout, region);
-    }
-    case VolumeSpec::Kind::VtkImage: return readVtkImage(spec.file, spec.scalar, region);
-    case VolumeSpec::Kind::Nrrd: {
-        Volume v = readNrrdRegion(*nrrdStream(readNrrdHeader(spec.file)), region);  // volumeHeader said it has one
-        v.source = spec.file.string();
-        return v;
-    }
-    default: throw InternalError("loadVolumeRegion: unreachable");
-    }
+    return reader->read(region);
 }
 
 Volume loadVolume(const nlohmann::json& spec, const fs::path& baseDir)

@@ -365,10 +365,7 @@ public:
                 read_.fail(what + "point array \"" + std::string(array.GetName() ? array.GetName() : "") + "\" has type " +
                            array.GetDataTypeAsString() + " (clvr reads 8-, 16- and 32-bit integers, float32 and float64)");
             }
-            if (v_.native())
-                v_.voxels.resize(v_.voxelCount() * voxelTypeSize(v_.voxelType));
-            else
-                v_.values.resize(v_.voxelCount());
+            v_.allocateValues();
         } else if (type != type_) {
             read_.fail(what + "point array \"" + std::string(array.GetName() ? array.GetName() : "") + "\" has type " +
                        array.GetDataTypeAsString() + ", another piece's has " + typeName_);
@@ -405,7 +402,7 @@ private:
     {
         const std::size_t hx = static_cast<std::size_t>(have[1] - have[0] + 1), hy = static_cast<std::size_t>(have[3] - have[2] + 1);
         const std::size_t dx = static_cast<std::size_t>(v_.dims.x), dy = static_cast<std::size_t>(v_.dims.y);
-        const std::size_t size = v_.native() ? voxelTypeSize(v_.voxelType) : sizeof(float);
+        const std::size_t size = voxelTypeSize(v_.voxelType);
         for (int k = box[4]; k <= box[5]; ++k)
             for (int j = box[2]; j <= box[3]; ++j) {
                 const S* row = src + (static_cast<std::size_t>(k - have[4]) * hy + static_cast<std::size_t>(j - have[2])) * hx +
@@ -414,7 +411,7 @@ private:
                                        static_cast<std::size_t>(box[0] - extent_[0]);
                 const std::size_t count = static_cast<std::size_t>(box[1] - box[0] + 1);
                 if (v_.native())
-                    std::memcpy(v_.voxels.data() + at * size, row, count * size);  // the same type (checked)
+                    std::memcpy(v_.valueData() + at * size, row, count * size);  // the same type (checked)
                 else
                     for (std::size_t i = 0; i < count; ++i)
                         v_.values[at + i] = static_cast<float>(row[i]);

@@ -95,6 +95,24 @@ float Volume::value(std::size_t index) const
     return values[index];
 }
 
+void Volume::allocateValues()
+{
+    if (native())
+        voxels.resize(voxelCount() * voxelTypeSize(voxelType));
+    else
+        values.resize(voxelCount());
+}
+
+std::uint8_t* Volume::valueData()
+{
+    return native() ? voxels.data() : reinterpret_cast<std::uint8_t*>(values.data());
+}
+
+const std::uint8_t* Volume::valueData() const
+{
+    return native() ? voxels.data() : reinterpret_cast<const std::uint8_t*>(values.data());
+}
+
 const std::vector<float>& Volume::floats(std::vector<float>& scratch) const
 {
     if (!native())

@@ -87,6 +87,12 @@ struct Volume {
     const std::vector<float>& floats(std::vector<float>& scratch) const;
     // Host bytes of the values: 4 per grid point as float32, 1 or 2 as native voxels.
     std::uint64_t valueBytes() const { return values.size() * sizeof(float) + voxels.size(); }
+    // Sizes the storage voxelType names for voxelCount() values (the other one left empty), and the values'
+    // bytes in it, x fastest, voxelTypeSize(voxelType) bytes each: for code that moves values whatever their
+    // type (cutting parts, transposing, copying pieces in).
+    void allocateValues();
+    std::uint8_t* valueData();
+    const std::uint8_t* valueData() const;
     // Trilinear reconstruction at a world position; nullopt outside the bounds.
     std::optional<double> sample(const glm::dvec3& p) const;
     // Smallest and largest value.
