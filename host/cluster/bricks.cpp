@@ -23,13 +23,14 @@ public:
             throw InternalError("makeBrickedRenderer: " + t.name + " does not render a part");
         Scene partScene = scene;
         partScene.image.background = glm::dvec3(0.0);  // premultiplied bricks; the background goes on last
+        std::string lastError;  // why the last brick count did not fit
         for (int n = 2;; n *= 2) {
             GridPartition partition;
             try {
                 partition = partitionGrid(volume.dims, volume.origin, volume.spacing, n);
             } catch (const InputError&) {
                 throw DeviceError("out of device memory: " + volume.source + " does not fit " + device.listing().name +
-                                  " even in " + std::to_string(n / 2) + " bricks (" + lastError_ + ")");
+                                  " even in " + std::to_string(n / 2) + " bricks (" + lastError + ")");
             }
             bricks_.clear();
             try {
@@ -42,7 +43,7 @@ public:
             } catch (const DeviceError& e) {
                 if (!isOutOfDeviceMemory(e))
                     throw;
-                lastError_ = e.what();
+                lastError = e.what();
                 continue;  // smaller bricks
             }
             tree_ = partition.tree;
@@ -110,7 +111,6 @@ private:
     KdTree tree_;
     Camera camera_;
     glm::dvec3 background_;
-    std::string lastError_;  // why the last brick count did not fit
 };
 
 }  // namespace
