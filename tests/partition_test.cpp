@@ -13,7 +13,6 @@
 #include "tests/support/test_util.h"
 
 #include <nlohmann/json.hpp>
-#include <zlib.h>
 
 #include <algorithm>
 #include <cmath>
@@ -201,22 +200,9 @@ TEST(Partition, PartReadByItselfEqualsPartCutFromTheWhole)
     test::writeFile(dir / "detached.nhdr", "NRRD0004\ntype: uint16\ndimension: 3\nsizes: 13 9 11\nendian: little\n"
                                            "encoding: raw\nbyte skip: 7\ndata file: skip.data\n");
     // NRRD, gzip: attached, with a byte skip inside the inflated data, in two gzip members.
-    const auto gzip = [](const std::string& data) {
-        z_stream z{};
-        EXPECT_EQ(deflateInit2(&z, 6, Z_DEFLATED, 16 + MAX_WBITS, 8, Z_DEFAULT_STRATEGY), Z_OK);
-        std::string out(deflateBound(&z, static_cast<uLong>(data.size())) + 64, '\0');
-        z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data.data()));
-        z.avail_in = static_cast<uInt>(data.size());
-        z.next_out = reinterpret_cast<Bytef*>(out.data());
-        z.avail_out = static_cast<uInt>(out.size());
-        EXPECT_EQ(deflate(&z, Z_FINISH), Z_STREAM_END);
-        out.resize(z.total_out);
-        deflateEnd(&z);
-        return out;
-    };
     test::writeFile(dir / "gz.nrrd", "NRRD0004\ntype: uint16\ndimension: 3\nsizes: 13 9 11\nendian: little\n"
                                      "encoding: gzip\nbyte skip: 5\nspacings: 0.5 1 2\n\n" +
-                                         gzip("skip!" + raw16.substr(0, 1000)) + gzip(raw16.substr(1000)));
+                                         test::gzip("skip!" + raw16.substr(0, 1000)) + test::gzip(raw16.substr(1000)));
     const std::vector<nlohmann::json> specs = {
         {{"file", "gz.nrrd"}},
         {{"file", "attached.nrrd"}},

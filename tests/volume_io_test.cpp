@@ -29,6 +29,8 @@ using clvr::ScalarType;
 
 namespace {
 
+using clvr::test::gzip;
+using clvr::test::throwsInputError;
 using clvr::test::readFile;
 using clvr::test::TempDir;
 using clvr::test::writeFile;
@@ -62,22 +64,6 @@ std::string encode(ScalarType type, const std::vector<double>& values, Endian en
     case ScalarType::Float64: return encode<double>(values, endian);
     }
     return {};
-}
-
-// gzip (not zlib) framing, as NRRD's gzip encoding writes it.
-std::string gzip(const std::string& data)
-{
-    z_stream z{};
-    EXPECT_EQ(deflateInit2(&z, 6, Z_DEFLATED, 16 + MAX_WBITS, 8, Z_DEFAULT_STRATEGY), Z_OK);
-    std::string out(deflateBound(&z, data.size()) + 64, '\0');
-    z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data.data()));
-    z.avail_in = static_cast<uInt>(data.size());
-    z.next_out = reinterpret_cast<Bytef*>(out.data());
-    z.avail_out = static_cast<uInt>(out.size());
-    EXPECT_EQ(deflate(&z, Z_FINISH), Z_STREAM_END);
-    out.resize(z.total_out);
-    deflateEnd(&z);
-    return out;
 }
 
 // Decompresses a whole gzip file with zlib's gz* interface (not the reader's inflate loop).
@@ -143,25 +129,6 @@ std::string nrrdHeader(const std::string& type, const std::string& extra, const 
 {
     return "NRRD0004\n# written by volume_io_test\ntype: " + type + "\ndimension: 3\nsizes: 5 4 6\n" +
            "spacings: 0.5 0.25 2\nendian: " + endian + "\nencoding: " + encoding + "\n" + extra;
-}
-
-// The call throws InputError with one line that contains every piece.
-testing::AssertionResult throwsInputError(const std::function<void()>& call, std::vector<std::string> pieces)
-{
-    try {
-        call();
-    } catch (const clvr::InputError& e) {
-        const std::string what = e.what();
-        if (what.find('\n') != std::string::npos)
-            return testing::AssertionFailure() << "message has more than one line: " << what;
-        for (const std::string& p : pieces)
-            if (what.find(p) == std::string::npos)
-                return testing::AssertionFailure() << "message lacks \"" << p << "\": " << what;
-        return testing::AssertionSuccess() << what;
-    } catch (const std::exception& e) {
-        return testing::AssertionFailure() << "threw something other than InputError: " << e.what();
-    }
-    return testing::AssertionFailure() << "did not throw";
 }
 
 // ------------------------------------------------------------------------------------------------

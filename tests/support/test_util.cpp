@@ -2,7 +2,10 @@
 #include "tests/support/test_util.h"
 
 #include "host/io/image_io.h"
+#include "host/runtime/errors.h"
 #include "host/reference/reference_integral.h"
+
+#include <zlib.h>
 
 #include <cmath>
 #include <cstdio>
@@ -231,6 +234,39 @@ std::string readFile(const std::filesystem::path& path)
     std::ostringstream s;
     s << in.rdbuf();
     return s.str();
+}
+
+std::string gzip(const std::string& data)
+{
+    z_stream z{};
+    EXPECT_EQ(deflateInit2(&z, 6, Z_DEFLATED, 16 + MAX_WBITS, 8, Z_DEFAULT_STRATEGY), Z_OK);
+    std::string out(deflateBound(&z, data.size()) + 64, '\0');
+    z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data.data()));
+    z.avail_in = static_cast<uInt>(data.size());
+    z.next_out = reinterpret_cast<Bytef*>(out.data());
+    z.avail_out = static_cast<uInt>(out.size());
+    EXPECT_EQ(deflate(&z, Z_FINISH), Z_STREAM_END);
+    out.resize(z.total_out);
+    deflateEnd(&z);
+    return out;
+}
+
+testing::AssertionResult throwsInputError(const std::function<void()>& call, std::vector<std::string> pieces)
+{
+    try {
+        call();
+    } catch (const clvr::InputError& e) {
+        const std::string what = e.what();
+        if (what.find('\n') != std::string::npos)
+            return testing::AssertionFailure() << "message has more than one line: " << what;
+        for (const std::string& p : pieces)
+            if (what.find(p) == std::string::npos)
+                return testing::AssertionFailure() << "message lacks \"" << p << "\": " << what;
+        return testing::AssertionSuccess() << what;
+    } catch (const std::exception& e) {
+        return testing::AssertionFailure() << "threw something other than InputError: " << e.what();
+    }
+    return testing::AssertionFailure() << "did not throw";
 }
 
 std::uint64_t Rng::next()

@@ -19,6 +19,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace clvr::test {
 
@@ -102,6 +103,12 @@ private:
 // Whole-file binary write (asserting success) and read.
 void writeFile(const std::filesystem::path& path, const std::string& bytes);
 std::string readFile(const std::filesystem::path& path);
+
+// The call throws InputError with one line that contains every piece (the readers' promise for bad input).
+testing::AssertionResult throwsInputError(const std::function<void()>& call, std::vector<std::string> pieces);
+
+// `data` deflated with gzip (not zlib) framing, as NRRD's gzip encoding writes it.
+std::string gzip(const std::string& data);
 
 // A small deterministic generator (splitmix64): the same numbers on every standard library.
 class Rng {
