@@ -10,7 +10,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
+#include <memory>
 
 namespace {
 
@@ -45,6 +47,48 @@ TEST(Device, CountsLiveDeviceBytesAndThePeak)
     device.queue().finish();
     EXPECT_EQ(device.deviceBytes(), before);
     EXPECT_GE(device.deviceBytesPeak(), before + 1004);
+}
+
+// Device::readOnlyOver: on a device whose memory is the host's (PoCL), a buffer over an aligned block is the
+// block itself and keeps its owner alive after the caller drops it; an unaligned block, or a device with its own
+// memory, gets a copy. Either way a kernel reads the bytes as they were.
+TEST(Device, ReadOnlyOverSharesAnAlignedHostBlockAndKeepsItAlive)
+{
+    clvr::Device& device = clvr::test::device();
+    const std::size_t n = 4096;
+    std::weak_ptr<const void> watch;
+    cl::Buffer buffer;
+    const std::uint64_t before = device.deviceBytes();
+    {
+        auto block = std::shared_ptr<float>(static_cast<float*>(std::aligned_alloc(4096, n * sizeof(float))),
+                                            [](float* p) { std::free(p); });
+        for (std::size_t i = 0; i < n; ++i)
+            block.get()[i] = static_cast<float>(i) * 0.5f;
+        watch = block;
+        bool inPlace = false;
+        buffer = device.readOnlyOver("shared block", n * sizeof(float), block.get(), block, &inPlace);
+        EXPECT_EQ(inPlace, device.listing().hostUnifiedMemory);
+        EXPECT_EQ(device.deviceBytes(), before + n * sizeof(float));
+    }
+    EXPECT_EQ(!watch.expired(), device.listing().hostUnifiedMemory) << "the buffer holds the block where it uses it";
+    const std::vector<float> back = device.download<float>(buffer, n);
+    for (std::size_t i = 0; i < n; i += 97)
+        ASSERT_EQ(back[i], static_cast<float>(i) * 0.5f) << i;
+    buffer = cl::Buffer();
+    device.queue().finish();
+    EXPECT_TRUE(watch.expired()) << "released with the buffer";
+    EXPECT_EQ(device.deviceBytes(), before);
+
+    // One byte past a page-aligned address: no device's base address alignment allows it, so a copy.
+    std::vector<unsigned char> bytes(8192, 7);
+    const unsigned char* unaligned =
+        bytes.data() + (4096 - reinterpret_cast<std::uintptr_t>(bytes.data()) % 4096) % 4096 + 1;
+    auto owner = std::make_shared<int>(0);
+    bool inPlace = true;
+    cl::Buffer copy = device.readOnlyOver("unaligned block", 16, unaligned, owner, &inPlace);
+    EXPECT_FALSE(inPlace);
+    EXPECT_EQ(owner.use_count(), 1) << "a copy keeps nothing";
+    EXPECT_EQ(device.download<unsigned char>(copy, 16), std::vector<unsigned char>(16, 7));
 }
 
 TEST(Device, FillKernelWritesEveryElementOfAnOddSizedBuffer)

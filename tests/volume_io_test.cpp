@@ -818,5 +818,34 @@ TEST(HostMemory, MoreThanHalfOfTheMachineIsAnInputErrorNamingWhat)
     EXPECT_THROW(checkHostMemoryForVoxels("huge.nrrd", std::uint64_t(1) << 60), InputError);
 }
 
+// VoxelBytes: page-aligned (what lets a device buffer use it in place), zero-filled, copied by value.
+TEST(VoxelBytes, AlignedZeroFilledAndCopiedByValue)
+{
+    VoxelBytes a(5000);
+    ASSERT_EQ(a.size(), 5000u);
+    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(a.data()) % 4096, 0u);
+    EXPECT_TRUE(std::all_of(a.data(), a.data() + a.size(), [](std::uint8_t b) { return b == 0; }));
+    a[4999] = 9;
+    VoxelBytes b = a;  // a copy: its own block
+    EXPECT_NE(b.data(), a.data());
+    EXPECT_TRUE(b == a);
+    b[0] = 1;
+    EXPECT_EQ(a[0], 0) << "the copy shares nothing";
+    EXPECT_FALSE(b == a);
+    const std::uint8_t* block = b.data();
+    VoxelBytes c = std::move(b);  // a move: the same block
+    EXPECT_EQ(c.data(), block);
+    EXPECT_TRUE(b.empty());
+    c.resize(3);
+    EXPECT_EQ(c.size(), 3u);
+    EXPECT_EQ(c[0], 1);
+    c.resize(6);
+    EXPECT_EQ(c[0], 1);
+    EXPECT_EQ(c[5], 0);
+    std::weak_ptr<const void> owner = c.owner();
+    c = VoxelBytes();
+    EXPECT_TRUE(owner.expired());
+}
+
 }  // namespace
 }  // namespace clvr

@@ -1472,7 +1472,7 @@ Volume readGzipRegion(const NrrdStream& st, const GridRegion& region)
     const RegionRuns runs = regionRuns(layout.dims, region);
     const std::uint64_t run = runs.length;
     const std::vector<std::uint64_t>& runStart = runs.starts;
-    std::vector<unsigned char> bytes(static_cast<std::size_t>(count * elem));
+    VoxelBytes bytes(static_cast<std::size_t>(count * elem));  // kept as the voxels where their type is native
     std::size_t next = 0;  // the first run not yet complete
     std::ifstream in = openBinary(st.file);
     in.seekg(static_cast<std::streamoff>(layout.headerBytes));

@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
+#include <new>
 #include <unistd.h>
 
 namespace clvr {
@@ -49,6 +51,69 @@ void checkHostMemory(const std::string& what, std::uint64_t bytes)
     if (physical > 0 && bytes > physical / 2)
         throw InputError(what + " needs " + std::to_string(bytes >> 20) + " MiB, more than half of this machine's " +
                          std::to_string(physical >> 20) + " MiB of memory");
+}
+
+namespace {
+
+constexpr std::size_t kVoxelBlockAlignment = 4096;  // a page: more than any OpenCL device's base address alignment
+
+std::shared_ptr<std::uint8_t> allocateVoxelBlock(std::size_t size)
+{
+    if (size == 0)
+        return nullptr;
+    const std::size_t rounded = (size + kVoxelBlockAlignment - 1) / kVoxelBlockAlignment * kVoxelBlockAlignment;
+    void* p = std::aligned_alloc(kVoxelBlockAlignment, rounded);
+    if (!p)
+        throw std::bad_alloc();
+    std::memset(p, 0, rounded);
+    return std::shared_ptr<std::uint8_t>(static_cast<std::uint8_t*>(p), [](std::uint8_t* q) { std::free(q); });
+}
+
+}  // namespace
+
+VoxelBytes::VoxelBytes(std::size_t size) : block_(allocateVoxelBlock(size)), size_(size) {}
+
+VoxelBytes::VoxelBytes(const VoxelBytes& other) : VoxelBytes(other.size_)
+{
+    if (size_)
+        std::memcpy(block_.get(), other.block_.get(), size_);
+}
+
+VoxelBytes::VoxelBytes(VoxelBytes&& other) noexcept : block_(std::move(other.block_)), size_(other.size_)
+{
+    other.size_ = 0;
+}
+
+VoxelBytes& VoxelBytes::operator=(const VoxelBytes& other)
+{
+    if (this != &other)
+        *this = VoxelBytes(other);
+    return *this;
+}
+
+VoxelBytes& VoxelBytes::operator=(VoxelBytes&& other) noexcept
+{
+    if (this != &other) {
+        block_ = std::move(other.block_);
+        size_ = other.size_;
+        other.size_ = 0;
+    }
+    return *this;
+}
+
+void VoxelBytes::resize(std::size_t size)
+{
+    if (size == size_)
+        return;
+    VoxelBytes grown(size);
+    if (const std::size_t kept = std::min(size, size_))
+        std::memcpy(grown.data(), data(), kept);
+    *this = std::move(grown);
+}
+
+bool operator==(const VoxelBytes& a, const VoxelBytes& b)
+{
+    return a.size_ == b.size_ && (a.size_ == 0 || std::memcmp(a.data(), b.data(), a.size_) == 0);
 }
 
 std::size_t voxelTypeSize(VoxelType type)

@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -53,6 +54,37 @@ struct GridHeader {
     glm::dvec3 origin{0.0};
 };
 
+// The bytes of a volume's voxels in their own type: one page-aligned block behind a shared pointer, so that a
+// device whose memory is the host's can render from the block itself (Device::readOnlyOver) and keep it alive
+// as long as its buffer lives — one copy of the voxels in the process, not two (issue 37 goal 4). Value
+// semantics as std::vector<std::uint8_t>: a copy copies the bytes, a move moves the block.
+class VoxelBytes {
+public:
+    VoxelBytes() = default;
+    explicit VoxelBytes(std::size_t size);  // zero-filled
+    VoxelBytes(const VoxelBytes& other);
+    VoxelBytes(VoxelBytes&& other) noexcept;
+    VoxelBytes& operator=(const VoxelBytes& other);
+    VoxelBytes& operator=(VoxelBytes&& other) noexcept;
+
+    std::size_t size() const { return size_; }
+    bool empty() const { return size_ == 0; }
+    std::uint8_t* data() { return block_.get(); }
+    const std::uint8_t* data() const { return block_.get(); }
+    std::uint8_t& operator[](std::size_t i) { return block_.get()[i]; }
+    std::uint8_t operator[](std::size_t i) const { return block_.get()[i]; }
+    // A new zero-filled block of `size` bytes that starts with the old one's first min(size, size()) bytes.
+    void resize(std::size_t size);
+    // Shares the block: what a device buffer over data() holds to keep it alive.
+    std::shared_ptr<const void> owner() const { return block_; }
+
+    friend bool operator==(const VoxelBytes& a, const VoxelBytes& b);
+
+private:
+    std::shared_ptr<std::uint8_t> block_;
+    std::size_t size_ = 0;
+};
+
 // The types a Volume holds its values in: float32, or (where a file stores them so) integers of one and two
 // bytes in their own type, which float represents exactly (issue 37 goal 2: no float copy of such a volume).
 enum class VoxelType : std::uint32_t { Float32, UInt8, Int8, UInt16, Int16 };
@@ -69,7 +101,7 @@ struct Volume {
     // NRRD in one raw stream, .npy, VTK's formats); `values` is then empty. Read either storage through
     // at(), value(), floats() or withVoxels().
     VoxelType voxelType = VoxelType::Float32;
-    std::vector<std::uint8_t> voxels;
+    VoxelBytes voxels;
     std::string source;         // file or generator it came from, for messages
     std::optional<GridPart> part;  // set only on a part of a larger grid (sort-last); see GridPart
     // `part`, or for a whole volume the GridPart that makes it the only part of itself (offset 0).

@@ -57,6 +57,8 @@ std::vector<Found> enumerate()
             l.computeUnits = d.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>();
             l.globalMemBytes = d.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
             l.maxAllocBytes = d.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
+            l.hostUnifiedMemory = d.getInfo<CL_DEVICE_HOST_UNIFIED_MEMORY>() == CL_TRUE;
+            l.baseAddressAlignment = d.getInfo<CL_DEVICE_MEM_BASE_ADDR_ALIGN>() / 8;  // bits to bytes
             // Strip the trailing NULs some drivers leave in info strings.
             for (std::string* s : {&l.platform, &l.name, &l.version})
                 s->erase(std::find(s->begin(), s->end(), '\0'), s->end());
@@ -344,18 +346,22 @@ std::vector<PassTime> Device::takePassTimes()
 namespace {
 
 // Device::deviceBytes(): `bytes` counted in now and out when OpenCL releases the buffer.
+// `owner` (may be null) is kept alive until then. False when OpenCL refused the callback (the buffer is then
+// not counted, and `owner` not kept).
 template <typename Count>
-void countBuffer(const cl::Buffer& buffer, std::uint64_t bytes, const std::shared_ptr<Count>& count)
+bool countBuffer(const cl::Buffer& buffer, std::uint64_t bytes, const std::shared_ptr<Count>& count,
+                 std::shared_ptr<const void> owner = nullptr)
 {
     struct Release {
         std::shared_ptr<Count> count;
         std::uint64_t bytes;
+        std::shared_ptr<const void> owner;
     };
     const std::uint64_t live = count->live.fetch_add(bytes) + bytes;
     std::uint64_t peak = count->peak.load();
     while (live > peak && !count->peak.compare_exchange_weak(peak, live)) {
     }
-    auto* release = new Release{count, bytes};
+    auto* release = new Release{count, bytes, std::move(owner)};
     const cl_int err = clSetMemObjectDestructorCallback(
         buffer(),
         [](cl_mem, void* data) {
@@ -367,7 +373,9 @@ void countBuffer(const cl::Buffer& buffer, std::uint64_t bytes, const std::share
     if (err != CL_SUCCESS) {  // not counted out then: forget it now rather than leak the record
         count->live.fetch_sub(bytes);
         delete release;
+        return false;
     }
+    return true;
 }
 
 }  // namespace
@@ -397,6 +405,32 @@ cl::Buffer Device::buffer(std::string_view what, std::size_t bytes, cl_mem_flags
         throw DeviceError(std::string(noMemory ? "out of device memory: " : "") + "allocating " + mib(bytes) +
                           " for " + std::string(what) + " on " + listing_.name + " failed: " + clErrorName(e.err()));
     }
+}
+
+cl::Buffer Device::readOnlyOver(std::string_view what, std::size_t bytes, const void* host,
+                                std::shared_ptr<const void> owner, bool* inPlace)
+{
+    const std::size_t align = listing_.baseAddressAlignment;
+    const bool shareable = listing_.hostUnifiedMemory && owner && host && bytes > 0 && align > 0 &&
+                           reinterpret_cast<std::uintptr_t>(host) % align == 0 && bytes <= listing_.maxAllocBytes &&
+                           bytes <= listing_.globalMemBytes;
+    if (inPlace)
+        *inPlace = false;
+    if (shareable) {
+        cl_int err = CL_SUCCESS;
+        cl_mem mem = clCreateBuffer(context_(), CL_MEM_READ_ONLY | CL_MEM_USE_HOST_PTR, bytes, const_cast<void*>(host),
+                                    &err);
+        if (err == CL_SUCCESS) {
+            cl::Buffer buffer(mem);  // takes the reference
+            if (countBuffer(buffer, bytes, memory_, std::move(owner))) {
+                if (inPlace)
+                    *inPlace = true;
+                return buffer;
+            }
+            // No callback to keep `owner` alive: copy instead (the fallback below).
+        }
+    }
+    return buffer(what, bytes, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, host);
 }
 
 }  // namespace clvr

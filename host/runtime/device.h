@@ -27,6 +27,10 @@ struct DeviceListing {
     cl_uint computeUnits = 0;
     cl_ulong globalMemBytes = 0;
     cl_ulong maxAllocBytes = 0;
+    // The device's memory is the host's (CL_DEVICE_HOST_UNIFIED_MEMORY: PoCL's CPU devices, integrated GPUs), and
+    // the alignment a host block must have for a buffer to use it in place (CL_DEVICE_MEM_BASE_ADDR_ALIGN, bytes).
+    bool hostUnifiedMemory = false;
+    std::size_t baseAddressAlignment = 0;
 };
 
 // Every device of every platform, in platform order. Empty if there is no OpenCL platform.
@@ -102,6 +106,13 @@ public:
     // `what` if it exceeds the device's largest allocation or its global memory.
     cl::Buffer buffer(std::string_view what, std::size_t bytes, cl_mem_flags flags = CL_MEM_READ_WRITE,
                       const void* host = nullptr);
+
+    // A read-only device buffer holding the `bytes` at `host`. Where the device's memory is the host's and
+    // `host` is aligned as the device requires, the buffer is those bytes themselves (CL_MEM_USE_HOST_PTR: no
+    // second copy; `owner` is kept alive until OpenCL releases the buffer, and the bytes must not change while it
+    // lives); elsewhere a copy (CL_MEM_COPY_HOST_PTR). *inPlace, when given, says which. Errors as buffer().
+    cl::Buffer readOnlyOver(std::string_view what, std::size_t bytes, const void* host,
+                            std::shared_ptr<const void> owner, bool* inPlace = nullptr);
 
     // Bytes of the buffers buffer() made that are still alive (OpenCL frees a buffer when its last
     // cl::Buffer goes: a destructor callback counts it out), and the most there were at once.

@@ -71,6 +71,7 @@ private:
     TransferFunctionUpload tf_;
     SlicePlan plan_;
     cl::Buffer volume_;
+    bool volumeSharesHost_ = false;  // volume_ is the host volume's own block (Device::readOnlyOver)
     std::uint64_t residentBytes_ = 0;
     // Empty-space skipping (fused path).
     glm::ivec3 brickDims_{0};
@@ -134,7 +135,8 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
     // range (1 or 2 bytes per grid point, converted to float exactly in the kernel); else float32, 4
     // bytes per grid point. Device::buffer throws DeviceError if too big. A volume held in its own 1- or
     // 2-byte type (Volume::voxels) goes up as it is, with no host copy: int8 and int16 too where no value
-    // is negative (the same bits as uint8 and uint16).
+    // is negative (the same bits as uint8 and uint16). Where the device's memory is the host's, the buffer is
+    // the voxels' own block (stats: volume_shares_host), so the process holds them once.
     std::string trilinearOptions;
     const bool fused = options_.path == Slice3dOptions::Path::Fused;
     auto integralUpTo = [&](float top) {
@@ -146,8 +148,9 @@ Slice3dRenderer::Slice3dRenderer(Device& device, const Scene& scene, const Volum
     const std::size_t nativeSize = voxelTypeSize(volume.voxelType);
     std::vector<float> scratch;  // only where a native volume must go up as float32
     if (fused && options_.nativeVoxels && nativeUnsigned) {
-        volume_ = device_.buffer(nativeSize == 1 ? "slice3d volume (uint8)" : "slice3d volume (uint16)",
-                                 volume.voxels.size(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, volume.voxels.data());
+        volume_ = device_.readOnlyOver(nativeSize == 1 ? "slice3d volume (uint8)" : "slice3d volume (uint16)",
+                                       volume.voxels.size(), volume.voxels.data(), volume.voxels.owner(),
+                                       &volumeSharesHost_);
         voxelType_ = nativeSize == 1 ? "uint8" : "uint16";
         residentBytes_ = volume.voxels.size();
         trilinearOptions = nativeSize == 1
@@ -298,6 +301,7 @@ Image4f Slice3dRenderer::render(FrameStats& stats)
     stats.extra["voxels"] = static_cast<std::uint64_t>(dims_.x) * dims_.y * dims_.z;
     stats.extra["resident_bytes"] = residentBytes_;
     stats.extra["voxel_type"] = voxelType_;
+    stats.extra["volume_shares_host"] = volumeSharesHost_;
     if (clipTexture_)
         addClipTextureStats(stats.extra, *clipTexture_, *options_.clipTexture);
     return image;
