@@ -8,6 +8,7 @@
 #include "host/io/volume_io.h"
 
 #include <sys/resource.h>
+#include <time.h>
 
 #include <chrono>
 #include <cmath>
@@ -126,6 +127,12 @@ std::uint64_t hostPeakBytes()
 {
     rusage usage{};  // Linux gives ru_maxrss in kilobytes
     return ::getrusage(RUSAGE_SELF, &usage) == 0 ? static_cast<std::uint64_t>(usage.ru_maxrss) * 1024 : 0;
+}
+
+double processCpuMs()
+{
+    timespec t{};
+    return ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t) == 0 ? t.tv_sec * 1e3 + t.tv_nsec * 1e-6 : 0.0;
 }
 
 nlohmann::json Session::stats(const Frame& frame) const

@@ -36,6 +36,10 @@ Camera sceneCamera(const Scene& scene, const SceneData& data);
 // --stats' host_peak_bytes, per rank under MPI.
 std::uint64_t hostPeakBytes();
 
+// The CPU time this process (all its threads, PoCL's among them) has used so far, in milliseconds: a
+// sort-last rank's own work where ranks share cores and its wall time counts the others' too.
+double processCpuMs();
+
 // One rendered frame: the image and what the frame did. stats.frameMs is the renderer's own time, or
 // the wall time where the renderer reports none; stats.passes the device time of each named launch.
 struct Frame {

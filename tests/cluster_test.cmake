@@ -114,12 +114,33 @@ function(expect_job_error expected_rc pattern)
   endif()
 endfunction()
 
+# sort_last_orbit(NAME RANKS FRAMES scene args...): a sort-last orbit re-cut before every frame after the
+# first (--rebalance-above 1: the parts cut by the view's estimate and the ranks' measured times, so each
+# frame's parts differ), every frame equal to one process's within the sort-last tolerance; the stats count
+# the re-cuts and give each frame's per-rank times.
+function(sort_last_orbit name ranks frames)
+  run_ok(${CLVR} render ${ARGN} --orbit ${frames} -o ${WORK}/${name}-1p-%d.exr)
+  run_ok(${MPI} -np ${ranks} ${CLVR} render ${ARGN} --orbit ${frames} --distribution sort-last --rebalance-above 1
+         -o ${WORK}/${name}-%d.exr --stats ${WORK}/${name}.json)
+  math(EXPR last "${frames} - 1")
+  foreach(k RANGE ${last})
+    expect_same(${WORK}/${name}-1p-${k}.exr ${WORK}/${name}-${k}.exr 2e-5)
+  endforeach()
+  file(READ ${WORK}/${name}.json stats)
+  string(JSON recuts GET "${stats}" recuts)
+  string(JSON times LENGTH "${stats}" frames ${last} render_ms_per_rank)
+  if(NOT recuts EQUAL last OR NOT times EQUAL ranks)
+    message(FATAL_ERROR "${name}: ${recuts} re-cuts and ${times} times in the last frame; want ${last} and ${ranks}\n${stats}")
+  endif()
+endfunction()
+
 set(SMALL64 --set image.width=64 --set image.height=64)
 
 if(PART STREQUAL "volume")
   sort_last(volume "1;2;3;5;8" ${VOLUME})
   expect_png_of(volume ${VOLUME})
   sort_first(first-volume ${WORK}/volume-1p.exr "2;8" ${VOLUME})
+  sort_last_orbit(volume-orbit 4 3 ${VOLUME})
 
   # Frames: an orbit of 5 frames on 3 ranks, each frame as one process renders it.
   run_ok(${CLVR} render ${VOLUME} --orbit 5 -o ${WORK}/orbit-1p-%d.png)
@@ -204,6 +225,7 @@ if(PART STREQUAL "mesh")
   sort_last(mesh "1;2;4;7" ${MESH})
   expect_png_of(mesh ${MESH})
   sort_first(first-mesh ${WORK}/mesh-1p.exr "4" ${MESH})
+  sort_last_orbit(mesh-orbit 3 3 ${MESH})
 
   # Sort-first orbit: each frame as one process renders it, the bands rebalanced from the previous frame's
   # cost (rows per rank in the stats add up to the image's height every frame).

@@ -3,7 +3,11 @@
 // steady frame's render time (the slowest rank's), IceT's composite time (blend and collection on rank 0)
 // and their sum, with each rank count's image against one rank's. Then sort-first on 1, 2 and 4 ranks: an
 // --orbit of kSortFirstFrames frames, each frame's bands balanced by the previous frame's cost; the median
-// over frames 1.. of the slowest rank's render time and the row gather; frame 0 against 1 rank's.
+// over frames 1.. of the slowest rank's render time and the row gather; frame 0 against 1 rank's. Then
+// sort-last's balance on 4 ranks: the same orbit cut by data size (--balance data) and by work (--balance
+// cost, re-cut when the ranks' times drift), each frame's slowest rank over the mean, by wall and by CPU
+// time (the ranks share this machine's cores: a rank's CPU time is its own work). Each sort-last row keeps
+// every rank's peak resident memory.
 // tools/cluster_model.py fits the scaling model to the sort-last figures and projects it (docs/cluster.md).
 #include "tools/bench.h"
 
@@ -48,7 +52,8 @@ double maxDifference(const Image4f& a, const Image4f& b)
 
 // One `mpirun -np ranks clvr render` of the scene; its --stats.
 nlohmann::json runRanks(const fs::path& scene, int ranks, const fs::path& image, const fs::path& stats,
-                        const BenchOptions& options, const std::string& distribution = "sort-last", int orbit = 0)
+                        const BenchOptions& options, const std::string& distribution = "sort-last", int orbit = 0,
+                        const std::string& extra = "")
 {
     std::ostringstream cmd;
     cmd << "mpirun --oversubscribe --bind-to none -np " << ranks << " '" << fs::read_symlink("/proc/self/exe").string()
@@ -56,6 +61,7 @@ nlohmann::json runRanks(const fs::path& scene, int ranks, const fs::path& image,
         << "' --stats '" << stats.string() << "'";
     if (orbit > 0)
         cmd << " --orbit " << orbit;
+    cmd << extra;
     if (!options.deviceSpec.empty())
         cmd << " --device '" << options.deviceSpec << "'";
     for (const std::string& o : options.overrides)
@@ -87,6 +93,21 @@ void printRow(const std::string& label, int ranks, double renderMs, double secon
 // 360/kSortFirstFrames degrees between frames, so the cost moves a little, as in an interactive session).
 constexpr int kSortFirstFrames = 12;
 
+// Per frame of a run's stats: the slowest rank's time over the mean, of `key` (render_ms_per_rank or
+// render_cpu_ms_per_rank).
+std::vector<double> frameImbalances(const nlohmann::json& run, const std::string& key)
+{
+    std::vector<double> out;
+    for (const nlohmann::json& f : run["frames"]) {
+        const std::vector<double> ms = f[key].get<std::vector<double>>();
+        double sum = 0.0;
+        for (double t : ms)
+            sum += t;
+        out.push_back(sum > 0.0 ? *std::max_element(ms.begin(), ms.end()) * static_cast<double>(ms.size()) / sum : 1.0);
+    }
+    return out;
+}
+
 }  // namespace
 
 int benchCluster(const BenchOptions& options)
@@ -97,7 +118,7 @@ int benchCluster(const BenchOptions& options)
 #else
     std::vector<fs::path> scenes(options.scenes.begin(), options.scenes.end());
     if (scenes.empty())
-        for (const char* name : {"reg-slice3d-ml256.json", "harc-bluntfin-10.json"})
+        for (const char* name : {"reg-slice3d-ml256.json", "harc-bluntfin-10.json", "slice3d-engine.json"})
             scenes.push_back(repoFile(fs::path("data/scenes/bench") / name));
     const int runs = std::max(3, options.frames / 2);  // each run: a first frame and a steady one
     const fs::path outJson = options.outJson;
@@ -147,6 +168,9 @@ int benchCluster(const BenchOptions& options)
                                         {"render_ms_runs", render},
                                         {"composite_ms_runs", composite},
                                         {"render_ms_per_rank", last["frames"][0]["render_ms_per_rank"]},
+                                        {"render_cpu_ms_per_rank", last["frames"][0]["render_cpu_ms_per_rank"]},
+                                        {"host_peak_bytes_per_rank", last["host_peak_bytes_per_rank"]},
+                                        {"device_peak_bytes_per_rank", last["device_peak_bytes_per_rank"]},
                                         {"setup_ms", last["setup_ms"]},
                                         {"width", last["width"]},
                                         {"height", last["height"]},
@@ -184,6 +208,34 @@ int benchCluster(const BenchOptions& options)
                                            {"max_diff_vs_one_rank", diff}});
             printRow(name + " (sort-first)", ranks, median(render), median(gather), median(frame), firstOneRankFrame,
                      diff);
+        }
+        // Sort-last's balance: 4 ranks, the orbit cut by data size and by work.
+        entry["sort_last_balance"] = nlohmann::json::array();
+        for (const char* balance : {"data", "cost"}) {
+            const std::string base = "bench.cluster." + name + ".balance-" + balance;
+            const nlohmann::json run = runRanks(scene, 4, outDir / (base + ".%02d.exr"), outDir / (base + ".json"),
+                                                options, "sort-last", kSortFirstFrames,
+                                                std::string(" --balance ") + balance);
+            const std::vector<double> wall = frameImbalances(run, "render_ms_per_rank");
+            const std::vector<double> cpu = frameImbalances(run, "render_cpu_ms_per_rank");
+            std::vector<double> slowest, recutMs;
+            for (const nlohmann::json& f : run["frames"]) {
+                slowest.push_back(f["render_ms"].get<double>());
+                if (f.contains("recut_ms"))
+                    recutMs.push_back(f["recut_ms"].get<double>());
+            }
+            entry["sort_last_balance"].push_back(
+                {{"balance", balance}, {"ranks", 4}, {"frames", run["frames"]}, {"recuts", run["recuts"]},
+                 {"cpu_imbalance_median", median(cpu)}, {"cpu_imbalance_max", *std::max_element(cpu.begin(), cpu.end())},
+                 {"wall_imbalance_median", median(wall)},
+                 {"wall_imbalance_max", *std::max_element(wall.begin(), wall.end())},
+                 {"render_ms_median", median(slowest)}, {"recut_ms_median", median(recutMs)}});
+            std::cout << std::left << std::setw(26) << (name + " (balance " + balance + ")") << std::right << std::fixed
+                      << std::setprecision(2) << "  4 ranks, " << kSortFirstFrames << " frames: slowest/mean cpu median "
+                      << median(cpu) << " max " << *std::max_element(cpu.begin(), cpu.end()) << ", wall median "
+                      << median(wall) << " max " << *std::max_element(wall.begin(), wall.end()) << "; render "
+                      << std::setprecision(1) << median(slowest) << " ms; " << run["recuts"].get<int>() << " re-cuts ("
+                      << median(recutMs) << " ms)" << std::defaultfloat << '\n';
         }
         report["scenes"].push_back(entry);
     }

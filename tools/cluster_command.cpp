@@ -1,9 +1,10 @@
 // tools/cluster_command.cpp — `mpirun -np N clvr render` (docs/cluster.md): one image (or --orbit frames)
 // from N ranks, the same files and errors as one process.
-//   sort-last: every rank loads the data, keeps its k-d part (host/cluster/partition.h) and renders it
-//              with the scene's technique into premultiplied RGBA on a black background; IceT composites
-//              the parts in the view's visibility order (host/cluster/compositor.h); rank 0 adds the
-//              background and writes.
+//   sort-last: every rank loads its k-d part (host/cluster/partition.h), cut by the view's estimated work
+//              and re-cut in an orbit when the ranks' times drift apart (host/cluster/balance.h), and
+//              renders it with the scene's technique into premultiplied RGBA on a black background; IceT
+//              composites the parts in the view's visibility order (host/cluster/compositor.h); rank 0
+//              adds the background and writes.
 //   sort-first: every rank holds the whole data and renders a band of image rows (Camera::bandFullHeight),
 //              balanced by the previous frame's cost; rank 0 gathers the rows and writes.
 //   frames:    frame k of --orbit N on rank k mod N; each rank writes its own frames.
@@ -11,6 +12,7 @@
 // every rank (rank 0 prints it, every rank exits with its status) and nobody waits in a collective.
 #include "tools/commands.h"
 
+#include "host/cluster/balance.h"
 #include "host/cluster/compositor.h"
 #include "host/cluster/partition.h"
 #include "host/cluster/world.h"
@@ -165,50 +167,87 @@ int renderFrames(const RenderOptions& options, World& world, Job& job)
 int renderSortLast(const RenderOptions& options, World& world, Job& job)
 {
     const int count = static_cast<int>(job.outputs.size());
+    const int width = job.scene.image.width, height = job.scene.image.height;
     std::unique_ptr<Device> device;
     std::unique_ptr<Session> session;
+    std::optional<GridPartition> gridCut;  // the parts now rendered (one of the two)
+    std::optional<MeshPartition> meshCut;
+    glm::dvec3 gridOrigin{0.0}, gridSpacing{1.0};  // the whole grid's, with gridCut
     KdTree tree;
     std::string partText;
+    // This rank's part for the view `camera`, cut by its estimated work and, after a measured frame, by
+    // the rates measured (host/cluster/balance.h); `gridCut`/`meshCut` and `tree` set to the new cut.
+    // A volume whose format reads by regions (raw, NRRD, Fortran-order .npy, .vti, .pvti, .mhd): the rank
+    // reads only its part's points, placed as cutGridPart would cut them from the whole. Else every rank
+    // loads the whole data (or takes `whole`, loaded already) and cuts out its part (the rest is freed here).
+    const bool byCost = options.balance != "data";
+    const auto loadPart = [&](const Camera& camera, const MeasuredFrame* measured,
+                              std::optional<SceneData> whole = std::nullopt) {
+        const ViewCost view(camera, width, height);
+        const int ghost = technique(job.scene.technique).sortLastGhost;
+        const std::optional<GridHeader> header = job.scene.volume ? volumeHeader(*job.scene.volume) : std::nullopt;
+        SceneData data;
+        if (header && !whole) {
+            const auto t0 = std::chrono::steady_clock::now();
+            gridCut = byCost ? balanceGrid(header->dims, header->origin, header->spacing, world.size(), view,
+                                           gridCut ? &*gridCut : nullptr, measured)
+                             : partitionGrid(header->dims, header->origin, header->spacing, world.size());
+            data.volume = loadVolumeRegion(*job.scene.volume, gridPartRegion(*gridCut, header->dims, world.rank(), ghost));
+            data.volume.part = gridPartPlacement(*gridCut, header->dims, header->origin, world.rank(), ghost);
+            gridOrigin = header->origin;
+            gridSpacing = header->spacing;
+            data.loadMs = msSince(t0);
+            tree = gridCut->tree;
+            const glm::ivec3 n = data.volume.dims;
+            partText = std::to_string(n.x) + "x" + std::to_string(n.y) + "x" + std::to_string(n.z) + " points read";
+            return data;
+        }
+        data = whole ? std::move(*whole) : loadSceneData(job.scene);
+        if (job.scene.mesh) {
+            meshCut = byCost ? balanceMesh(data.mesh, world.size(), view, meshCut ? &*meshCut : nullptr, measured)
+                             : partitionMesh(data.mesh, world.size());
+            data.mesh = cutMeshPart(data.mesh, *meshCut, world.rank());
+            tree = meshCut->tree;
+            partText = std::to_string(data.mesh.tets.size()) + " tets";
+        } else {
+            const Volume& v = data.volume;
+            gridCut = byCost ? balanceGrid(v.dims, v.origin, v.spacing, world.size(), view,
+                                           gridCut ? &*gridCut : nullptr, measured)
+                             : partitionGrid(v.dims, v.origin, v.spacing, world.size());
+            gridOrigin = v.origin;
+            gridSpacing = v.spacing;
+            data.volume = cutGridPart(data.volume, *gridCut, world.rank(), ghost);
+            tree = gridCut->tree;
+            const glm::ivec3 n = data.volume.dims;
+            partText = std::to_string(n.x) + "x" + std::to_string(n.y) + "x" + std::to_string(n.z) + " points";
+        }
+        return data;
+    };
+    // The part's session for `camera`: premultiplied parts on black; the background goes on last.
+    const auto startSession = [&](SceneData data, const Camera& camera) {
+        Scene partScene = job.scene;
+        partScene.camera = camera;
+        partScene.image.background = glm::dvec3(0.0);
+        session = std::make_unique<Session>(*device, partScene, std::move(data), job.sceneLabel);
+    };
     double setupMs = 0.0;
     world.agree([&] {
         const auto t0 = std::chrono::steady_clock::now();
-        // A volume whose format reads by regions (raw, Fortran-order .npy, .vti, .pvti, .mhd): each rank
-        // reads only its part's points, placed as cutGridPart would cut them from the whole.
+        // The whole data's camera, on every rank (it decides the cut): from the grid's header where the
+        // format reads by regions, else from the whole data, loaded here and cut by loadPart.
         const std::optional<GridHeader> header = job.scene.volume ? volumeHeader(*job.scene.volume) : std::nullopt;
         SceneData data;
         if (header) {
-            if (!job.scene.camera)  // the whole grid's camera, on every rank
+            if (!job.scene.camera)
                 job.scene.camera = fitCamera(header->origin, header->origin + glm::dvec3(header->dims - 1) * header->spacing);
-            const GridPartition partition = partitionGrid(header->dims, header->origin, header->spacing, world.size());
-            const int ghost = technique(job.scene.technique).sortLastGhost;
-            data.volume = loadVolumeRegion(*job.scene.volume, gridPartRegion(partition, header->dims, world.rank(), ghost));
-            data.volume.part = gridPartPlacement(partition, header->dims, header->origin, world.rank(), ghost);
-            data.loadMs = msSince(t0);
-            tree = partition.tree;
-            const glm::ivec3 n = data.volume.dims;
-            partText = std::to_string(n.x) + "x" + std::to_string(n.y) + "x" + std::to_string(n.z) + " points read";
+            data = loadPart(*job.scene.camera, nullptr);
         } else {
-            // Else every rank loads the whole data and cuts out its part (the rest is freed here).
-            data = loadSceneData(job.scene);
-            job.scene.camera = sceneCamera(job.scene, data);  // the whole data's camera, on every rank
-            if (job.scene.mesh) {
-                const MeshPartition partition = partitionMesh(data.mesh, world.size());
-                data.mesh = cutMeshPart(data.mesh, partition, world.rank());
-                tree = partition.tree;
-                partText = std::to_string(data.mesh.tets.size()) + " tets";
-            } else {
-                const GridPartition partition = partitionGrid(data.volume.dims, data.volume.origin, data.volume.spacing,
-                                                              world.size());
-                data.volume = cutGridPart(data.volume, partition, world.rank(), technique(job.scene.technique).sortLastGhost);
-                tree = partition.tree;
-                const glm::ivec3 n = data.volume.dims;
-                partText = std::to_string(n.x) + "x" + std::to_string(n.y) + "x" + std::to_string(n.z) + " points";
-            }
+            SceneData whole = loadSceneData(job.scene);
+            job.scene.camera = sceneCamera(job.scene, whole);
+            data = loadPart(*job.scene.camera, nullptr, std::move(whole));
         }
-        Scene partScene = job.scene;
-        partScene.image.background = glm::dvec3(0.0);  // premultiplied parts; the background goes on last
         device = std::make_unique<Device>(rankDevice(options, world));
-        session = std::make_unique<Session>(*device, partScene, std::move(data), job.sceneLabel);
+        startSession(std::move(data), *job.scene.camera);
         setupMs = msSince(t0);
     });
     cluster::Compositor compositor(world, job.scene.image.width, job.scene.image.height);
@@ -218,22 +257,64 @@ int renderSortLast(const RenderOptions& options, World& world, Job& job)
     nlohmann::json frame0Stats;
     double frame0Ms = 0.0, composite0Ms = 0.0;
     const Camera camera0 = *job.scene.camera;
+    // What a rank's part costs: its render time, or where ranks share cores (more on the node than it
+    // has hardware threads) its CPU time, since its wall time then counts the others' work too.
+    const bool sharedCores = world.nodeSize() > static_cast<int>(std::thread::hardware_concurrency());
+    std::vector<double> lastMs, lastCpuMs;  // the previous frame's render and CPU time per rank
+    int recuts = 0;
     for (int k = 0; k < count; ++k) {
         const Camera camera = orbitCamera(camera0, k, count);
+        // Re-cut where the current parts would be out of balance for this frame's view: the previous
+        // frame's per-rank times, over its estimate per part, are the rates by which this frame's
+        // estimate predicts them, and then cuts (the old session freed first).
+        const std::vector<double>& lastCost = sharedCores ? lastCpuMs : lastMs;
+        bool recut = false;
+        if (byCost && k > 0 && world.size() > 1) {
+            const ViewCost before(orbitCamera(camera0, k - 1, count), width, height), next(camera, width, height);
+            std::vector<double> estimateBefore, estimateNext;
+            if (meshCut) {  // each rank knows its own part's tetrahedra
+                const TetMesh& part = session->data().mesh;
+                estimateBefore = world.allGather(meshPartWork(part, tree, world.rank(), before));
+                estimateNext = world.allGather(meshPartWork(part, tree, world.rank(), next));
+            } else {
+                const auto costs = [&](const ViewCost& view) {
+                    return gridPartCosts(*gridCut, gridOrigin, gridSpacing,
+                                         [&](const glm::dvec3& p) { return view.density(p); });
+                };
+                estimateBefore = costs(before);
+                estimateNext = costs(next);
+            }
+            recut = predictedImbalance(estimateBefore, estimateNext, lastCost) > options.rebalanceAbove;
+        }
+        double recutMs = 0.0;
+        if (recut) {
+            const auto t0 = std::chrono::steady_clock::now();
+            world.agree([&] {
+                session.reset();
+                const MeasuredFrame measured{ViewCost(orbitCamera(camera0, k - 1, count), width, height), lastCost};
+                startSession(loadPart(camera, &measured), camera);
+            });
+            recutMs = msSince(t0);
+            ++recuts;
+        }
         Frame frame;
+        double cpuMs = 0.0;
         world.agree([&] {
-            if (k != 0)
+            if (k != 0 && !recut)
                 session->setCamera(camera);
-            frame = session->render();
             if (k == 0 && !options.singleFrame)
-                frame = session->render();  // the first frame builds kernels; time a steady one
+                session->render();  // the first frame builds kernels; time a steady one
+            const double cpu0 = processCpuMs();
+            frame = session->render();
+            cpuMs = processCpuMs() - cpu0;
         });
         const auto t0 = std::chrono::steady_clock::now();
         Image4f image;
         world.agree([&] { image = compositor.composite(frame.image, tree.frontToBack(camera)); });
         const double compositeMs = msSince(t0);
-        const double renderMs = world.maxOver(frame.stats.frameMs);
-        const std::vector<double> perRank = world.gather(frame.stats.frameMs);
+        lastMs = world.allGather(frame.stats.frameMs);
+        lastCpuMs = world.allGather(cpuMs);
+        const double renderMs = *std::max_element(lastMs.begin(), lastMs.end());  // the slowest part
         world.agree([&] {
             if (world.rank() != 0)
                 return;
@@ -241,8 +322,13 @@ int renderSortLast(const RenderOptions& options, World& world, Job& job)
             const std::string& path = job.outputs[static_cast<std::size_t>(k)];
             writeImage(path, image);
             written.add(path);
-            frames.push_back({{"index", k}, {"output", path}, {"render_ms", renderMs}, {"composite_ms", compositeMs},
-                              {"frame_ms", renderMs + compositeMs}, {"render_ms_per_rank", perRank}});
+            nlohmann::json f = {{"index", k}, {"output", path}, {"render_ms", renderMs}, {"composite_ms", compositeMs},
+                                {"frame_ms", renderMs + compositeMs}, {"render_ms_per_rank", lastMs},
+                                {"render_cpu_ms_per_rank", lastCpuMs}, {"imbalance", imbalance(lastMs)},
+                                {"cpu_imbalance", imbalance(lastCpuMs)}};
+            if (recut)
+                f["recut_ms"] = recutMs;  // the new parts' reads and set-up, before the frame
+            frames.push_back(f);
             if (k == 0) {
                 frame0Stats = session->stats(frame);
                 frame0Ms = renderMs + compositeMs;
@@ -258,7 +344,8 @@ int renderSortLast(const RenderOptions& options, World& world, Job& job)
         nlohmann::json stats = frame0Stats;  // rank 0's own part
         stats["host_peak_bytes_per_rank"] = hostPeaks;
         stats["device_peak_bytes_per_rank"] = devicePeaks;
-        stats["rank0_part"] = partText;
+        stats["rank0_part"] = partText;  // the last cut's
+        stats["recuts"] = recuts;
         stats["setup_ms"] = setupMs;
         stats["composite_ms"] = composite0Ms;
         writeImageJobStats(options, world, job, stats, frames, frame0Ms);

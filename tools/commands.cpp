@@ -155,6 +155,15 @@ int run(int argc, char** argv)
                        "under mpirun: sort-last (the data split over the ranks, images composited by IceT), "
                        "sort-first (image rows shared out, every technique) or frames (--orbit frames shared out); default: the scene's, else sort-last, "
                        "frames with --orbit (docs/cluster.md)");
+    render->add_option("--balance", renderOptions.balance,
+                       "under mpirun, sort-last: cut the data by work (cost: the view's estimated ray work, re-cut in "
+                       "an orbit from the ranks' measured times; the default) or by size (data: equal parts, never "
+                       "re-cut) (docs/cluster.md)")
+        ->check(CLI::IsMember({"cost", "data"}));
+    render->add_option("--rebalance-above", renderOptions.rebalanceAbove,
+                       "under mpirun, sort-last with --balance cost: re-cut the parts before a frame when the slowest "
+                       "rank is predicted to take more than X times the mean (default 1.2; 1: every frame)")
+        ->check(CLI::Range(1.0, 1e9));
     render->add_flag("--single-frame", renderOptions.singleFrame,
                      "render once (by default a first frame and a steady frame are rendered; frame_ms is the steady one)");
     std::string threads;

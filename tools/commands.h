@@ -25,6 +25,8 @@ struct RenderOptions {
     int orbit = 0;                       // --orbit N: N frames about view-up, `output` a %d pattern; 0: one image
     bool singleFrame = false;            // --single-frame: render once (no separate steady frame)
     std::string distribution;            // --distribution (MPI jobs): sort-last, sort-first, frames; empty: the scene's
+    std::string balance = "cost";        // --balance (sort-last): cost (by estimated and measured work) or data
+    double rebalanceAbove = 1.2;         // --rebalance-above: re-cut when the predicted slowest/mean passes it
     bool threadsGiven = false;           // --threads or $CLVR_THREADS set the thread budget
 };
 

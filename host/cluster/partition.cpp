@@ -24,9 +24,61 @@ int longestAxis(const glm::dvec3& extent)
     return axis;
 }
 
+// Up to `most` sample coordinates spread evenly over cells [c0, c1) of one axis (cell units, centers of
+// equal stretches).
+std::vector<double> spreadSamples(int c0, int c1, int most)
+{
+    const int n = std::min(c1 - c0, most);
+    std::vector<double> out;
+    for (int i = 0; i < n; ++i)
+        out.push_back(c0 + (i + 0.5) * (c1 - c0) / n);
+    return out;
+}
+
+// The mean of `cost` over the sample points (cell units, per axis) times the box's world volume.
+double boxCost(const std::vector<double> (&samples)[3], const glm::dvec3& origin, const glm::dvec3& spacing,
+               double volume, const CostDensity& cost)
+{
+    double sum = 0.0;
+    for (double z : samples[2])
+        for (double y : samples[1])
+            for (double x : samples[0])
+                sum += cost(origin + glm::dvec3(x, y, z) * spacing);
+    const double count = static_cast<double>(samples[0].size() * samples[1].size() * samples[2].size());
+    return sum / count * volume;
+}
+
+// The cell layer on `axis` in (c0, c1) where cells [c0, cut) hold `share` of the cost of cells [c0, c1):
+// the layers' costs summed in order, the cut at the layer boundary nearest the target. -1 when the cost
+// is not positive (nothing to balance by).
+int costCut(const glm::ivec3& c0, const glm::ivec3& c1, int axis, double share, const glm::dvec3& origin,
+            const glm::dvec3& spacing, const CostDensity& cost)
+{
+    std::vector<double> samples[3];
+    glm::dvec3 layerSize = glm::dvec3(c1 - c0) * spacing;
+    layerSize[axis] = spacing[axis];
+    const double layerVolume = layerSize.x * layerSize.y * layerSize.z;
+    for (int a = 0; a < 3; ++a)
+        samples[a] = spreadSamples(c0[a], c1[a], 16);
+    std::vector<double> cumulative{0.0};  // cost of cells [c0, c0 + i) on the axis
+    for (int layer = c0[axis]; layer < c1[axis]; ++layer) {
+        samples[axis] = {layer + 0.5};
+        cumulative.push_back(cumulative.back() + boxCost(samples, origin, spacing, layerVolume, cost));
+    }
+    const double total = cumulative.back();
+    if (!(total > 0.0) || !std::isfinite(total))
+        return -1;
+    const double target = share * total;
+    std::size_t best = 1;
+    for (std::size_t i = 1; i + 1 < cumulative.size(); ++i)
+        if (std::abs(cumulative[i] - target) < std::abs(cumulative[best] - target))
+            best = i;
+    return c0[axis] + static_cast<int>(best);
+}
+
 // Builds the grid tree over cells [c0, c1) per axis for `ranks` parts numbered from `firstPart`.
 int splitGrid(GridPartition& out, const glm::ivec3& c0, const glm::ivec3& c1, const glm::dvec3& origin,
-              const glm::dvec3& spacing, int ranks, int firstPart)
+              const glm::dvec3& spacing, const CostDensity& cost, int ranks, int firstPart)
 {
     const int node = static_cast<int>(out.tree.nodes.size());
     out.tree.nodes.emplace_back();
@@ -48,13 +100,15 @@ int splitGrid(GridPartition& out, const glm::ivec3& c0, const glm::ivec3& c1, co
                          "cell per axis); use fewer ranks, or --distribution sort-first or frames");
     const int below = ranks / 2;
     const double share = static_cast<double>(below) / ranks;
-    const int cut = std::clamp(c0[axis] + static_cast<int>(std::lround(cells[axis] * share)), c0[axis] + 1,
-                               c1[axis] - 1);
+    int cut = cost ? costCut(c0, c1, axis, share, origin, spacing, cost) : -1;
+    if (cut < 0)
+        cut = c0[axis] + static_cast<int>(std::lround(cells[axis] * share));
+    cut = std::clamp(cut, c0[axis] + 1, c1[axis] - 1);
     glm::ivec3 mid1 = c1, mid0 = c0;
     mid1[axis] = cut;
     mid0[axis] = cut;
-    const int b = splitGrid(out, c0, mid1, origin, spacing, below, firstPart);
-    const int a = splitGrid(out, mid0, c1, origin, spacing, ranks - below, firstPart + below);
+    const int b = splitGrid(out, c0, mid1, origin, spacing, cost, below, firstPart);
+    const int a = splitGrid(out, mid0, c1, origin, spacing, cost, ranks - below, firstPart + below);
     KdTree::Node& n = out.tree.nodes[node];
     n.axis = axis;
     n.split = origin[axis] + cut * spacing[axis];
@@ -63,8 +117,14 @@ int splitGrid(GridPartition& out, const glm::ivec3& c0, const glm::ivec3& c1, co
     return node;
 }
 
-// Builds the mesh tree over the centroids [first, last) (sorted in place) inside the box [lo, hi].
-int splitMesh(MeshPartition& out, std::vector<glm::dvec3>& centroids, std::size_t first, std::size_t last,
+// A tetrahedron's centroid with its cost.
+struct WeightedPoint {
+    glm::dvec3 at;
+    double cost;
+};
+
+// Builds the mesh tree over the points [first, last) (reordered in place) inside the box [lo, hi].
+int splitMesh(MeshPartition& out, std::vector<WeightedPoint>& points, std::size_t first, std::size_t last,
               const glm::dvec3& lo, const glm::dvec3& hi, int ranks, int firstPart)
 {
     const int node = static_cast<int>(out.tree.nodes.size());
@@ -77,16 +137,26 @@ int splitMesh(MeshPartition& out, std::vector<glm::dvec3>& centroids, std::size_
     }
     const int axis = longestAxis(hi - lo);
     const int below = ranks / 2;
-    // The centroid quantile of the ranks' share, inside the box (never on its faces, so both sides
-    // keep a volume).
-    const std::size_t count = last - first;
-    const std::size_t k = first + std::min(count - 1, count * static_cast<std::size_t>(below) / ranks);
+    const auto begin = points.begin() + static_cast<std::ptrdiff_t>(first);
+    const auto end = points.begin() + static_cast<std::ptrdiff_t>(last);
+    // The cost quantile of the ranks' share, inside the box (never on its faces, so both sides keep a
+    // volume): the first point whose cost, with those before it, passes the share. With equal costs,
+    // the centroid of rank count * below / ranks.
     double split = 0.5 * (lo[axis] + hi[axis]);
-    if (count > 0) {
-        std::nth_element(centroids.begin() + static_cast<std::ptrdiff_t>(first), centroids.begin() + static_cast<std::ptrdiff_t>(k),
-                         centroids.begin() + static_cast<std::ptrdiff_t>(last),
-                         [axis](const glm::dvec3& p, const glm::dvec3& q) { return p[axis] < q[axis]; });
-        split = centroids[k][axis];
+    if (first < last) {
+        std::sort(begin, end, [axis](const WeightedPoint& p, const WeightedPoint& q) { return p.at[axis] < q.at[axis]; });
+        double total = 0.0;
+        for (auto it = begin; it != end; ++it)
+            total += it->cost;
+        const double target = total * below / ranks;
+        double sum = 0.0;
+        auto it = begin;
+        for (; it + 1 != end; ++it) {
+            sum += it->cost;
+            if (sum > target)
+                break;
+        }
+        split = it->at[axis];
     }
     const double margin = 1e-6 * (hi[axis] - lo[axis]);
     if (!(split > lo[axis] + margin && split < hi[axis] - margin))
@@ -94,13 +164,11 @@ int splitMesh(MeshPartition& out, std::vector<glm::dvec3>& centroids, std::size_
     glm::dvec3 mid1 = hi, mid0 = lo;
     mid1[axis] = split;
     mid0[axis] = split;
-    // The centroids on each side, for the next levels.
-    const auto middle = std::partition(centroids.begin() + static_cast<std::ptrdiff_t>(first),
-                                       centroids.begin() + static_cast<std::ptrdiff_t>(last),
-                                       [&](const glm::dvec3& p) { return p[axis] < split; });
-    const std::size_t m = static_cast<std::size_t>(middle - centroids.begin());
-    const int b = splitMesh(out, centroids, first, m, lo, mid1, below, firstPart);
-    const int a = splitMesh(out, centroids, m, last, mid0, hi, ranks - below, firstPart + below);
+    // The points on each side, for the next levels.
+    const auto middle = std::partition(begin, end, [&](const WeightedPoint& p) { return p.at[axis] < split; });
+    const std::size_t m = static_cast<std::size_t>(middle - points.begin());
+    const int b = splitMesh(out, points, first, m, lo, mid1, below, firstPart);
+    const int a = splitMesh(out, points, m, last, mid0, hi, ranks - below, firstPart + below);
     KdTree::Node& n = out.tree.nodes[node];
     n.axis = axis;
     n.split = split;
@@ -140,13 +208,38 @@ std::vector<int> KdTree::frontToBack(const Camera& camera) const
     return order;
 }
 
-GridPartition partitionGrid(const glm::ivec3& dims, const glm::dvec3& origin, const glm::dvec3& spacing, int n)
+int KdTree::partAt(const glm::dvec3& p) const
+{
+    if (nodes.empty())
+        throw InternalError("KdTree::partAt: an empty tree");
+    const Node* n = &nodes[0];
+    while (n->axis >= 0)
+        n = &nodes[static_cast<std::size_t>(p[n->axis] < n->split ? n->below : n->above)];
+    return n->part;
+}
+
+GridPartition partitionGrid(const glm::ivec3& dims, const glm::dvec3& origin, const glm::dvec3& spacing, int n,
+                            const CostDensity& cost)
 {
     checkRanks(n);
     GridPartition out;
     out.lo.resize(static_cast<std::size_t>(n));
     out.hi.resize(static_cast<std::size_t>(n));
-    splitGrid(out, glm::ivec3(0), dims - 1, origin, spacing, n, 0);
+    splitGrid(out, glm::ivec3(0), dims - 1, origin, spacing, cost, n, 0);
+    return out;
+}
+
+std::vector<double> gridPartCosts(const GridPartition& partition, const glm::dvec3& origin, const glm::dvec3& spacing,
+                                  const CostDensity& cost)
+{
+    std::vector<double> out;
+    for (std::size_t p = 0; p < partition.lo.size(); ++p) {
+        std::vector<double> samples[3];
+        for (int a = 0; a < 3; ++a)
+            samples[a] = spreadSamples(partition.lo[p][a], partition.hi[p][a], 16);
+        const glm::dvec3 size = glm::dvec3(partition.hi[p] - partition.lo[p]) * spacing;
+        out.push_back(boxCost(samples, origin, spacing, size.x * size.y * size.z, cost));
+    }
     return out;
 }
 
@@ -192,19 +285,38 @@ Volume cutGridPart(const Volume& volume, const GridPartition& partition, int p, 
     return part;
 }
 
-MeshPartition partitionMesh(const TetMesh& mesh, int n)
+std::vector<glm::dvec3> tetCentroids(const TetMesh& mesh)
+{
+    std::vector<glm::dvec3> out;
+    out.reserve(mesh.tets.size());
+    for (const glm::uvec4& t : mesh.tets)
+        out.push_back(0.25 * (mesh.points[t.x] + mesh.points[t.y] + mesh.points[t.z] + mesh.points[t.w]));
+    return out;
+}
+
+MeshPartition partitionMesh(const TetMesh& mesh, int n, const std::vector<double>& tetCost)
 {
     checkRanks(n);
     if (mesh.tets.empty())
         throw InputError(mesh.source + ": the mesh has no tetrahedra to split into parts");
-    std::vector<glm::dvec3> centroids;
-    centroids.reserve(mesh.tets.size());
-    for (const glm::uvec4& t : mesh.tets)
-        centroids.push_back(0.25 * (mesh.points[t.x] + mesh.points[t.y] + mesh.points[t.z] + mesh.points[t.w]));
+    if (!tetCost.empty() && tetCost.size() != mesh.tets.size())
+        throw InternalError("partitionMesh: one cost per tetrahedron");
+    double total = 0.0;
+    for (double c : tetCost) {
+        if (!(c >= 0.0) || !std::isfinite(c))
+            throw InternalError("partitionMesh: a tetrahedron's cost is negative or not finite");
+        total += c;
+    }
+    const bool byCost = total > 0.0;  // all zero: nothing to balance by, so by count
+    const std::vector<glm::dvec3> centroids = tetCentroids(mesh);
+    std::vector<WeightedPoint> points;
+    points.reserve(centroids.size());
+    for (std::size_t i = 0; i < centroids.size(); ++i)
+        points.push_back({centroids[i], byCost ? tetCost[i] : 1.0});
     MeshPartition out;
     out.lo.resize(static_cast<std::size_t>(n));
     out.hi.resize(static_cast<std::size_t>(n));
-    splitMesh(out, centroids, 0, centroids.size(), mesh.boundsMin(), mesh.boundsMax(), n, 0);
+    splitMesh(out, points, 0, points.size(), mesh.boundsMin(), mesh.boundsMax(), n, 0);
     return out;
 }
 

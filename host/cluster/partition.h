@@ -18,6 +18,7 @@
 
 #include <glm/glm.hpp>
 
+#include <functional>
 #include <vector>
 
 namespace clvr {
@@ -37,7 +38,14 @@ struct KdTree {
     // holding the eye (perspective) or the side the view direction comes from (parallel) goes first.
     // Exact for every eye position, inside the data's bounds too.
     std::vector<int> frontToBack(const Camera& camera) const;
+
+    // The part whose box holds p (a point on a splitting plane belongs to the side above it).
+    int partAt(const glm::dvec3& p) const;
 };
+
+// What rendering the data near a world point costs, per unit volume (host/cluster/balance.h): where a
+// partition cuts when it balances cost rather than data.
+using CostDensity = std::function<double(const glm::dvec3&)>;
 
 // A regular grid cut into n parts: part p holds the grid points [lo[p], hi[p]] (inclusive) per axis.
 struct GridPartition {
@@ -47,9 +55,17 @@ struct GridPartition {
 
 // Splits the cells of a grid with `dims` points and `spacing` into n parts, halving the rank count at each
 // level and cutting the longest axis (in world units) in proportion, so parts differ by at most one cell
-// layer per cut. InputError when the grid has too few cells for n parts (each needs at least one cell
-// per axis).
-GridPartition partitionGrid(const glm::ivec3& dims, const glm::dvec3& origin, const glm::dvec3& spacing, int n);
+// layer per cut. With `cost`, each cut is on the same axis at the cell layer that gives the two sides
+// cost in proportion to their rank counts instead (a layer's cost: the mean of `cost` over up to 16x16
+// of its cells' centers, times its volume). InputError when the grid has too few cells for n parts
+// (each needs at least one cell per axis).
+GridPartition partitionGrid(const glm::ivec3& dims, const glm::dvec3& origin, const glm::dvec3& spacing, int n,
+                            const CostDensity& cost = {});
+
+// The cost of each part of `partition`: the mean of `cost` over up to 16^3 of its cells' centers, times
+// its volume (the same measure partitionGrid balances).
+std::vector<double> gridPartCosts(const GridPartition& partition, const glm::dvec3& origin, const glm::dvec3& spacing,
+                                  const CostDensity& cost);
 
 // Part p of `volume` as its own Volume: the grid points [lo[p], hi[p]] plus `ghost` (0 or 1) more layers
 // on each side where the grid goes on (GridPart set, ghostLo/ghostHi saying how many it holds). The part
@@ -72,9 +88,13 @@ struct MeshPartition {
 };
 
 // Splits the mesh's bounding box into n boxes, each cut on the longest axis at the centroid quantile
-// that gives the two sides tetrahedra in proportion to their rank counts. InputError for n < 1 or an
-// empty mesh.
-MeshPartition partitionMesh(const TetMesh& mesh, int n);
+// that gives the two sides tetrahedra in proportion to their rank counts — or, with `tetCost` (one
+// non-negative cost per tetrahedron), cost in proportion. InputError for n < 1 or an empty mesh.
+MeshPartition partitionMesh(const TetMesh& mesh, int n, const std::vector<double>& tetCost = {});
+
+// The centroid of each tetrahedron of `mesh`: what partitionMesh splits and what decides a tetrahedron's
+// part when costs are summed per part.
+std::vector<glm::dvec3> tetCentroids(const TetMesh& mesh);
 
 // Part p of `mesh`: the tetrahedra whose bounding boxes meet part p's box (points renumbered, MeshPart
 // set with the box and the full mesh's box). The mesh must have passed checkMesh.
