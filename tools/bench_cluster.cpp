@@ -11,6 +11,7 @@
 // tools/cluster_model.py fits the scaling model to the sort-last figures and projects it (docs/cluster.md).
 #include "tools/bench.h"
 
+#include "host/cluster/balance.h"
 #include "host/io/image_io.h"
 #include "host/runtime/errors.h"
 #include "tools/bench_machine.h"
@@ -98,13 +99,8 @@ constexpr int kSortFirstFrames = 12;
 std::vector<double> frameImbalances(const nlohmann::json& run, const std::string& key)
 {
     std::vector<double> out;
-    for (const nlohmann::json& f : run["frames"]) {
-        const std::vector<double> ms = f[key].get<std::vector<double>>();
-        double sum = 0.0;
-        for (double t : ms)
-            sum += t;
-        out.push_back(sum > 0.0 ? *std::max_element(ms.begin(), ms.end()) * static_cast<double>(ms.size()) / sum : 1.0);
-    }
+    for (const nlohmann::json& f : run["frames"])
+        out.push_back(imbalance(f[key].get<std::vector<double>>()));
     return out;
 }
 

@@ -172,32 +172,34 @@ int renderSortLast(const RenderOptions& options, World& world, Job& job)
     std::unique_ptr<Session> session;
     std::optional<GridPartition> gridCut;  // the parts now rendered (one of the two)
     std::optional<MeshPartition> meshCut;
-    glm::dvec3 gridOrigin{0.0}, gridSpacing{1.0};  // the whole grid's, with gridCut
+    std::optional<GridHeader> grid;  // the whole grid's points and placement, with gridCut
+    bool readsRegions = false;       // the volume's format reads by regions: grid is its header
     KdTree tree;
     std::string partText;
-    // This rank's part for the view `camera`, cut by its estimated work and, after a measured frame, by
-    // the rates measured (host/cluster/balance.h); `gridCut`/`meshCut` and `tree` set to the new cut.
-    // A volume whose format reads by regions (raw, NRRD, Fortran-order .npy, .vti, .pvti, .mhd): the rank
-    // reads only its part's points, placed as cutGridPart would cut them from the whole. Else every rank
-    // loads the whole data (or takes `whole`, loaded already) and cuts out its part (the rest is freed here).
     const bool byCost = options.balance != "data";
+    // The grid's parts for `view` (after a measured frame, by the rates measured too: host/cluster/balance.h).
+    const auto cutGrid = [&](const ViewCost& view, const MeasuredFrame* measured) {
+        gridCut = byCost ? balanceGrid(grid->dims, grid->origin, grid->spacing, world.size(), view,
+                                       gridCut ? &*gridCut : nullptr, measured)
+                         : partitionGrid(grid->dims, grid->origin, grid->spacing, world.size());
+        tree = gridCut->tree;
+    };
+    // This rank's part for the view `camera`, cut by its estimated work and, after a measured frame, by
+    // the rates measured; `gridCut`/`meshCut` and `tree` set to the new cut. A volume whose format reads
+    // by regions (raw, NRRD, Fortran-order .npy, .vti, .pvti, .mhd): the rank reads only its part's points,
+    // placed as cutGridPart would cut them from the whole. Else every rank loads the whole data (or takes
+    // `whole`, loaded already) and cuts out its part (the rest is freed here).
     const auto loadPart = [&](const Camera& camera, const MeasuredFrame* measured,
                               std::optional<SceneData> whole = std::nullopt) {
         const ViewCost view(camera, width, height);
         const int ghost = technique(job.scene.technique).sortLastGhost;
-        const std::optional<GridHeader> header = job.scene.volume ? volumeHeader(*job.scene.volume) : std::nullopt;
         SceneData data;
-        if (header && !whole) {
+        if (readsRegions) {
             const auto t0 = std::chrono::steady_clock::now();
-            gridCut = byCost ? balanceGrid(header->dims, header->origin, header->spacing, world.size(), view,
-                                           gridCut ? &*gridCut : nullptr, measured)
-                             : partitionGrid(header->dims, header->origin, header->spacing, world.size());
-            data.volume = loadVolumeRegion(*job.scene.volume, gridPartRegion(*gridCut, header->dims, world.rank(), ghost));
-            data.volume.part = gridPartPlacement(*gridCut, header->dims, header->origin, world.rank(), ghost);
-            gridOrigin = header->origin;
-            gridSpacing = header->spacing;
+            cutGrid(view, measured);
+            data.volume = loadVolumeRegion(*job.scene.volume, gridPartRegion(*gridCut, grid->dims, world.rank(), ghost));
+            data.volume.part = gridPartPlacement(*gridCut, grid->dims, grid->origin, world.rank(), ghost);
             data.loadMs = msSince(t0);
-            tree = gridCut->tree;
             const glm::ivec3 n = data.volume.dims;
             partText = std::to_string(n.x) + "x" + std::to_string(n.y) + "x" + std::to_string(n.z) + " points read";
             return data;
@@ -210,14 +212,9 @@ int renderSortLast(const RenderOptions& options, World& world, Job& job)
             tree = meshCut->tree;
             partText = std::to_string(data.mesh.tets.size()) + " tets";
         } else {
-            const Volume& v = data.volume;
-            gridCut = byCost ? balanceGrid(v.dims, v.origin, v.spacing, world.size(), view,
-                                           gridCut ? &*gridCut : nullptr, measured)
-                             : partitionGrid(v.dims, v.origin, v.spacing, world.size());
-            gridOrigin = v.origin;
-            gridSpacing = v.spacing;
+            grid = GridHeader{data.volume.dims, data.volume.spacing, data.volume.origin};
+            cutGrid(view, measured);
             data.volume = cutGridPart(data.volume, *gridCut, world.rank(), ghost);
-            tree = gridCut->tree;
             const glm::ivec3 n = data.volume.dims;
             partText = std::to_string(n.x) + "x" + std::to_string(n.y) + "x" + std::to_string(n.z) + " points";
         }
@@ -235,11 +232,12 @@ int renderSortLast(const RenderOptions& options, World& world, Job& job)
         const auto t0 = std::chrono::steady_clock::now();
         // The whole data's camera, on every rank (it decides the cut): from the grid's header where the
         // format reads by regions, else from the whole data, loaded here and cut by loadPart.
-        const std::optional<GridHeader> header = job.scene.volume ? volumeHeader(*job.scene.volume) : std::nullopt;
+        grid = job.scene.volume ? volumeHeader(*job.scene.volume) : std::nullopt;
+        readsRegions = grid.has_value();
         SceneData data;
-        if (header) {
+        if (readsRegions) {
             if (!job.scene.camera)
-                job.scene.camera = fitCamera(header->origin, header->origin + glm::dvec3(header->dims - 1) * header->spacing);
+                job.scene.camera = fitCamera(grid->origin, grid->origin + glm::dvec3(grid->dims - 1) * grid->spacing);
             data = loadPart(*job.scene.camera, nullptr);
         } else {
             SceneData whole = loadSceneData(job.scene);
@@ -261,6 +259,13 @@ int renderSortLast(const RenderOptions& options, World& world, Job& job)
     // has hardware threads) its CPU time, since its wall time then counts the others' work too.
     const bool sharedCores = world.nodeSize() > static_cast<int>(std::thread::hardware_concurrency());
     std::vector<double> lastMs, lastCpuMs;  // the previous frame's render and CPU time per rank
+    // Each part's estimated work for the previous frame's view (empty after a re-cut, until measured).
+    std::vector<double> estimated;
+    const auto partEstimates = [&](const ViewCost& view) {
+        if (meshCut)  // each rank knows its own part's tetrahedra
+            return world.allGather(meshPartWork(session->data().mesh, tree, world.rank(), view));
+        return gridPartCosts(*gridCut, grid->origin, grid->spacing, [&](const glm::dvec3& p) { return view.density(p); });
+    };
     int recuts = 0;
     for (int k = 0; k < count; ++k) {
         const Camera camera = orbitCamera(camera0, k, count);
@@ -269,33 +274,24 @@ int renderSortLast(const RenderOptions& options, World& world, Job& job)
         // estimate predicts them, and then cuts (the old session freed first).
         const std::vector<double>& lastCost = sharedCores ? lastCpuMs : lastMs;
         bool recut = false;
+        double recutMs = 0.0;
         if (byCost && k > 0 && world.size() > 1) {
             const ViewCost before(orbitCamera(camera0, k - 1, count), width, height), next(camera, width, height);
-            std::vector<double> estimateBefore, estimateNext;
-            if (meshCut) {  // each rank knows its own part's tetrahedra
-                const TetMesh& part = session->data().mesh;
-                estimateBefore = world.allGather(meshPartWork(part, tree, world.rank(), before));
-                estimateNext = world.allGather(meshPartWork(part, tree, world.rank(), next));
-            } else {
-                const auto costs = [&](const ViewCost& view) {
-                    return gridPartCosts(*gridCut, gridOrigin, gridSpacing,
-                                         [&](const glm::dvec3& p) { return view.density(p); });
-                };
-                estimateBefore = costs(before);
-                estimateNext = costs(next);
+            if (estimated.empty())  // new parts: their estimate for the view they were measured in
+                estimated = partEstimates(before);
+            const std::vector<double> estimateNext = partEstimates(next);
+            recut = predictedImbalance(estimated, estimateNext, lastCost) > options.rebalanceAbove;
+            estimated = recut ? std::vector<double>{} : estimateNext;
+            if (recut) {
+                const auto t0 = std::chrono::steady_clock::now();
+                world.agree([&] {
+                    session.reset();
+                    const MeasuredFrame measured{before, lastCost};
+                    startSession(loadPart(camera, &measured), camera);
+                });
+                recutMs = msSince(t0);
+                ++recuts;
             }
-            recut = predictedImbalance(estimateBefore, estimateNext, lastCost) > options.rebalanceAbove;
-        }
-        double recutMs = 0.0;
-        if (recut) {
-            const auto t0 = std::chrono::steady_clock::now();
-            world.agree([&] {
-                session.reset();
-                const MeasuredFrame measured{ViewCost(orbitCamera(camera0, k - 1, count), width, height), lastCost};
-                startSession(loadPart(camera, &measured), camera);
-            });
-            recutMs = msSince(t0);
-            ++recuts;
         }
         Frame frame;
         double cpuMs = 0.0;

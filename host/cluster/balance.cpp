@@ -30,7 +30,10 @@ ViewCost::ViewCost(const Camera& camera, int width, int height)
     // Half the view's height is tan(angle / 2) at depth 1 (perspective) or the parallel scale.
     const double halfHeight = parallel_ ? camera.parallelScale : std::tan(glm::radians(camera.viewAngle) * 0.5);
     pixelsPerUnit_ = 0.5 * height_ / halfHeight;
-    minDepth_ = 0.05 * glm::length(camera.focalPoint - camera.position);
+    const double focalDistance = glm::length(camera.focalPoint - camera.position);
+    minDepth_ = 0.05 * focalDistance;
+    const double focalPerUnit = parallel_ ? pixelsPerUnit_ : pixelsPerUnit_ / focalDistance;
+    outsideDensity_ = kOutsideShare * focalPerUnit * focalPerUnit;
 }
 
 glm::dvec3 ViewCost::project(const glm::dvec3& p) const
@@ -43,13 +46,11 @@ glm::dvec3 ViewCost::project(const glm::dvec3& p) const
 
 double ViewCost::density(const glm::dvec3& p) const
 {
-    const double focal = parallel_ ? pixelsPerUnit_ : pixelsPerUnit_ / (20.0 * minDepth_);  // at the focal plane
-    const double outside = kOutsideShare * focal * focal;
     const glm::dvec3 s = project(p);
     if (!parallel_ && s.z <= 0.0)
-        return outside;  // behind the eye
+        return outsideDensity_;  // behind the eye
     if (s.x < 0.0 || s.x > width_ || s.y < 0.0 || s.y > height_)
-        return outside;
+        return outsideDensity_;
     const double perUnit = parallel_ ? pixelsPerUnit_ : pixelsPerUnit_ / std::max(s.z, minDepth_);
     return perUnit * perUnit;
 }

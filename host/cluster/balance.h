@@ -40,6 +40,7 @@ private:
     double width_, height_;
     double pixelsPerUnit_;  // parallel: pixels per world unit; perspective: the same at depth 1
     double minDepth_;
+    double outsideDensity_;  // density() out of view: 1/1000 of the focal plane's
     bool parallel_;
 };
 
